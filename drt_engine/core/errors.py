@@ -1,0 +1,13 @@
+"""Exceptions the core raises with messages meant for the user."""
+
+
+class DRTError(Exception):
+    """Base class: the Blender layer reports these as errors, the CLI exits non-zero."""
+
+
+class SceneError(DRTError):
+    """The scene cannot be rendered as given (invalid light, camera, geometry...)."""
+
+
+class RenderCancelled(DRTError):
+    """The user or a stop rule ended the render; the image so far is still valid."""

@@ -1,0 +1,267 @@
+"""SceneData: the plain-data contract between the Blender export and the tracer.
+
+Everything here is NumPy arrays and small dataclasses, nothing of Blender. A scene
+written by hand in a test is as good as one exported from Blender. Units follow
+Blender and Cycles; the export converts Blender's light units into the radiometric
+quantities documented on each field, so the core never needs Blender's conventions.
+
+Coordinates: right-handed, Z up, metres (scene units at unit scale 1), float64.
+Matrices are 4x4 float64 mapping object space to world space (column vectors).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _vec3(value) -> np.ndarray:
+    return np.asarray(value, dtype=np.float64).reshape(3)
+
+
+@dataclass
+class Closure:
+    """One shader closure with its mixing weight.
+
+    ``kind`` is one of ``CLOSURE_KINDS``. Fields a kind does not use are ignored.
+    Principled follows Cycles' layering: coat over (metal | glass | specular over diffuse).
+    """
+
+    kind: str
+    weight: np.ndarray = field(default_factory=lambda: np.ones(3))
+    color: np.ndarray = field(default_factory=lambda: np.full(3, 0.8))
+    roughness: float = 0.5
+    metallic: float = 0.0
+    ior: float = 1.5
+    specular_ior_level: float = 0.5
+    specular_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    transmission: float = 0.0
+    coat_weight: float = 0.0
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    coat_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    emission: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
+
+    def __post_init__(self):
+        if self.kind not in CLOSURE_KINDS:
+            raise ValueError(f"unknown closure kind {self.kind!r}")
+        for name in ("weight", "color", "specular_tint", "coat_tint", "emission"):
+            setattr(self, name, _vec3(getattr(self, name)))
+
+
+CLOSURE_KINDS = (
+    "PRINCIPLED",  # full Principled BSDF
+    "DIFFUSE",  # Lambert, colour = albedo
+    "GLOSSY",  # GGX reflection tinted by colour, no Fresnel (Blender's Glossy BSDF)
+    "GLASS",  # smooth or rough dielectric, reflection + refraction tinted by colour
+    "REFRACTION",  # refraction only, tinted by colour
+    "EMISSION",  # emitted radiance ``emission``, two-sided
+    "TRANSPARENT",  # straight through, tinted by colour
+)
+
+
+@dataclass
+class Material:
+    """A weighted sum of closures (Mix and Add Shader flattened by the export).
+
+    Principled alpha is expressed as a mix with a TRANSPARENT closure.
+    """
+
+    name: str
+    closures: list[Closure]
+
+    @property
+    def emission(self) -> np.ndarray:
+        """Total emitted radiance of the material (constant over the surface)."""
+        total = np.zeros(3)
+        for c in self.closures:
+            if c.kind in ("EMISSION", "PRINCIPLED"):
+                total += c.weight * c.emission
+        return total
+
+
+DEFAULT_MATERIAL = Material("Default", [Closure("PRINCIPLED", color=(0.8, 0.8, 0.8))])
+"""Blender's default surface for objects without a material."""
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh in its object space.
+
+    ``corner_normals`` (T, 3, 3) hold the shading normal of each triangle corner in
+    object space (smooth, flat or custom split normals alike); ``None`` means flat.
+    ``material_indices`` (T,) index ``SceneData.materials``. ``uvs`` (T, 3, 2) or None.
+    """
+
+    name: str
+    vertices: np.ndarray
+    triangles: np.ndarray
+    material_indices: np.ndarray
+    corner_normals: np.ndarray | None = None
+    uvs: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        self.triangles = np.ascontiguousarray(self.triangles, dtype=np.int32).reshape(-1, 3)
+        self.material_indices = np.ascontiguousarray(self.material_indices, dtype=np.int32).reshape(-1)
+        if self.material_indices.size == 1 and len(self.triangles) != 1:
+            self.material_indices = np.full(len(self.triangles), self.material_indices[0], np.int32)
+        if len(self.material_indices) != len(self.triangles):
+            raise ValueError(f"mesh {self.name!r}: one material index per triangle expected")
+        if self.corner_normals is not None:
+            self.corner_normals = np.asarray(self.corner_normals, dtype=np.float32).reshape(-1, 3, 3)
+        if self.uvs is not None:
+            self.uvs = np.asarray(self.uvs, dtype=np.float32).reshape(-1, 3, 2)
+
+
+@dataclass
+class Instance:
+    """One placement of a mesh: ``mesh`` indexes ``SceneData.meshes``.
+
+    ``matrices`` (S, 4, 4) are object-to-world transforms at S evenly spaced times over
+    the shutter interval; S == 1 for an object that does not move.
+    """
+
+    mesh: int
+    matrices: np.ndarray
+    name: str = ""
+
+    def __post_init__(self):
+        self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Transform at the shutter's centre step (the static transform)."""
+        return self.matrices[len(self.matrices) // 2]
+
+
+LIGHT_KINDS = ("POINT", "SPOT", "SUN", "AREA")
+AREA_SHAPES = ("SQUARE", "RECTANGLE", "DISK", "ELLIPSE")
+
+
+@dataclass
+class Light:
+    """A light in radiometric units (the export has applied Cycles' conversions).
+
+    Orientation comes from ``matrix`` (light space to world, scale removed): lights
+    shine along local -Z, area lights span local X (``size_x``) and Y (``size_y``).
+
+    - POINT, SPOT: ``intensity`` is radiant intensity (W/sr) of the whole light;
+      with ``radius`` > 0 it is a sphere (or, with ``soft_falloff``, a disk facing the
+      shaded point, as Cycles does) of radiance intensity / (π radius²).
+      SPOT adds ``spot_size`` (full cone angle, radians) and ``spot_blend``.
+    - SUN: ``irradiance`` (W/m² on a facing surface), ``angle`` (full angular diameter).
+    - AREA: ``radiance`` (W/(m² sr)), one-sided along -Z, with ``shape``, ``size_x``,
+      ``size_y`` in world units and ``spread`` (radians, π = no restriction).
+    """
+
+    kind: str
+    matrix: np.ndarray
+    intensity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    irradiance: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    radiance: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    radius: float = 0.0
+    soft_falloff: bool = True
+    spot_size: float = np.pi / 4
+    spot_blend: float = 0.15
+    angle: float = 0.0
+    shape: str = "SQUARE"
+    size_x: float = 1.0
+    size_y: float = 1.0
+    spread: float = np.pi
+    name: str = ""
+
+    def __post_init__(self):
+        if self.kind not in LIGHT_KINDS:
+            raise ValueError(f"unknown light kind {self.kind!r}")
+        if self.shape not in AREA_SHAPES:
+            raise ValueError(f"unknown area light shape {self.shape!r}")
+        self.matrix = np.asarray(self.matrix, dtype=np.float64).reshape(4, 4)
+        for name in ("intensity", "irradiance", "radiance"):
+            setattr(self, name, _vec3(getattr(self, name)))
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.matrix[:3, 3].copy()
+
+    @property
+    def direction(self) -> np.ndarray:
+        """Unit vector the light shines along (local -Z in world space)."""
+        d = -self.matrix[:3, 2]
+        return d / np.linalg.norm(d)
+
+
+@dataclass
+class World:
+    """Uniform environment: ``radiance`` seen by rays that escape (colour times strength)."""
+
+    radiance: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self):
+        self.radiance = _vec3(self.radiance)
+
+
+@dataclass
+class Camera:
+    """A pinhole or orthographic camera looking along local -Z with Y up.
+
+    ``frame`` = (left, right, bottom, top) of the image window in camera space on the
+    plane z = -1 (perspective) or in scene units (orthographic); sensor fit, pixel
+    aspect and shift are already folded into it. ``resolution`` is the full image in
+    pixels after the resolution percentage; ``window`` = (x0, y0, x1, y1) is the pixel
+    rectangle actually rendered (border render), rows counted from the bottom as in
+    Blender. ``matrices`` (S, 4, 4) as for ``Instance``.
+    """
+
+    matrices: np.ndarray
+    frame: tuple[float, float, float, float]
+    resolution: tuple[int, int]
+    type: str = "PERSP"
+    clip_start: float = 0.1
+    clip_end: float = 1000.0
+    window: tuple[int, int, int, int] | None = None
+    aperture_radius: float = 0.0
+    focus_distance: float = 10.0
+
+    def __post_init__(self):
+        self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+        w, h = (int(v) for v in self.resolution)
+        if w < 1 or h < 1:
+            raise ValueError(f"camera resolution must be positive, got {w}x{h}")
+        self.resolution = (w, h)
+        if self.window is None:
+            self.window = (0, 0, w, h)
+        x0, y0, x1, y1 = (int(v) for v in self.window)
+        if not (0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h):
+            raise ValueError(f"render window {self.window} outside the image {w}x{h}")
+        self.window = (x0, y0, x1, y1)
+        if self.type not in ("PERSP", "ORTHO"):
+            raise ValueError(f"unknown camera type {self.type!r}")
+
+    @property
+    def matrix(self) -> np.ndarray:
+        return self.matrices[len(self.matrices) // 2]
+
+    @property
+    def window_size(self) -> tuple[int, int]:
+        x0, y0, x1, y1 = self.window
+        return x1 - x0, y1 - y0
+
+
+@dataclass
+class SceneData:
+    """Everything the tracer needs to render one image."""
+
+    camera: Camera
+    meshes: list[Mesh] = field(default_factory=list)
+    instances: list[Instance] = field(default_factory=list)
+    materials: list[Material] = field(default_factory=lambda: [DEFAULT_MATERIAL])
+    lights: list[Light] = field(default_factory=list)
+    world: World = field(default_factory=World)
+    film_transparent: bool = False
+    warnings: list[str] = field(default_factory=list)
+    """Messages for the user gathered during export (unsupported nodes and the like)."""
+
+    def triangle_count(self) -> int:
+        return sum(len(self.meshes[i.mesh].triangles) for i in self.instances)

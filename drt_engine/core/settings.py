@@ -1,0 +1,64 @@
+"""Render settings the core reads: the plain-data mirror of ``scene.drt``."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+SAMPLING_PATTERNS = ("GRID", "JITTERED", "SOBOL")
+FILTER_TYPES = ("BOX", "GAUSSIAN", "BLACKMAN_HARRIS")
+
+PASSES = (
+    "Combined",  # RGBA
+    "Depth",  # Z: distance along the view axis, as Blender's Depth pass
+    "Normal",  # world-space shading normal
+    "Position",  # world-space hit position
+    "DiffCol",  # diffuse albedo of the first hit
+    "GlossCol",  # glossy albedo of the first hit
+    "Emit",  # emission seen directly
+    "Env",  # environment seen directly
+    "Sample Count",  # samples taken per pixel
+    "Noise",  # standard error of the Combined estimate per pixel
+)
+PASS_CHANNELS = {
+    "Combined": "RGBA",
+    "Depth": "Z",
+    "Normal": "XYZ",
+    "Position": "XYZ",
+    "DiffCol": "RGB",
+    "GlossCol": "RGB",
+    "Emit": "RGB",
+    "Env": "RGB",
+    "Sample Count": "X",
+    "Noise": "RGB",
+}
+
+
+@dataclass
+class RenderSettings:
+    samples: int = 64
+    seed: int = 0
+    sampling_pattern: str = "SOBOL"
+    max_depth: int = 8
+    clamp: float = 0.0
+    threads: int = 0
+    filter_type: str = "BLACKMAN_HARRIS"
+    filter_size: float = 1.5
+    passes: tuple[str, ...] = ("Combined",)
+    use_adaptive_sampling: bool = False
+    adaptive_threshold: float = 0.01
+    adaptive_min_samples: int = 0
+    time_limit: float = 0.0
+    target_error: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.sampling_pattern not in SAMPLING_PATTERNS:
+            raise ValueError(f"unknown sampling pattern {self.sampling_pattern!r}")
+        if self.filter_type not in FILTER_TYPES:
+            raise ValueError(f"unknown filter type {self.filter_type!r}")
+        if self.samples < 1:
+            raise ValueError("samples must be at least 1")
+        unknown = set(self.passes) - set(PASSES)
+        if unknown:
+            raise ValueError(f"unknown passes {sorted(unknown)}")
+        if "Combined" not in self.passes:
+            self.passes = ("Combined",) + tuple(self.passes)
