@@ -1,0 +1,271 @@
+"""Light sampling and evaluation: point, spot, sun, area shapes, emissive meshes, world.
+
+Each light is one next-event strategy that casts one shadow ray per shading point;
+emissive triangles together form one strategy, the uniform world another. Delta
+lights (radius 0, sun angle 0) return pdf = inf so multiple importance sampling gives
+them full weight. Area lights, emissive triangles and the world can also be hit by
+continued rays, and expose ``pdf`` for the power heuristic.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import microfacet as mf
+from .errors import SceneError
+from .scene import Light, SceneData
+
+_TINY = 1e-30
+
+
+class LightSample:
+    """Direction to a light, distance (inf for distant), and radiance / pdf."""
+
+    def __init__(self, wi, dist, value, pdf, tmax_scale=None):
+        self.wi, self.dist, self.value, self.pdf = wi, dist, value, pdf
+        self.tmax_scale = tmax_scale  # distance to stop short of an emitter that is geometry
+
+
+def _smoothstep(t):
+    t = np.clip(t, 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+def _lum(c):
+    return float(np.dot(c, [0.2126, 0.7152, 0.0722]))
+
+
+def _orthonormal(n):
+    """Two unit vectors perpendicular to each row of n (Duff et al. 2017)."""
+    s = np.where(n[:, 2] >= 0, 1.0, -1.0)
+    a = -1.0 / (s + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * b, -s * n[:, 0]], axis=1)
+    bt = np.stack([b, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
+    return t, bt
+
+
+def validate_light(light: Light):
+    for name in ("intensity", "irradiance", "radiance"):
+        value = getattr(light, name)
+        if not np.isfinite(value).all() or (value < 0).any():
+            raise SceneError(f"light {light.name!r} has an invalid {name} {value.tolist()} (must be finite and >= 0)")
+    for name in ("radius", "size_x", "size_y", "angle", "spot_size", "spot_blend"):
+        value = getattr(light, name)
+        if not np.isfinite(value) or value < 0:
+            raise SceneError(f"light {light.name!r} has an invalid {name} {value}")
+
+
+def light_power_zero(light: Light) -> bool:
+    """Lights that cannot contribute are dropped, as Cycles drops them."""
+    if light.kind in ("POINT", "SPOT"):
+        return not np.any(light.intensity > 0)
+    if light.kind == "SUN":
+        return not np.any(light.irradiance > 0)
+    return not np.any(light.radiance > 0) or light.size_x <= 0 or light.size_y <= 0
+
+
+class Lights:
+    """All next-event strategies of a scene."""
+
+    def __init__(self, scene: SceneData, geometry, shaders):
+        for light in scene.lights:
+            validate_light(light)
+        self.lights = [light for light in scene.lights if not light_power_zero(light)]
+        self.area = [i for i, light in enumerate(self.lights) if light.kind == "AREA"]
+        self.geometry = geometry
+        emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))
+        tri_emission = emission[geometry.material] if len(geometry.material) else np.zeros((0, 3))
+        power = tri_emission @ np.array([0.2126, 0.7152, 0.0722]) * geometry.area
+        self.emissive = np.flatnonzero(power > 0)
+        if len(self.emissive):
+            cdf = np.cumsum(power[self.emissive])
+            self.emissive_cdf = cdf / cdf[-1]
+            self.emissive_prob = np.zeros(len(power))
+            self.emissive_prob[self.emissive] = power[self.emissive] / cdf[-1]
+        self.tri_emission = tri_emission
+        self.world = scene.world.radiance if np.any(scene.world.radiance > 0) else None
+        self.strategies = len(self.lights) + (1 if len(self.emissive) else 0) + (1 if self.world is not None else 0)
+
+    # -- next-event estimation ----------------------------------------------------
+    def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray) -> LightSample:
+        """Strategy k for shading points ``pos``; ``normal`` faces the incoming ray."""
+        if k < len(self.lights):
+            light = self.lights[k]
+            return getattr(self, "_sample_" + light.kind.lower())(light, pos, u)
+        k -= len(self.lights)
+        if len(self.emissive) and k == 0:
+            return self._sample_emissive(pos, u, u_pick)
+        return self._sample_world(normal, u)
+
+    def _sample_point(self, light: Light, pos, u, spot=False):
+        c = light.position
+        to = c - pos
+        d = np.linalg.norm(to, axis=1)
+        wi = to / np.maximum(d, _TINY)[:, None]
+        n = len(pos)
+        if light.radius <= 0:
+            value = light.intensity / np.maximum(d * d, _TINY)[:, None]
+            sample = LightSample(wi, d, value, np.full(n, np.inf))
+        elif light.soft_falloff:
+            sample = self._sample_facing_disk(light, pos, wi, d, u)
+        else:
+            sample = self._sample_sphere(light, pos, wi, d, u)
+        if spot:
+            sample.value = sample.value * self._spot(light, -wi)[:, None]
+        return sample
+
+    def _sample_spot(self, light, pos, u):
+        return self._sample_point(light, pos, u, spot=True)
+
+    @staticmethod
+    def _spot(light: Light, direction):
+        """Cycles' spot cone: smoothstep over the blend region, no extra cosine."""
+        cos_half = np.cos(min(light.spot_size, np.pi) / 2.0)
+        cos_a = direction @ light.direction
+        smooth = (1.0 - cos_half) * light.spot_blend
+        if smooth <= 0:
+            return (cos_a > cos_half).astype(float)
+        return np.where(cos_a > cos_half, _smoothstep((cos_a - cos_half) / smooth), 0.0)
+
+    def _sample_facing_disk(self, light, pos, wi_c, d, u):
+        """Cycles' soft-falloff point light: a disk of radius r facing the shaded point."""
+        r = light.radius
+        t, b = _orthonormal(-wi_c)
+        disk = mf.concentric_disk(u) * r
+        q = light.position + disk[:, :1] * t + disk[:, 1:] * b
+        to = q - pos
+        dist = np.linalg.norm(to, axis=1)
+        wi = to / np.maximum(dist, _TINY)[:, None]
+        cos_l = np.clip(-mf.dot(wi, -wi_c), 0.0, 1.0)
+        radiance = light.intensity / (np.pi * r * r)
+        pdf = dist * dist / np.maximum(cos_l * np.pi * r * r, _TINY)
+        value = radiance * (np.pi * r * r * cos_l / np.maximum(dist * dist, _TINY))[:, None]
+        return LightSample(wi, dist, value, pdf)
+
+    def _sample_sphere(self, light, pos, wi_c, d, u):
+        """Uniform cone sampling of the solid angle a sphere light subtends."""
+        r = light.radius
+        sin2 = np.clip(r * r / np.maximum(d * d, _TINY), 0.0, 1.0)
+        cos_max = np.sqrt(1.0 - sin2)
+        cos_t = 1.0 - u[:, 0] * (1.0 - cos_max)
+        sin_t = np.sqrt(np.maximum(1.0 - cos_t * cos_t, 0.0))
+        phi = 2.0 * np.pi * u[:, 1]
+        t, b = _orthonormal(wi_c)
+        wi = (sin_t * np.cos(phi))[:, None] * t + (sin_t * np.sin(phi))[:, None] * b + cos_t[:, None] * wi_c
+        # distance to the sphere's near surface along wi
+        proj = d * cos_t
+        dist = proj - np.sqrt(np.maximum(r * r - d * d * sin_t * sin_t, 0.0))
+        solid = 2.0 * np.pi * np.maximum(1.0 - cos_max, _TINY)
+        radiance = light.intensity / (np.pi * r * r)
+        inside = d <= r
+        value = np.where(inside[:, None], 0.0, radiance * solid[:, None])
+        return LightSample(wi, np.maximum(dist, 0.0), value, 1.0 / solid)
+
+    def _sample_sun(self, light, pos, u):
+        n = len(pos)
+        to_sun = -light.direction
+        half = min(light.angle, np.pi) / 2.0
+        if half <= 0:
+            return LightSample(np.tile(to_sun, (n, 1)), np.full(n, np.inf),
+                               np.tile(light.irradiance, (n, 1)), np.full(n, np.inf))
+        cos_max = np.cos(half)
+        cos_t = 1.0 - u[:, 0] * (1.0 - cos_max)
+        sin_t = np.sqrt(np.maximum(1.0 - cos_t * cos_t, 0.0))
+        phi = 2.0 * np.pi * u[:, 1]
+        axis = np.tile(to_sun, (n, 1))
+        t, b = _orthonormal(axis)
+        wi = (sin_t * np.cos(phi))[:, None] * t + (sin_t * np.sin(phi))[:, None] * b + cos_t[:, None] * axis
+        solid = 2.0 * np.pi * (1.0 - cos_max)
+        radiance = light.irradiance / (np.pi * np.sin(half) ** 2)
+        return LightSample(wi, np.full(n, np.inf), np.tile(radiance * solid, (n, 1)), np.full(n, 1.0 / solid))
+
+    def _area_frame(self, light: Light):
+        m = light.matrix
+        ex = m[:3, 0] / np.linalg.norm(m[:3, 0])
+        ey = m[:3, 1] / np.linalg.norm(m[:3, 1])
+        ez = m[:3, 2] / np.linalg.norm(m[:3, 2])
+        disk = light.shape in ("DISK", "ELLIPSE")
+        sx = light.size_x
+        sy = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size_x
+        area = (np.pi / 4.0 if disk else 1.0) * sx * sy
+        return light.position, ex, ey, ez, sx, sy, disk, area
+
+    def _sample_area(self, light, pos, u):
+        c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
+        if disk:
+            p2 = mf.concentric_disk(u) * 0.5
+        else:
+            p2 = u - 0.5
+        q = c + (p2[:, :1] * sx) * ex + (p2[:, 1:] * sy) * ey
+        to = q - pos
+        dist = np.linalg.norm(to, axis=1)
+        wi = to / np.maximum(dist, _TINY)[:, None]
+        cos_l = wi @ ez  # the light emits along -Z: seen from the front when wi . ez > 0
+        front = cos_l > 0
+        pdf = np.where(front, dist * dist / np.maximum(cos_l * area, _TINY), 0.0)
+        value = np.where(front[:, None], light.radiance * (area * cos_l / np.maximum(dist * dist, _TINY))[:, None], 0.0)
+        return LightSample(wi, dist, value, pdf)
+
+    def _sample_emissive(self, pos, u, u_pick):
+        g = self.geometry
+        pick = self.emissive[np.minimum(np.searchsorted(self.emissive_cdf, u_pick, side="right"),
+                                        len(self.emissive) - 1)]
+        p = g.vertices[g.triangles[pick]]
+        su = np.sqrt(u[:, 0])
+        b0, b1 = 1.0 - su, u[:, 1] * su
+        q = b0[:, None] * p[:, 0] + b1[:, None] * p[:, 1] + (1.0 - b0 - b1)[:, None] * p[:, 2]
+        to = q - pos
+        dist = np.linalg.norm(to, axis=1)
+        wi = to / np.maximum(dist, _TINY)[:, None]
+        cos_l = np.abs(mf.dot(wi, g.ng[pick]))
+        pdf_area = self.emissive_prob[pick] / g.area[pick]
+        pdf = dist * dist / np.maximum(cos_l, _TINY) * pdf_area
+        value = np.where((cos_l > 0)[:, None],
+                         self.tri_emission[pick] / np.maximum(pdf, _TINY)[:, None], 0.0)
+        return LightSample(wi, dist, value, pdf, tmax_scale=g.offset_scale(pick, q))
+
+    def _sample_world(self, normal, u):
+        local = mf.cosine_hemisphere(u)
+        t, b = _orthonormal(normal)
+        wi = local[:, :1] * t + local[:, 1:2] * b + local[:, 2:] * normal
+        pdf = local[:, 2] / np.pi
+        value = np.where((pdf > 0)[:, None], self.world / np.maximum(pdf, _TINY)[:, None], 0.0)
+        return LightSample(wi, np.full(len(u), np.inf), value, pdf)
+
+    # -- lights hit by rays (multiple importance sampling) --------------------------
+    def intersect_area(self, origins, dirs, tmax):
+        """Nearest area light along each ray before tmax: (t, light index or -1, radiance)."""
+        n = len(origins)
+        best_t = np.array(tmax, dtype=np.float64, copy=True)
+        best = np.full(n, -1)
+        for i in self.area:
+            c, ex, ey, ez, sx, sy, disk, _ = self._area_frame(self.lights[i])
+            denom = dirs @ ez
+            front = denom > 0
+            t = ((c - origins) @ ez) / np.where(front, denom, 1.0)
+            q = origins + t[:, None] * dirs - c
+            x, y = (q @ ex) / (0.5 * sx), (q @ ey) / (0.5 * sy)
+            inside = (x * x + y * y <= 1.0) if disk else ((np.abs(x) <= 1.0) & (np.abs(y) <= 1.0))
+            ok = front & inside & (t > 0) & (t < best_t)
+            best_t[ok] = t[ok]
+            best[ok] = i
+        radiance = np.zeros((n, 3))
+        for i in self.area:
+            radiance[best == i] = self.lights[i].radiance
+        return best_t, best, radiance
+
+    def pdf_area(self, light_index, origins, dirs, t):
+        """Solid-angle density of sampling ``light_index`` toward dirs from origins."""
+        light = self.lights[light_index]
+        *_, ez, _sx, _sy, _disk, area = self._area_frame(light)
+        cos_l = np.maximum(dirs @ ez, _TINY)
+        return t * t / (cos_l * area)
+
+    def pdf_emissive(self, prim, dirs, t):
+        g = self.geometry
+        cos_l = np.maximum(np.abs(mf.dot(dirs, g.ng[prim])), _TINY)
+        return self.emissive_prob[prim] / g.area[prim] * t * t / cos_l
+
+    @staticmethod
+    def pdf_world(prev_normal, dirs):
+        return np.maximum(mf.dot(prev_normal, dirs), 0.0) / np.pi

@@ -1,0 +1,394 @@
+"""The distribution ray tracing loop over wavefronts.
+
+A wave is a batch of camera samples (pixel, sample id). Each depth step intersects
+all live rays at once, adds what they see (emission, lights, world, each weighted
+by multiple importance sampling against light sampling), estimates direct light at
+every hit with one shadow ray per light strategy, and continues each path through
+one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
+Every random number is drawn from ``Sampler`` with the camera sample's own id.
+"""
+from __future__ import annotations
+
+import os
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import camera as camera_rays
+from . import microfacet as mf
+from .accel import Geometry, spawn
+from .bsdf import MaterialShader
+from .errors import SceneError
+from .film import Film, PixelFilter
+from .lights import Lights
+from .sampling import Sampler
+from .scene import SceneData
+from .settings import RenderSettings
+
+WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
+_TINY = 1e-30
+_MISS_DEPTH = 1e10  # Blender's depth for the background
+
+
+@dataclass
+class RenderResult:
+    passes: dict
+    stats: dict
+    cancelled: bool = False
+    warnings: list = field(default_factory=list)
+
+
+@dataclass
+class ProgressUpdate:
+    fraction: float
+    samples_done: int
+    samples_total: int
+    elapsed: float
+    _film: Film
+
+    def passes(self) -> dict:
+        return self._film.images()
+
+
+def _power(a, b):
+    """Power heuristic weight of strategy a against b (densities per solid angle)."""
+    a2 = np.where(np.isinf(a), 1.0, a * a)
+    b2 = np.where(np.isinf(a), 0.0, b * b)
+    return a2 / np.maximum(a2 + b2, _TINY)
+
+
+class _Dims:
+    """Sample dimensions of a path: pixel, lens, then a fixed stride per depth step."""
+
+    PIXEL, LENS = 0, 2
+
+    def __init__(self, strategies: int):
+        self.stride = 4 + 2 * strategies
+
+    def lobe(self, depth):
+        return 4 + depth * self.stride
+
+    def pick(self, depth):
+        return 4 + depth * self.stride + 2
+
+    def light(self, depth, k):
+        return 4 + depth * self.stride + 4 + 2 * k
+
+
+class Renderer:
+    """Renders one SceneData with one RenderSettings."""
+
+    def __init__(self, scene: SceneData, settings: RenderSettings):
+        if scene.camera is None:
+            raise SceneError("the scene has no camera")
+        self.scene = scene
+        self.settings = settings
+        threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
+        self.threads = threads
+        self.pool = ThreadPoolExecutor(threads) if threads > 1 else None
+        self.camera = scene.camera
+        self.geometry = Geometry(scene, self.camera.matrix[:3, 3], self.pool)
+        for i, mesh in enumerate(scene.meshes):
+            if len(mesh.material_indices) and (mesh.material_indices.max() >= len(scene.materials)
+                                               or mesh.material_indices.min() < 0):
+                raise SceneError(f"mesh {mesh.name!r} refers to a material that does not exist")
+        self.shaders = [MaterialShader(m) for m in scene.materials]
+        self.lights = Lights(scene, self.geometry, self.shaders)
+        self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
+        self.filter = PixelFilter(settings.filter_type, settings.filter_size)
+        self.dims = _Dims(self.lights.strategies)
+        w, h = self.camera.window_size
+        self.film = Film(w, h, settings.passes)
+        self.warnings = list(scene.warnings) + self.geometry.warnings
+        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
+
+    # -- driver ---------------------------------------------------------------------
+    def render(self, progress=None) -> RenderResult:
+        start = time.perf_counter()
+        w, h = self.camera.window_size
+        x0, y0, _, _ = self.camera.window
+        n_pix = w * h
+        spp = self.sampler.samples
+        per_round = max(1, min(spp, WAVE // n_pix)) if n_pix < WAVE else 1
+        done = 0
+        cancelled = False
+        try:
+            while done < spp:
+                count = min(per_round, spp - done)
+                total = n_pix * count
+                for a in range(0, total, WAVE):
+                    flat = np.arange(a, min(a + WAVE, total), dtype=np.int64)
+                    pixel = flat % n_pix
+                    sample = done + flat // n_pix
+                    self._trace(pixel, sample, x0, y0, w)
+                    if progress is not None and a + WAVE < total:
+                        frac = (done + (a + WAVE) / n_pix) / spp
+                        if progress(ProgressUpdate(frac, done, spp, time.perf_counter() - start, self.film)) is False:
+                            cancelled = True
+                            break
+                if cancelled:
+                    break
+                done += count
+                if progress is not None and done < spp:
+                    if progress(ProgressUpdate(done / spp, done, spp, time.perf_counter() - start, self.film)) is False:
+                        cancelled = True
+                        break
+        finally:
+            if self.pool is not None:
+                self.pool.shutdown(wait=True)
+        elapsed = time.perf_counter() - start
+        stats = {"samples": int(self.film.count.max()) if n_pix else 0, "samples_requested": spp,
+                 "elapsed": elapsed, "rays": dict(self.rays), "threads": self.threads,
+                 "triangles": self.geometry.triangle_count, "light_strategies": self.lights.strategies}
+        return RenderResult(self.film.images(), stats, cancelled, self.warnings)
+
+    # -- one wave of camera samples ---------------------------------------------------
+    def _trace(self, pixel, sample, x0, y0, w):
+        s = self.settings
+        passes = set(s.passes)
+        n = len(pixel)
+        pix_id = pixel.astype(np.uint32)
+        seed_pixel = (pixel % w + x0) + (pixel // w + y0) * self.camera.resolution[0]  # stable across windows
+        seed_pixel = seed_pixel.astype(np.uint32)
+        off = self.filter.offset(self.sampler.get2d(seed_pixel, sample, _Dims.PIXEL))
+        px = (pixel % w + x0) + 0.5 + off[:, 0]
+        py = (pixel // w + y0) + 0.5 + off[:, 1]
+        lens = self.sampler.get2d(seed_pixel, sample, _Dims.LENS) if self.camera.aperture_radius > 0 else None
+        cam = camera_rays.generate(self.camera, px, py, lens)
+        self.rays["camera"] += n
+
+        radiance = np.zeros((n, 3))
+        alpha = np.ones(n)
+        aux = {name: np.zeros((n, len(ch))) for name, ch in
+               (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"),
+                ("GlossCol", "RGB"), ("Emit", "RGB"), ("Env", "RGB")) if name in passes}
+        if "Depth" in aux:
+            aux["Depth"][:] = _MISS_DEPTH
+
+        # live path state, indexed by path id
+        path = np.arange(n)
+        origins, dirs, tmax = cam.origins, cam.directions, cam.tmax
+        throughput = np.ones((n, 3))
+        prev_pdf = np.full(n, np.inf)  # solid-angle pdf of the last continuation (inf: delta/camera)
+        prev_normal = np.zeros((n, 3))
+        straight = np.ones(n, bool)  # seen only through transparent surfaces from the camera
+
+        for depth in range(s.max_depth + 1):
+            if len(path) == 0:
+                break
+            hits = self.geometry.intersect(origins, dirs, tmax)
+            light_t, light_id, light_le = self.lights.intersect_area(origins, dirs, np.minimum(hits.t, tmax))
+            on_light = light_id >= 0
+            on_surface = hits.hit & ~on_light
+            escaped = ~hits.hit & ~on_light
+
+            # lights hit directly: visible to reflected and refracted rays, not to the camera
+            idx = np.flatnonzero(on_light & ~straight[path]) if depth > 0 else np.zeros(0, int)
+            if len(idx):
+                contrib = light_le[idx].copy()
+                smooth = ~np.isinf(prev_pdf[idx])
+                if smooth.any():
+                    k = idx[smooth]
+                    pl = np.zeros(len(k))
+                    for li in np.unique(light_id[k]):
+                        sel = light_id[k] == li
+                        pl[sel] = self.lights.pdf_area(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]])
+                    contrib[smooth] *= _power(prev_pdf[k], pl)[:, None]
+                radiance[path[idx]] += throughput[idx] * contrib
+
+            # escaped rays see the world
+            idx = np.flatnonzero(escaped)
+            if len(idx):
+                st = straight[path[idx]]
+                world = self.scene.world.radiance
+                if "Env" in aux:
+                    aux["Env"][path[idx[st]]] += throughput[idx[st]] * world
+                if self.scene.film_transparent:
+                    alpha[path[idx[st]]] -= throughput[idx[st]].mean(axis=1)
+                    idx = idx[~st]
+                if len(idx) and self.lights.world is not None:
+                    weight = np.ones(len(idx))
+                    smooth = ~np.isinf(prev_pdf[idx])
+                    if smooth.any():
+                        k = idx[smooth]
+                        weight[smooth] = _power(prev_pdf[k], self.lights.pdf_world(prev_normal[k], dirs[k]))
+                    radiance[path[idx]] += throughput[idx] * world * weight[:, None]
+
+            surf = np.flatnonzero(on_surface)
+            if len(surf) == 0:
+                break
+            p_ids = path[surf]
+            pos, ng, ns = self.geometry.surface(hits, surf)
+            prim = hits.prim[surf]
+            mat = self.geometry.material[prim]
+            wo = -dirs[surf]
+
+            # emission seen (two-sided), weighted against light sampling of emissive triangles
+            emission = self.lights.tri_emission[prim] if len(self.lights.tri_emission) else np.zeros((len(surf), 3))
+            glowing = np.flatnonzero(emission.max(axis=1) > 0)
+            if len(glowing):
+                weight = np.ones(len(glowing))
+                k = surf[glowing]
+                smooth = ~np.isinf(prev_pdf[k])
+                if smooth.any():
+                    pl = self.lights.pdf_emissive(prim[glowing[smooth]], dirs[k[smooth]], hits.t[k[smooth]])
+                    weight[smooth] = _power(prev_pdf[k[smooth]], pl)
+                e = throughput[k] * emission[glowing] * weight[:, None]
+                radiance[p_ids[glowing]] += e
+                if "Emit" in aux:
+                    first = straight[p_ids[glowing]]
+                    aux["Emit"][p_ids[glowing[first]]] += e[first]
+
+            # orient the frame toward the incoming ray
+            inside = mf.dot(wo, ng) < 0
+            flip = np.where(inside, -1.0, 1.0)[:, None]
+            ng_o = ng * flip
+            ns_o = ns * flip
+            bad = mf.dot(wo, ns_o) <= 1e-6
+            ns_o[bad] = ng_o[bad]
+            tangent, bitangent = _frame(ns_o)
+            wo_l = _to_local(wo, tangent, bitangent, ns_o)
+
+            first_hit = np.full(len(surf), depth == 0)
+            if depth == 0:
+                if "Depth" in aux:
+                    aux["Depth"][p_ids, 0] = (cam.t_start[p_ids] + hits.t[surf]) * cam.depth_per_t[p_ids]
+                if "Normal" in aux:
+                    aux["Normal"][p_ids] = ns
+                if "Position" in aux:
+                    aux["Position"][p_ids] = pos
+
+            scale = self.geometry.offset_scale(prim, pos)
+            next_state = []
+            shadow = []
+            for m in np.unique(mat):
+                g = np.flatnonzero(mat == m)
+                shader = self.shaders[m]
+                if ("DiffCol" in aux or "GlossCol" in aux) and first_hit[g].any():
+                    fg = g[first_hit[g]]
+                    diff, gloss = shader.colors(wo_l[fg, 2])
+                    if "DiffCol" in aux:
+                        aux["DiffCol"][p_ids[fg]] = diff
+                    if "GlossCol" in aux:
+                        aux["GlossCol"][p_ids[fg]] = gloss
+                shadow.append(self._direct(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o, ns_o,
+                                           tangent, bitangent, wo_l, inside, scale, throughput[surf]))
+                if shader.can_continue and depth < s.max_depth:
+                    next_state.append(self._continue(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o,
+                                                     ns_o, tangent, bitangent, wo_l, inside, scale,
+                                                     throughput[surf], straight[p_ids]))
+            self._resolve_shadows(shadow, radiance)
+
+            if not next_state:
+                break
+            path = np.concatenate([st[0] for st in next_state])
+            origins = np.concatenate([st[1] for st in next_state])
+            dirs = np.concatenate([st[2] for st in next_state])
+            throughput = np.concatenate([st[3] for st in next_state])
+            prev_pdf = np.concatenate([st[4] for st in next_state])
+            prev_normal = np.concatenate([st[5] for st in next_state])
+            straight = np.zeros(n, bool)
+            straight[path] = np.concatenate([st[6] for st in next_state])
+            tmax = np.full(len(path), np.inf)
+
+        if s.clamp > 0:
+            peak = radiance.max(axis=1)
+            radiance *= np.where(peak > s.clamp, s.clamp / np.maximum(peak, _TINY), 1.0)[:, None]
+        radiance = np.where(np.isfinite(radiance), radiance, 0.0)
+        values = {"Combined": np.concatenate([radiance, np.clip(alpha, 0.0, 1.0)[:, None]], axis=1)}
+        values.update(aux)
+        self.film.add(pixel, values)
+
+    # -- next-event estimation ----------------------------------------------------------
+    def _direct(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale, thr):
+        """Shadow rays (not yet traced) for the hits g of one material, one per light strategy."""
+        lights = self.lights
+        out = []
+        if lights.strategies == 0 or not shader.lobes:
+            return out
+        pid = p_ids[g]
+        sp, sm = seed_pixel[pid], sample[pid]
+        u_pick = self.sampler.get(sp, sm, self.dims.pick(depth) + 1)
+        for k in range(lights.strategies):
+            u = self.sampler.get2d(sp, sm, self.dims.light(depth, k))
+            ls = lights.sample(k, pos[g], ng[g], u, u_pick)
+            ok = ls.value.max(axis=1) > 0
+            if not ok.any():
+                continue
+            wi_l = _to_local(ls.wi, t[g], b[g], ns[g])
+            above = mf.dot(ls.wi, ng[g]) > 0
+            f_diff, f_nd, pdf_b = shader.evaluate(wo_l[g], wi_l, above, inside[g])
+            w_l = _power(ls.pdf, pdf_b)
+            contrib = thr[g] * ls.value * (f_diff + f_nd * w_l[:, None])
+            ok &= contrib.max(axis=1) > 0
+            sel = np.flatnonzero(ok)
+            if len(sel) == 0:
+                continue
+            gi = g[sel]
+            origin = spawn(pos[gi], ng[gi], ls.wi[sel], scale[gi])
+            dist = ls.dist[sel]
+            stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
+            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale[gi])
+            out.append((pid[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel]))
+        return out
+
+    def _resolve_shadows(self, shadow, radiance):
+        parts = [item for group in shadow for item in group]
+        if not parts:
+            return
+        pid = np.concatenate([p[0] for p in parts])
+        origins = np.concatenate([p[1] for p in parts])
+        dirs = np.concatenate([p[2] for p in parts])
+        tmax = np.concatenate([p[3] for p in parts])
+        contrib = np.concatenate([p[4] for p in parts])
+        self.rays["shadow"] += len(pid)
+        blocked = self.geometry.occluded(origins, dirs, tmax)
+        # area lights are not geometry: a nearer area light also blocks (lights cast shadows
+        # of each other's bodies in Cycles only when they are meshes, so it does not here)
+        visible = ~blocked
+        for c in range(3):
+            radiance[:, c] += np.bincount(pid[visible], weights=contrib[visible, c], minlength=len(radiance))
+
+    # -- continuation through a non-diffuse lobe ------------------------------------
+    def _continue(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale,
+                  thr, straight):
+        pid = p_ids[g]
+        sp, sm = seed_pixel[pid], sample[pid]
+        u2 = self.sampler.get2d(sp, sm, self.dims.lobe(depth))
+        u_sel = self.sampler.get(sp, sm, self.dims.pick(depth))
+        wi_l, weight, pdf, delta, valid, passthrough = shader.sample(wo_l[g], u_sel, u2, inside[g])
+        new_thr = thr[g] * weight
+        valid &= new_thr.max(axis=1) > 0
+        sel = np.flatnonzero(valid)
+        gi = g[sel]
+        wi = _to_world(wi_l[sel], t[gi], b[gi], ns[gi])
+        # a sampled direction on the wrong side of the geometric surface would leak light
+        transmit = wi_l[sel, 2] < 0
+        geo_ok = (mf.dot(wi, ng[gi]) < 0) == transmit
+        sel, gi, wi, transmit = sel[geo_ok], gi[geo_ok], wi[geo_ok], transmit[geo_ok]
+        passthrough = passthrough[sel]
+        origin = spawn(pos[gi], ng[gi], wi, scale[gi])
+        self.rays["refraction"] += int((transmit & ~passthrough).sum())
+        self.rays["reflection"] += int((~transmit).sum())
+        self.rays["transparent"] += int(passthrough.sum())
+        prev_pdf = np.where(delta[sel], np.inf, pdf[sel])
+        return pid[sel], origin, wi, new_thr[sel], prev_pdf, ng[gi], straight[g][sel] & passthrough
+
+
+def _frame(n):
+    s = np.where(n[:, 2] >= 0, 1.0, -1.0)
+    a = -1.0 / (s + n[:, 2])
+    bb = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * bb, -s * n[:, 0]], axis=1)
+    b = np.stack([bb, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
+    return t, b
+
+
+def _to_local(v, t, b, n):
+    return np.stack([mf.dot(v, t), mf.dot(v, b), mf.dot(v, n)], axis=1)
+
+
+def _to_world(v, t, b, n):
+    return v[:, :1] * t + v[:, 1:2] * b + v[:, 2:] * n

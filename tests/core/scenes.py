@@ -1,0 +1,59 @@
+"""Small scenes written by hand for core tests (no Blender)."""
+import numpy as np
+
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
+
+
+def translation(x=0.0, y=0.0, z=0.0):
+    m = np.eye(4)
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def plane(size=10.0, z=0.0, material=0):
+    h = size / 2
+    v = np.array([[-h, -h, z], [h, -h, z], [h, h, z], [-h, h, z]])
+    return Mesh("plane", v, [[0, 1, 2], [0, 2, 3]], [material, material])
+
+
+def top_camera(height=1.0, half_width=0.01, res=8):
+    """Looks straight down at the origin from ``height``; sees a tiny patch of the plane."""
+    m = translation(0, 0, height)
+    return Camera(m[None], (-half_width, half_width, -half_width, half_width), (res, res))
+
+
+def lit_plane_scene(light: Light, albedo=0.5, camera=None, world=None):
+    mat = Material("white", [Closure("DIFFUSE", color=(albedo,) * 3)])
+    scene = SceneData(camera=camera or top_camera(), meshes=[plane()], instances=[Instance(0, np.eye(4))],
+                      materials=[mat], lights=[light])
+    if world is not None:
+        scene.world.radiance = np.asarray(world, float)
+    return scene
+
+
+def uv_sphere(radius=1.0, center=(0, 0, 0), segments=48, rings=24, material=0, smooth=True):
+    th = np.linspace(0, np.pi, rings + 1)
+    ph = np.linspace(0, 2 * np.pi, segments, endpoint=False)
+    t, p = np.meshgrid(th, ph, indexing="ij")
+    n = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3)
+    v = n * radius + np.asarray(center, float)
+    idx = np.arange((rings + 1) * segments).reshape(rings + 1, segments)
+    a, b = idx[:-1], np.roll(idx[:-1], -1, axis=1)
+    c, d = idx[1:], np.roll(idx[1:], -1, axis=1)
+    tris = np.concatenate([np.stack([a, c, d], -1).reshape(-1, 3), np.stack([a, d, b], -1).reshape(-1, 3)])
+    p0, p1, p2 = v[tris[:, 0]], v[tris[:, 1]], v[tris[:, 2]]
+    tris = tris[np.linalg.norm(np.cross(p1 - p0, p2 - p0), axis=1) > 1e-12]
+    normals = n[tris] if smooth else None
+    return Mesh("sphere", v, tris, np.full(len(tris), material), corner_normals=normals)
+
+
+def look_at(eye, target, up=(0, 0, 1)):
+    eye, target, up = (np.asarray(x, float) for x in (eye, target, up))
+    z = eye - target
+    z /= np.linalg.norm(z)
+    x = np.cross(up, z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x, y, z, eye
+    return m
