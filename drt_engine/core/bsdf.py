@@ -73,15 +73,24 @@ def _reflect_lobe(weight, alpha, fresnel, layer=None) -> Lobe:
     mu, e = mf.directional_albedo(alpha, fresnel)
     lobe = Lobe("reflect", np.asarray(weight, float), layer=layer, alpha=alpha, fresnel=fresnel)
     if alpha >= mf.DELTA_ALPHA:
-        # Cycles' multiscatter GGX: scale by 1 + F_avg (1 - E) / E so energy lost to
-        # single-scattering masking returns (Kulla-Conty style albedo scaling).
+        # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
+        # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
         _, e1 = mf.directional_albedo(alpha, lambda c: np.ones_like(c))
-        f_avg = float(np.mean(2.0 * mu * np.asarray(fresnel(mu)).mean(axis=-1)))
-        factor = 1.0 + f_avg * (1.0 - e1) / np.maximum(e1, 1e-3)
+        e_avg = _cosine_average(mu, e1)
+        f_avg = _cosine_average(mu, np.asarray(fresnel(mu)).mean(axis=-1))
+        f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg))
+        factor = 1.0 + f_ms * (1.0 - e1) / np.maximum(e1, 1e-3)
         lobe.ms = (mu, factor)
         e = e * factor[:, None]
     lobe.table = (mu, e)
     return lobe
+
+
+def _cosine_average(mu: np.ndarray, values: np.ndarray) -> float:
+    """2 * integral of values(mu) mu dmu over [0, 1] (trapezoids, held constant below mu[0])."""
+    x = np.concatenate([[0.0], mu])
+    y = 2.0 * x * np.concatenate([values[:1], values])
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
 
 
 def _layer_under(upper: Lobe, weight_scalar: float, tint: np.ndarray | None = None) -> Callable:

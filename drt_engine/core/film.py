@@ -26,10 +26,14 @@ def _filter_profile(kind: str, width: float, x: np.ndarray) -> np.ndarray:
 
 
 class PixelFilter:
-    """Separable filter sampled through an inverse CDF table."""
+    """Separable filter sampled through an inverse CDF table.
+
+    As in Cycles, Blackman-Harris spans twice the nominal width (measured: width 1.5
+    gives a 3-pixel window), so its default looks as soft as Cycles'.
+    """
 
     def __init__(self, kind: str, width: float):
-        self.width = max(float(width), 1e-3)
+        self.width = max(float(width), 1e-3) * (2.0 if kind == "BLACKMAN_HARRIS" else 1.0)
         x = np.linspace(-self.width / 2, self.width / 2, _TABLE + 1)
         f = np.maximum(_filter_profile(kind, self.width, x), 0.0)
         cdf = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]))])

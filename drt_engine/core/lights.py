@@ -72,6 +72,7 @@ class Lights:
             validate_light(light)
         self.lights = [light for light in scene.lights if not light_power_zero(light)]
         self.area = [i for i, light in enumerate(self.lights) if light.kind == "AREA"]
+        self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
         self.geometry = geometry
         emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))
         tri_emission = emission[geometry.material] if len(geometry.material) else np.zeros((0, 3))

@@ -139,7 +139,7 @@ def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 1
     Computed once per material with a fixed stratified pattern (deterministic),
     tabulated at ``n_mu`` cosines; returns (mu, E).
     """
-    mu = (np.arange(n_mu) + 0.5) / n_mu
+    mu = np.linspace(0.5 / n_mu, 1.0, n_mu)
     side = int(np.sqrt(n_samples))
     g = (np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2) + 0.5) / side
     m = len(g)

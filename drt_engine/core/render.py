@@ -184,8 +184,9 @@ class Renderer:
             on_surface = hits.hit & ~on_light
             escaped = ~hits.hit & ~on_light
 
-            # lights hit directly: visible to reflected and refracted rays, not to the camera
-            idx = np.flatnonzero(on_light & ~straight[path]) if depth > 0 else np.zeros(0, int)
+            # lights hit directly: always by reflected and refracted rays, by the camera if asked
+            seen = on_light & (~straight[path] | self.lights.camera_visible[np.maximum(light_id, 0)])
+            idx = np.flatnonzero(seen)
             if len(idx):
                 contrib = light_le[idx].copy()
                 smooth = ~np.isinf(prev_pdf[idx])
@@ -197,6 +198,9 @@ class Renderer:
                         pl[sel] = self.lights.pdf_area(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]])
                     contrib[smooth] *= _power(prev_pdf[k], pl)[:, None]
                 radiance[path[idx]] += throughput[idx] * contrib
+                if self.scene.film_transparent:
+                    direct = straight[path[idx]]
+                    alpha[path[idx[direct]]] -= throughput[idx[direct]].mean(axis=1)
 
             # escaped rays see the world
             idx = np.flatnonzero(escaped)

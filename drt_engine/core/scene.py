@@ -170,6 +170,8 @@ class Light:
     size_x: float = 1.0
     size_y: float = 1.0
     spread: float = np.pi
+    visible_camera: bool = False
+    """Seen by camera rays (Blender's ray visibility; off for lights by default)."""
     name: str = ""
 
     def __post_init__(self):
