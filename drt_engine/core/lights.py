@@ -71,7 +71,8 @@ class Lights:
         for light in scene.lights:
             validate_light(light)
         self.lights = [light for light in scene.lights if not light_power_zero(light)]
-        self.area = [i for i, light in enumerate(self.lights) if light.kind == "AREA"]
+        self.hittable = [i for i, light in enumerate(self.lights)
+                         if light.kind == "AREA" or (light.kind in ("POINT", "SPOT") and light.radius > 0)]
         self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
         self.geometry = geometry
         emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))
@@ -234,33 +235,85 @@ class Lights:
         return LightSample(wi, np.full(len(u), np.inf), value, pdf)
 
     # -- lights hit by rays (multiple importance sampling) --------------------------
-    def intersect_area(self, origins, dirs, tmax):
-        """Nearest area light along each ray before tmax: (t, light index or -1, radiance)."""
+    def intersect(self, origins, dirs, tmax):
+        """Nearest light body along each ray before tmax: (t, light index or -1, radiance).
+
+        Area lights are one-sided rectangles, disks and ellipses; point and spot lights
+        with a radius are spheres, or with soft falloff the disk facing the ray origin
+        that light sampling uses (so both strategies integrate the same shape).
+        """
         n = len(origins)
         best_t = np.array(tmax, dtype=np.float64, copy=True)
         best = np.full(n, -1)
-        for i in self.area:
-            c, ex, ey, ez, sx, sy, disk, _ = self._area_frame(self.lights[i])
-            denom = dirs @ ez
-            front = denom > 0
-            t = ((c - origins) @ ez) / np.where(front, denom, 1.0)
-            q = origins + t[:, None] * dirs - c
-            x, y = (q @ ex) / (0.5 * sx), (q @ ey) / (0.5 * sy)
-            inside = (x * x + y * y <= 1.0) if disk else ((np.abs(x) <= 1.0) & (np.abs(y) <= 1.0))
-            ok = front & inside & (t > 0) & (t < best_t)
+        radiance = np.zeros((n, 3))
+        for i in self.hittable:
+            light = self.lights[i]
+            if light.kind == "AREA":
+                t, le = self._hit_area(light, origins, dirs)
+            else:
+                t, le = self._hit_round(light, origins, dirs)
+            ok = (t > 0) & (t < best_t)
             best_t[ok] = t[ok]
             best[ok] = i
-        radiance = np.zeros((n, 3))
-        for i in self.area:
-            radiance[best == i] = self.lights[i].radiance
+            radiance[ok] = le[ok]
         return best_t, best, radiance
 
-    def pdf_area(self, light_index, origins, dirs, t):
-        """Solid-angle density of sampling ``light_index`` toward dirs from origins."""
+    def _hit_area(self, light, origins, dirs):
+        c, ex, ey, ez, sx, sy, disk, _ = self._area_frame(light)
+        denom = dirs @ ez
+        front = denom > 0
+        t = ((c - origins) @ ez) / np.where(front, denom, 1.0)
+        q = origins + t[:, None] * dirs - c
+        x, y = (q @ ex) / (0.5 * sx), (q @ ey) / (0.5 * sy)
+        inside = (x * x + y * y <= 1.0) if disk else ((np.abs(x) <= 1.0) & (np.abs(y) <= 1.0))
+        t = np.where(front & inside, t, np.inf)
+        return t, np.broadcast_to(light.radiance, (len(t), 3))
+
+    def _hit_round(self, light, origins, dirs):
+        c, r = light.position, light.radius
+        oc = c - origins
+        if light.soft_falloff:
+            axis = oc / np.maximum(np.linalg.norm(oc, axis=1), _TINY)[:, None]
+            denom = mf.dot(dirs, axis)
+            t = mf.dot(oc, axis) / np.where(denom > 0, denom, 1.0)
+            q = origins + t[:, None] * dirs - c
+            t = np.where((denom > 0) & (mf.dot(q, q) <= r * r), t, np.inf)
+        else:
+            b = mf.dot(oc, dirs)
+            disc = b * b - (mf.dot(oc, oc) - r * r)
+            t = np.where(disc >= 0, b - np.sqrt(np.maximum(disc, 0.0)), np.inf)
+        le = np.broadcast_to(light.intensity / (np.pi * r * r), (len(t), 3))
+        if light.kind == "SPOT":
+            le = le * self._spot(light, -dirs)[:, None]
+        return t, le
+
+    def pdf(self, light_index, origins, dirs, t):
+        """Solid-angle density with which light sampling picks dirs from origins."""
         light = self.lights[light_index]
-        *_, ez, _sx, _sy, _disk, area = self._area_frame(light)
-        cos_l = np.maximum(dirs @ ez, _TINY)
-        return t * t / (cos_l * area)
+        if light.kind == "AREA":
+            *_, ez, _sx, _sy, _disk, area = self._area_frame(light)
+            return t * t / (np.maximum(dirs @ ez, _TINY) * area)
+        oc = light.position - origins
+        d2 = mf.dot(oc, oc)
+        r = light.radius
+        if light.soft_falloff:
+            cos_l = mf.dot(dirs, oc) / np.sqrt(np.maximum(d2, _TINY))
+            return t * t / np.maximum(cos_l * np.pi * r * r, _TINY)
+        cos_max = np.sqrt(np.clip(1.0 - r * r / np.maximum(d2, _TINY), 0.0, 1.0))
+        return 1.0 / (2.0 * np.pi * np.maximum(1.0 - cos_max, _TINY))
+
+    def suns_seen(self, dirs):
+        """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs."""
+        radiance = np.zeros((len(dirs), 3))
+        pdf = np.zeros(len(dirs))
+        for light in self.lights:
+            half = min(light.angle, np.pi) / 2.0
+            if light.kind != "SUN" or half <= 0:
+                continue
+            inside = dirs @ -light.direction > np.cos(half)
+            radiance[inside] += light.irradiance / (np.pi * np.sin(half) ** 2)
+            pdf[inside] = 1.0 / (2.0 * np.pi * (1.0 - np.cos(half)))
+        return radiance, pdf
 
     def pdf_emissive(self, prim, dirs, t):
         g = self.geometry

@@ -179,7 +179,7 @@ class Renderer:
             if len(path) == 0:
                 break
             hits = self.geometry.intersect(origins, dirs, tmax)
-            light_t, light_id, light_le = self.lights.intersect_area(origins, dirs, np.minimum(hits.t, tmax))
+            light_t, light_id, light_le = self.lights.intersect(origins, dirs, np.minimum(hits.t, tmax))
             on_light = light_id >= 0
             on_surface = hits.hit & ~on_light
             escaped = ~hits.hit & ~on_light
@@ -195,7 +195,7 @@ class Renderer:
                     pl = np.zeros(len(k))
                     for li in np.unique(light_id[k]):
                         sel = light_id[k] == li
-                        pl[sel] = self.lights.pdf_area(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]])
+                        pl[sel] = self.lights.pdf(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]])
                     contrib[smooth] *= _power(prev_pdf[k], pl)[:, None]
                 radiance[path[idx]] += throughput[idx] * contrib
                 if self.scene.film_transparent:
@@ -219,6 +219,11 @@ class Renderer:
                         k = idx[smooth]
                         weight[smooth] = _power(prev_pdf[k], self.lights.pdf_world(prev_normal[k], dirs[k]))
                     radiance[path[idx]] += throughput[idx] * world * weight[:, None]
+                bounced = idx[~straight[path[idx]]] if len(idx) else idx
+                if len(bounced):
+                    sun, pdf_sun = self.lights.suns_seen(dirs[bounced])
+                    weight = np.where(np.isinf(prev_pdf[bounced]), 1.0, _power(prev_pdf[bounced], pdf_sun))
+                    radiance[path[bounced]] += throughput[bounced] * sun * weight[:, None]
 
             surf = np.flatnonzero(on_surface)
             if len(surf) == 0:
