@@ -1,0 +1,91 @@
+# DRT: distribution ray tracing for Blender.
+#   make render      venv + render the default sample scene to out/ (SCENE=name for another one)
+#   make test        venv + the whole test suite (TESTS=path and PYTEST_ARGS=... to narrow it)
+#   make extension   download the embreex wheels, validate, build the extension zips into dist/
+#   make scenes      rebuild the sample .blend files from their scripts
+#   make venv        only create .venv (Python 3.11) with the pinned requirements
+#   make clean       remove out/, dist/ and caches; make distclean also removes .venv and wheels/
+
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+PYTHON311 ?= python3.11
+VENV := .venv
+PY := $(VENV)/bin/python
+# Written after a successful install; newer than requirements.txt means the venv is current.
+STAMP := $(VENV)/.drt-requirements-installed
+
+SCENE ?= cornell_box
+OUT ?= out
+DIST ?= dist
+TESTS ?= tests
+PYTEST_ARGS ?=
+
+# The wheels listed in the manifest are the single source of truth for what gets downloaded.
+WHEELS := $(shell sed -n 's|^ *"\./\(wheels/[^"]*\.whl\)".*|\1|p' blender_manifest.toml)
+STAGE := $(DIST)/.stage
+# Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
+BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
+
+.PHONY: help venv render test extension scenes clean distclean
+
+help:
+	@sed -n 's/^#   //p' Makefile
+
+venv: $(STAMP)
+
+$(STAMP): requirements.txt
+	@if [ ! -x $(PY) ]; then \
+	  command -v $(PYTHON311) >/dev/null 2>&1 || { \
+	    echo "error: $(PYTHON311) not found on PATH. DRT needs Python 3.11 (bpy 5.0.1 exists only for 3.11);" \
+	         "install it, or pass PYTHON311=/path/to/python3.11" >&2; exit 1; }; \
+	  echo "creating $(VENV) with $$(command -v $(PYTHON311))"; \
+	  $(PYTHON311) -m venv $(VENV); \
+	fi
+	@$(PY) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' || { \
+	  echo "error: $(VENV) is not a Python 3.11 environment; remove it (make distclean) and run make again" >&2; exit 1; }
+	$(PY) -m pip install --disable-pip-version-check -r requirements.txt
+	@touch $@
+
+render: $(STAMP)
+	@mkdir -p $(OUT)
+	$(PY) -m drt_engine render sample_scenes/$(SCENE).blend -o $(OUT)/$(SCENE).exr
+	$(PY) -m drt_engine render sample_scenes/$(SCENE).blend -o $(OUT)/$(SCENE).png
+
+# pytest exits with 5 when it collects nothing; that is left as a failure on purpose:
+# a suite that runs no test must not pass CI.
+test: $(STAMP)
+	$(PY) -m pytest $(TESTS) -q $(PYTEST_ARGS)
+
+# One wheel per file name: embreex-VERSION-cpXY-cpXY-PLATFORM.whl gives pip its Python version and
+# platform (the last tag of a compound manylinux platform).
+wheels/%.whl: | $(STAMP)
+	@mkdir -p wheels
+	@IFS=- read -r dist version pytag abi platform <<< "$*"; \
+	pyversion=$${pytag#cp}; pyversion=$${pyversion:0:1}.$${pyversion:1}; \
+	echo "downloading $$dist $$version for Python $$pyversion, $${platform##*.}"; \
+	$(PY) -m pip download --disable-pip-version-check --quiet --no-deps --only-binary=:all: \
+	  --python-version $$pyversion --platform $${platform##*.} --dest wheels "$$dist==$$version"
+	@test -f $@ || { echo "error: pip did not produce $@ (check the wheel name in blender_manifest.toml)" >&2; exit 1; }
+
+# Blender wants the manifest and __init__.py at the root of the zip: stage the package, the manifest
+# and the wheels in one folder, then let Blender's own tool validate and build it.
+extension: $(WHEELS) | $(STAMP)
+	@rm -rf $(STAGE) && mkdir -p $(STAGE)/wheels
+	@cp -R drt_engine/. $(STAGE)/
+	@cp blender_manifest.toml $(STAGE)/
+	@cp $(WHEELS) $(STAGE)/wheels/
+	$(BLENDER_EXT) validate $(STAGE)
+	$(BLENDER_EXT) build --source-dir $(STAGE) --output-dir $(DIST) --split-platforms
+	@rm -rf $(STAGE)
+	@for zip in $(DIST)/drt_engine-*.zip; do $(BLENDER_EXT) validate "$$zip" || exit 1; done
+
+scenes: $(STAMP)
+	@for script in sample_scenes/build_*.py; do echo "$(PY) $$script"; $(PY) "$$script" || exit 1; done
+
+clean:
+	rm -rf $(OUT) $(DIST) .pytest_cache
+	find . -path ./$(VENV) -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV) wheels
