@@ -44,12 +44,13 @@ def hash_combine(*values) -> np.ndarray:
     return h
 
 
+_BYTE_REVERSED = np.array([int(f"{b:08b}"[::-1], 2) for b in range(256)], dtype=_U32)
+
+
 def _reverse_bits(x: np.ndarray) -> np.ndarray:
-    x = ((x >> _U32(1)) & _U32(0x55555555)) | ((x & _U32(0x55555555)) << _U32(1))
-    x = ((x >> _U32(2)) & _U32(0x33333333)) | ((x & _U32(0x33333333)) << _U32(2))
-    x = ((x >> _U32(4)) & _U32(0x0F0F0F0F)) | ((x & _U32(0x0F0F0F0F)) << _U32(4))
-    x = ((x >> _U32(8)) & _U32(0x00FF00FF)) | ((x & _U32(0x00FF00FF)) << _U32(8))
-    return (x >> _U32(16)) | (x << _U32(16))
+    r = _BYTE_REVERSED
+    return ((r[x & _U32(0xFF)] << _U32(24)) | (r[(x >> _U32(8)) & _U32(0xFF)] << _U32(16))
+            | (r[(x >> _U32(16)) & _U32(0xFF)] << _U32(8)) | r[x >> _U32(24)])
 
 
 def _laine_karras(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
@@ -78,19 +79,29 @@ def _sobol_matrices() -> np.ndarray:
     return out.astype(_U32)
 
 
-_SOBOL = _sobol_matrices()
+def _byte_tables(matrices: np.ndarray) -> np.ndarray:
+    """(dims, 4, 256): XOR of the generator columns selected by each byte of the index."""
+    tables = np.zeros((len(matrices), 4, 256), dtype=_U32)
+    for d, columns in enumerate(matrices):
+        for k in range(4):
+            for b in range(256):
+                v = 0
+                for bit in range(8):
+                    if b >> bit & 1:
+                        v ^= int(columns[8 * k + bit])
+                tables[d, k, b] = v
+    return tables
+
+
+_SOBOL = _byte_tables(_sobol_matrices())
 
 
 def sobol_u32(index: np.ndarray, dim: int) -> np.ndarray:
     """Unscrambled Sobol point ``index`` in dimension ``dim`` (0 or 1) as 32-bit fixed point."""
     index = np.asarray(index, dtype=_U32)
-    result = np.zeros(index.shape, dtype=_U32)
-    for bit in range(32):
-        rest = index >> _U32(bit)
-        if not rest.any():
-            break
-        result ^= _SOBOL[dim, bit] * (rest & _U32(1))
-    return result
+    t = _SOBOL[dim]
+    return (t[0][index & _U32(0xFF)] ^ t[1][(index >> _U32(8)) & _U32(0xFF)]
+            ^ t[2][(index >> _U32(16)) & _U32(0xFF)] ^ t[3][index >> _U32(24)])
 
 
 def _to_unit(x: np.ndarray) -> np.ndarray:
@@ -158,21 +169,24 @@ class Sampler:
 
     def get(self, pixel: np.ndarray, sample: np.ndarray, dim: int) -> np.ndarray:
         if self.pattern == "SOBOL":
-            return self._sobol(pixel, sample, dim)
+            return self._sobol(pixel, sample, dim - dim % 2, (dim % 2,))[:, 0]
         return self._stratified(pixel, sample, dim - dim % 2)[:, dim % 2]
 
     def get2d(self, pixel: np.ndarray, sample: np.ndarray, dim: int) -> np.ndarray:
         assert dim % 2 == 0, "2D dimensions start at an even index"
         if self.pattern == "SOBOL":
-            return np.stack([self._sobol(pixel, sample, dim), self._sobol(pixel, sample, dim + 1)], axis=1)
+            return self._sobol(pixel, sample, dim, (0, 1))
         return self._stratified(pixel, sample, dim)
 
-    def _sobol(self, pixel, sample, dim):
-        pair, j = divmod(dim, 2)
-        shuffle_seed = hash_combine(pixel, pair, self.seed, 0x5EED)
-        index = nested_uniform_scramble(np.asarray(sample, dtype=_U32), shuffle_seed)
-        value = sobol_u32(index, j)
-        return _to_unit(nested_uniform_scramble(value, hash_combine(pixel, dim, self.seed, 0x0A11)))
+    def _sobol(self, pixel, sample, dim, components):
+        """Dimensions dim + c for c in components, sharing one shuffled index."""
+        pixel_seed = hash_combine(pixel, self.seed)
+        index = nested_uniform_scramble(np.asarray(sample, dtype=_U32), hash_u32(pixel_seed ^ _U32(dim * 0x9E3779B9 & 0xFFFFFFFF)))
+        out = np.empty((len(index), len(components)))
+        for k, c in enumerate(components):
+            scramble = hash_u32(pixel_seed ^ _U32((dim + c) * 0x85EBCA6B & 0xFFFFFFFF) ^ _U32(0x0A11))
+            out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, c), scramble))
+        return out
 
     def _stratified(self, pixel, sample, dim):
         nx, ny = self.strata
