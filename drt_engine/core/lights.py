@@ -44,6 +44,21 @@ def _orthonormal(n):
     return t, bt
 
 
+def _spread(spread: float, cos_l: np.ndarray) -> np.ndarray:
+    """Cycles' area light spread: emission narrowed to a cone, normalised to keep power.
+
+    Factor max((tan h - tan a) / (tan h - h), 0) for half spread h and emission angle a
+    (area.h); 1 for spread = π.
+    """
+    h = min(spread, np.pi) / 2.0
+    if h >= np.pi / 2.0 - 1e-6:
+        return np.ones_like(cos_l)
+    c = np.clip(cos_l, 1e-12, 1.0)
+    tan_a = np.sqrt(1.0 - c * c) / c
+    norm = 3.0 / h**3 if h <= 0.05 else 1.0 / (np.tan(h) - h)
+    return np.maximum((np.tan(h) - tan_a) * norm, 0.0) if h > 0 else np.zeros_like(cos_l)
+
+
 def validate_light(light: Light):
     for name in ("intensity", "irradiance", "radiance"):
         value = getattr(light, name)
@@ -187,8 +202,7 @@ class Lights:
         ey = m[:3, 1] / np.linalg.norm(m[:3, 1])
         ez = m[:3, 2] / np.linalg.norm(m[:3, 2])
         disk = light.shape in ("DISK", "ELLIPSE")
-        sx = light.size_x
-        sy = light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size_x
+        sx, sy = light.size_x, light.size_y
         area = (np.pi / 4.0 if disk else 1.0) * sx * sy
         return light.position, ex, ey, ez, sx, sy, disk, area
 
@@ -206,7 +220,7 @@ class Lights:
         front = cos_l > 0
         pdf = np.where(front, dist * dist / np.maximum(cos_l * area, _TINY), 0.0)
         value = np.where(front[:, None], light.radiance * (area * cos_l / np.maximum(dist * dist, _TINY))[:, None], 0.0)
-        return LightSample(wi, dist, value, pdf)
+        return LightSample(wi, dist, value * _spread(light.spread, cos_l)[:, None], pdf)
 
     def _sample_emissive(self, pos, u, u_pick):
         g = self.geometry
@@ -267,7 +281,7 @@ class Lights:
         x, y = (q @ ex) / (0.5 * sx), (q @ ey) / (0.5 * sy)
         inside = (x * x + y * y <= 1.0) if disk else ((np.abs(x) <= 1.0) & (np.abs(y) <= 1.0))
         t = np.where(front & inside, t, np.inf)
-        return t, np.broadcast_to(light.radiance, (len(t), 3))
+        return t, light.radiance * _spread(light.spread, denom)[:, None]
 
     def _hit_round(self, light, origins, dirs):
         c, r = light.position, light.radius

@@ -152,8 +152,9 @@ class Light:
       shaded point, as Cycles does) of radiance intensity / (π radius²).
       SPOT adds ``spot_size`` (full cone angle, radians) and ``spot_blend``.
     - SUN: ``irradiance`` (W/m² on a facing surface), ``angle`` (full angular diameter).
-    - AREA: ``radiance`` (W/(m² sr)), one-sided along -Z, with ``shape``, ``size_x``,
-      ``size_y`` in world units and ``spread`` (radians, π = no restriction).
+    - AREA: ``radiance`` (W/(m² sr)), one-sided along -Z, with ``shape``, extents
+      ``size_x`` and ``size_y`` along local X and Y in world units (both used for every
+      shape, so a scaled square is a rectangle) and ``spread`` (radians, π = none).
     """
 
     kind: str

@@ -32,7 +32,7 @@ def mean(scene, samples=64):
 
 @pytest.mark.parametrize("roughness", [0.0, 0.2, 0.6])
 def test_glossy_furnace_under_a_huge_area_light(roughness):
-    light = Light("AREA", translation(0, 0, 1.5), radiance=np.full(3, L), size_x=4000.0)
+    light = Light("AREA", translation(0, 0, 1.5), radiance=np.full(3, L), size_x=4000.0, size_y=4000.0)
     assert mean(glossy_plane_scene(roughness, [light])) == pytest.approx(L, rel=0.01)
 
 

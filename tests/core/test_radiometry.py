@@ -89,3 +89,21 @@ def test_white_furnace_diffuse_sphere_under_uniform_world():
     img = result.passes["Combined"][..., :3]
     assert np.abs(img.mean() - 0.7) < 0.007
     assert np.abs(img - 0.7).max() < 0.1
+
+
+@pytest.mark.parametrize("spread_deg, view_deg", [(90, 0), (90, 30), (30, 10), (30, 20)])
+def test_area_light_spread_narrows_emission_like_cycles(spread_deg, view_deg):
+    """Seen in a mirror at angle a from its normal, a light of spread s has radiance
+    L * max((tan(s/2) - tan a) / (tan(s/2) - s/2), 0) (Cycles' area.h, measured in Cycles)."""
+    from scenes import look_at
+    from test_mis import glossy_plane_scene
+    h, a = np.radians(spread_deg) / 2, np.radians(view_deg)
+    eye = np.array([np.sin(a), 0.0, np.cos(a)]) * 2.0
+    # a horizontal light shining down, where the mirrored view ray meets it at angle a
+    light = Light("AREA", translation(-eye[0], 0.0, eye[2]), radiance=np.full(3, 5.0), size_x=0.5, size_y=0.5,
+                  spread=2 * h)
+    scene = glossy_plane_scene(0.0, [light])
+    scene.camera = Camera(look_at(eye, (0, 0, 0), up=(0, 1, 0))[None], (-1e-4, 1e-4, -1e-4, 1e-4), (4, 4))
+    value = Renderer(scene, RenderSettings(samples=1, threads=1)).render().passes["Combined"][..., 0].mean()
+    expected = 5.0 * max((np.tan(h) - np.tan(a)) / (np.tan(h) - h), 0.0)
+    assert value == pytest.approx(expected, rel=1e-3)

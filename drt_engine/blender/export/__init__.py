@@ -1,0 +1,65 @@
+"""The evaluated depsgraph into one plain-data ``SceneData``.
+
+Every visible object, including collection, geometry-nodes and particle instances,
+comes from ``depsgraph.object_instances``; the depsgraph has already left out what
+is disabled for render or excluded from the view layer.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ...core.errors import RenderCancelled
+from ...core.scene import SceneData
+from .camera import export_camera
+from .geometry import GeometryExporter
+from .lights import export_light
+from .materials import MaterialTable
+from .world import export_world
+
+CANCEL_CHECK_INTERVAL = 256
+"""Instances exported between two calls of the cancel callback."""
+
+
+def export_scene(
+    depsgraph, camera_object=None, cancel: Callable[[], bool] | None = None
+) -> SceneData:
+    """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
+
+    Raises ``SceneError`` for a scene that cannot be rendered and ``RenderCancelled``
+    when ``cancel()`` returns True.
+    """
+    scene = depsgraph.scene
+    camera_object = camera_object or scene.camera
+    if camera_object is not None and not camera_object.is_evaluated:
+        camera_object = camera_object.evaluated_get(depsgraph)  # animated and constrained transform
+    camera = export_camera(scene, camera_object)
+    warnings: list[str] = []
+    materials = MaterialTable(warnings)
+    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override)
+    lights = []
+    for count, instance in enumerate(depsgraph.object_instances):
+        if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
+            raise RenderCancelled("Render cancelled during scene export")
+        if not instance.show_self:
+            continue
+        obj = instance.object
+        matrix = np.array(instance.matrix_world, dtype=np.float64)
+        if obj.type == "LIGHT":
+            light = export_light(obj, matrix, warnings)
+            if light is not None:
+                lights.append(light)
+        else:
+            geometry.add(obj, matrix)
+    geometry.finish()
+    return SceneData(
+        camera=camera,
+        meshes=geometry.meshes,
+        instances=geometry.instances,
+        materials=materials.materials,
+        lights=lights,
+        world=export_world(getattr(depsgraph.view_layer, "world_override", None) or scene.world, warnings),
+        film_transparent=scene.render.film_transparent,
+        warnings=warnings,
+    )

@@ -1,0 +1,106 @@
+"""The scene camera, following Cycles' intern/cycles/blender/camera.cpp.
+
+The image window (``Camera.frame``) is Cycles' view plane: sensor fit, pixel
+aspect and shift folded in, scaled to the plane z = -1 for perspective cameras and
+left in scene units for orthographic ones. Depth of field: aperture radius =
+lens[mm]·1e-3 / (2·f-stop) for perspective (1 / (2·f-stop) for orthographic), in
+scene units whatever the unit scale, and 0 when depth of field is off.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...core.errors import SceneError
+from ...core.scene import Camera
+
+
+def resolution(render) -> tuple[int, int]:
+    """Image size after the resolution percentage (integer arithmetic, as Blender)."""
+    percent = render.resolution_percentage
+    return render.resolution_x * percent // 100, render.resolution_y * percent // 100
+
+
+def view_plane(cam, width: int, height: int, pixel_aspect: tuple[float, float]):
+    """(left, right, bottom, top) of the image, as Cycles' ``blender_camera_viewplane``."""
+    x_ratio = width * pixel_aspect[0]
+    y_ratio = height * pixel_aspect[1]
+    if cam.sensor_fit == "AUTO":
+        horizontal, sensor = x_ratio > y_ratio, cam.sensor_width
+    elif cam.sensor_fit == "HORIZONTAL":
+        horizontal, sensor = True, cam.sensor_width
+    else:
+        horizontal, sensor = False, cam.sensor_height
+    if horizontal:
+        aspect_ratio = x_ratio / y_ratio
+        half = np.array([aspect_ratio, 1.0])
+    else:
+        aspect_ratio = y_ratio / x_ratio
+        half = np.array([1.0, aspect_ratio])
+    if cam.type == "ORTHO":
+        half *= cam.ortho_scale / (aspect_ratio * 2.0)
+        aspect_ratio = cam.ortho_scale / 2.0
+    offset = 2.0 * aspect_ratio * np.array([cam.shift_x, cam.shift_y])
+    low, high = offset - half, offset + half
+    if cam.type == "PERSP":
+        tan_half_fov = 0.5 * sensor / cam.lens / aspect_ratio
+        low, high = low * tan_half_fov, high * tan_half_fov
+    return float(low[0]), float(high[0]), float(low[1]), float(high[1])
+
+
+def border_window(render, width: int, height: int) -> tuple[int, int, int, int]:
+    """Pixel rectangle of border render, as Blender's ``disprect``: border × size in
+    single precision, truncated (render_init_from_main in render/intern/pipeline.cc)."""
+    if not render.use_border:
+        return 0, 0, width, height
+    border = np.array(
+        [render.border_min_x, render.border_min_y, render.border_max_x, render.border_max_y], np.float32
+    )
+    window = tuple(int(v) for v in border * np.array([width, height, width, height], np.float32))
+    if window[2] <= window[0] or window[3] <= window[1]:
+        raise SceneError("The render border is smaller than one pixel")
+    return window
+
+
+def without_scale(matrix) -> np.ndarray:
+    matrix = np.array(matrix, dtype=np.float64)
+    axes = np.linalg.norm(matrix[:3, :3], axis=0)
+    matrix[:3, :3] /= np.where(axes > 0.0, axes, 1.0)
+    return matrix
+
+
+def export_camera(scene, camera_object) -> Camera:
+    if camera_object is None:
+        raise SceneError("No camera found in scene")
+    if camera_object.type != "CAMERA":
+        raise SceneError(f"The scene camera '{camera_object.name}' is not a camera object")
+    cam = camera_object.data
+    if cam.type not in ("PERSP", "ORTHO"):
+        raise SceneError(
+            f"Camera '{camera_object.name}' is {cam.type.lower()}: DRT renders perspective "
+            "and orthographic cameras only"
+        )
+    render = scene.render
+    width, height = resolution(render)
+    if width < 1 or height < 1:
+        raise SceneError(f"The image is empty ({width}x{height} pixels)")
+    matrix = without_scale(camera_object.matrix_world)
+    dof = cam.dof
+    aperture = 0.0
+    if dof.use_dof:
+        fstop = max(dof.aperture_fstop, 1e-5)
+        aperture = (1.0 if cam.type == "ORTHO" else cam.lens * 1e-3) / (2.0 * fstop)
+    focus = dof.focus_distance
+    if dof.focus_object is not None:
+        to_focus = matrix[:3, 3] - np.array(dof.focus_object.matrix_world.translation)
+        focus = abs(float(matrix[:3, 2] @ to_focus))
+    return Camera(
+        matrices=matrix[None],
+        frame=view_plane(cam, width, height, (render.pixel_aspect_x, render.pixel_aspect_y)),
+        resolution=(width, height),
+        type=cam.type,
+        clip_start=cam.clip_start,
+        clip_end=cam.clip_end,
+        window=border_window(render, width, height),
+        aperture_radius=aperture,
+        focus_distance=focus,
+    )

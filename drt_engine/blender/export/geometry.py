@@ -1,0 +1,136 @@
+"""Evaluated objects into triangle meshes and instances, each distinct mesh once.
+
+Which objects carry geometry follows Cycles (``object_is_geometry`` in
+intern/cycles/blender/object.cpp): objects whose evaluated data is a Mesh. Curves,
+surfaces, text and (in Blender 5.0) metaballs reach the renderer as separate Mesh
+instances in ``depsgraph.object_instances``, so reading their own data as well
+would count them twice. A metaball without such a mesh instance (older Blender)
+is converted with ``to_mesh``.
+
+Vertices stay in object space and are never flipped: for a negative-determinant
+instance matrix the core flips the geometric normal itself, and transforms the
+corner normals by the inverse transpose.
+"""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from ...core.scene import Instance, Mesh
+from .materials import MaterialTable
+
+
+def _read(collection, attribute, count, width, dtype):
+    values = np.empty(count * width, dtype=dtype)
+    collection.foreach_get(attribute, values)
+    return values.reshape(count, width) if width > 1 else values
+
+
+def _corner_normals(mesh, tri_vertices, tri_loops):
+    """Shading normal per triangle corner, or None when every face is flat."""
+    domain = mesh.normals_domain
+    if domain == "FACE":
+        return None
+    if domain == "POINT":
+        normals = _read(mesh.vertex_normals, "vector", len(mesh.vertices), 3, np.float32)
+        return normals[tri_vertices]
+    normals = _read(mesh.corner_normals, "vector", len(mesh.loops), 3, np.float32)
+    return normals[tri_loops]
+
+
+def _render_uvs(mesh, tri_loops):
+    layer = next((uv for uv in mesh.uv_layers if uv.active_render), None)
+    if layer is None or len(mesh.loops) == 0:
+        return None
+    uvs = _read(layer.uv, "vector", len(mesh.loops), 2, np.float32)
+    return uvs[tri_loops]
+
+
+def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray) -> Mesh | None:
+    """Triangulated copy of a Blender mesh; None for a mesh without faces.
+
+    ``slot_materials`` maps the object's material slots to scene material indices;
+    a face's slot index is clamped to the slots present, as Cycles does.
+    """
+    triangles = mesh.loop_triangles
+    count = len(triangles)
+    if count == 0:
+        return None
+    vertices = _read(mesh.vertices, "co", len(mesh.vertices), 3, np.float32)
+    tri_vertices = _read(triangles, "vertices", count, 3, np.int32)
+    tri_loops = _read(triangles, "loops", count, 3, np.int32)
+    slots = _read(triangles, "material_index", count, 1, np.int32)
+    materials = slot_materials[np.clip(slots, 0, len(slot_materials) - 1)]
+    return Mesh(
+        name=name,
+        vertices=vertices,
+        triangles=tri_vertices,
+        material_indices=materials,
+        corner_normals=_corner_normals(mesh, tri_vertices, tri_loops),
+        uvs=_render_uvs(mesh, tri_loops),
+    )
+
+
+class GeometryExporter:
+    """Collects meshes and instances; a mesh shared by several instances is exported once.
+
+    Meshes are keyed on the evaluated mesh datablock (shared by linked duplicates,
+    collection instances and geometry-nodes instances of the same geometry) and on
+    the scene materials of the object's slots, since object-linked slots can give
+    the same mesh different materials.
+    """
+
+    def __init__(self, materials: MaterialTable, material_override=None):
+        self.materials = materials
+        self.material_override = material_override
+        self.meshes: list[Mesh] = []
+        self.instances: list[Instance] = []
+        self._mesh_index: dict[tuple, int] = {}
+        self._metaballs: list = []
+        self._meshed: set[int] = set()
+
+    def _slot_materials(self, obj) -> np.ndarray:
+        """Scene material index per slot, as Cycles' ``find_used_shaders``."""
+        slots = obj.material_slots
+        if self.material_override is not None:
+            return np.full(max(len(slots), 1), self.materials.index(self.material_override), np.int32)
+        if len(slots) == 0:
+            return np.zeros(1, np.int32)
+        return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
+
+    def add(self, obj, matrix: np.ndarray) -> None:
+        """Add one evaluated object placed by ``matrix``; non-geometry objects are ignored."""
+        if obj.type == "META":
+            self._metaballs.append((obj, matrix))
+        elif isinstance(obj.data, bpy.types.Mesh):
+            self._meshed.add(obj.original.as_pointer())
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()))
+
+    def finish(self) -> None:
+        """Add metaballs that the depsgraph did not already hand over as mesh instances."""
+        for obj, matrix in self._metaballs:
+            if obj.original.as_pointer() not in self._meshed:
+                self._place(obj, matrix, ("meta", obj.original.as_pointer()))
+        self._metaballs.clear()
+
+    def _place(self, obj, matrix, source) -> None:
+        slot_materials = self._slot_materials(obj)
+        key = source + (slot_materials.tobytes(),)
+        index = self._mesh_index.get(key)
+        if index is None:
+            index = self._mesh_index[key] = self._export(obj, slot_materials)
+        if index >= 0:
+            self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
+
+    def _export(self, obj, slot_materials) -> int:
+        if obj.type == "META":
+            try:
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials)
+            finally:
+                obj.to_mesh_clear()
+        else:
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials)
+        if mesh is None:
+            return -1
+        self.meshes.append(mesh)
+        return len(self.meshes) - 1

@@ -1,0 +1,105 @@
+"""Blender lights into radiometric lights, converted exactly as Cycles converts them.
+
+From intern/cycles/blender/light.cpp and intern/cycles/scene/light.cpp (Blender 5.0):
+
+- strength S = color × temperature_color (if used) × energy × 2^exposure, times the
+  light's node-tree emission (colour × strength) when it has one.
+- point and spot: Cycles stores ``eval_fac = invarea / π`` with ``invarea = 1 /
+  (4π r²)`` (4 for r = 0) when normalised, else 1. The sphere (or facing disk) then
+  has radiance S·eval_fac, i.e. intensity S/(4π) W/sr when normalised, S·r² (r > 0)
+  or S/π (r = 0) when not.
+- sun: radiance S / (π sin²(angle/2)) when normalised (irradiance S), else radiance S
+  over the disk of solid-angle-area π sin²(angle/2) (irradiance S·π sin²(angle/2)).
+- area: sizes scale with the object's X and Y axes; area A = size_x·size_y (×π/4
+  for disk and ellipse); radiance S/(π A) when normalised, else S/π.
+- dropped like ``Light::has_contribution``: zero strength, area lights of zero size
+  (including a zero X or Y axis in the object matrix), and portals; also spot, sun
+  and area lights whose matrix has no Z axis (no direction).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...core.scene import Light
+from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
+
+
+def _node_emission(light, warnings: list[str]) -> np.ndarray:
+    """Colour × strength of the light's Emission nodes (1 without nodes, as in Cycles)."""
+    if not (light.use_nodes and light.node_tree):
+        return np.ones(3)
+    output = light.node_tree.get_output_node("CYCLES")
+    if output is None:
+        return np.zeros(3)
+    issues = Issues()
+
+    def leaf(node, weight):
+        if node.bl_idname != "ShaderNodeEmission":
+            issues.add(f"shader node '{node.name}'")
+            return []
+        report_linked_inputs(node, issues)
+        color = rgb(input_value(node, issues, 1.0, "Color"))
+        return [weight * color * input_value(node, issues, 1.0, "Strength")]
+
+    parts = flatten(output.inputs["Surface"], leaf, issues)
+    message = issues.message(f"Light '{light.name}'")
+    if message:
+        warnings.append(message)
+    return np.sum(parts, axis=0) if parts else np.zeros(3)
+
+
+def light_strength(light, warnings: list[str]) -> np.ndarray:
+    """Cycles' light strength: watts for point, spot and area lights, W/m² for suns."""
+    color = np.array(light.color[:3], dtype=np.float64)
+    if getattr(light, "use_temperature", False):
+        color *= np.array(light.temperature_color[:3])
+    exposure = getattr(light, "exposure", 0.0)
+    return color * light.energy * 2.0**exposure * _node_emission(light, warnings)
+
+
+def export_light(obj, matrix: np.ndarray, warnings: list[str]) -> Light | None:
+    """The light of an evaluated light object placed by ``matrix``; None if Cycles drops it."""
+    light = obj.data
+    if light.type == "AREA" and getattr(getattr(light, "cycles", None), "is_portal", False):
+        return None
+    strength = light_strength(light, warnings)
+    if not strength.any():
+        return None
+    normalize = getattr(light, "normalize", True)
+    axes = np.linalg.norm(matrix[:3, :3], axis=0)
+    if light.type != "POINT" and not axes[2]:
+        return None  # no direction to shine along
+    rotation = matrix.copy()
+    rotation[:3, :3] /= np.where(axes > 0.0, axes, 1.0)
+    common = dict(matrix=rotation, name=obj.name, visible_camera=bool(getattr(obj, "visible_camera", False)))
+    if light.type in ("POINT", "SPOT"):
+        radius = float(light.shadow_soft_size)
+        if normalize:
+            intensity = strength / (4.0 * math.pi)
+        else:
+            intensity = strength * radius**2 if radius > 0.0 else strength / math.pi
+        if light.type == "SPOT":
+            common.update(spot_size=light.spot_size, spot_blend=light.spot_blend)
+        return Light(light.type, intensity=intensity, radius=radius, soft_falloff=light.use_soft_falloff, **common)
+    if light.type == "SUN":
+        angle = float(light.angle)
+        disk = math.pi * math.sin(angle / 2.0) ** 2 if angle > 0.0 else 1.0
+        irradiance = strength if normalize else strength * disk
+        return Light("SUN", irradiance=irradiance, angle=angle, **common)
+    size_x = light.size * axes[0]
+    size_y = (light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size) * axes[1]
+    area = size_x * size_y * (math.pi / 4.0 if light.shape in ("DISK", "ELLIPSE") else 1.0)
+    if area == 0.0:
+        return None  # zero size or a zero X or Y axis in the object matrix
+    radiance = strength / (math.pi * area) if normalize else strength / math.pi
+    return Light(
+        "AREA",
+        radiance=radiance,
+        shape=light.shape,
+        size_x=size_x,
+        size_y=size_y,
+        spread=light.spread,
+        **common,
+    )

@@ -1,0 +1,141 @@
+"""Reading constant values out of shader node trees, and flattening Mix/Add Shader.
+
+The tracer evaluates constant closures only. A linked input is followed through
+reroutes to a constant node (RGB, Value); anything else falls back to the socket's
+default value and is recorded as an issue, so the caller can warn once per
+material or world.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+CONSTANT_NODES = ("ShaderNodeRGB", "ShaderNodeValue")
+
+
+@dataclass
+class Issues:
+    """What a tree uses that the tracer cannot evaluate, gathered for one warning."""
+
+    items: set[str] = field(default_factory=set)
+
+    def add(self, text: str) -> None:
+        self.items.add(text)
+
+    def message(self, owner: str) -> str | None:
+        if not self.items:
+            return None
+        details = "; ".join(sorted(self.items))
+        return f"{owner} uses what DRT cannot evaluate yet ({details}): default values used"
+
+
+def find_input(node, *names):
+    """The input socket with one of ``names`` (identifier first, then label), or None."""
+    for name in names:
+        for socket in node.inputs:
+            if socket.identifier == name and socket.enabled:
+                return socket
+        socket = node.inputs.get(name)
+        if socket is not None and socket.enabled:
+            return socket
+    return None
+
+
+def linked_from(socket):
+    """The (node, output socket) feeding ``socket`` through reroutes, or None."""
+    while socket.is_linked:
+        link = socket.links[0]
+        if link.is_muted or not link.is_valid:
+            return None
+        node = link.from_node
+        if node.bl_idname == "NodeReroute":
+            socket = node.inputs[0]
+            continue
+        return node, link.from_socket
+    return None
+
+
+def _constant(value) -> float | np.ndarray:
+    if isinstance(value, (int, float)):
+        return float(value)
+    return np.array(value[:], dtype=np.float64)
+
+
+def socket_value(socket, issues: Issues):
+    """Constant value of an input socket: float, or an array for colours and vectors."""
+    source = linked_from(socket)
+    if source is not None:
+        node, output = source
+        if node.bl_idname in CONSTANT_NODES:
+            value = _constant(output.default_value)
+            return _coerce(value, socket)
+        issues.add(f"'{socket.node.name}' input '{socket.name}' linked to '{node.name}'")
+    return _constant(socket.default_value)
+
+
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+"""Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
+
+
+def _coerce(value, socket):
+    """Match the value's shape to the socket, converting as Blender's implicit conversions do."""
+    target = socket.default_value
+    if isinstance(target, (int, float)):
+        return float(LUMINANCE @ value[:3]) if isinstance(value, np.ndarray) else value
+    if isinstance(value, float):
+        return np.full(len(target), value)
+    return value[: len(target)]
+
+
+def input_value(node, issues: Issues, default, *names):
+    """Value of the first present input among ``names``; ``default`` if none exists."""
+    socket = find_input(node, *names)
+    if socket is None:
+        return default
+    return socket_value(socket, issues)
+
+
+def rgb(value) -> np.ndarray:
+    """First three channels of a colour value (a float becomes grey)."""
+    if isinstance(value, float):
+        return np.full(3, value)
+    return np.asarray(value, dtype=np.float64)[:3]
+
+
+def report_linked_inputs(node, issues: Issues, ignored=("Weight",)) -> None:
+    """Record linked inputs a closure node has but the tracer does not read (normal maps...)."""
+    for socket in node.inputs:
+        if socket.type == "SHADER" or socket.name in ignored or not socket.enabled:
+            continue
+        source = linked_from(socket)
+        if source is not None and source[0].bl_idname not in CONSTANT_NODES:
+            issues.add(f"'{node.name}' input '{socket.name}' linked to '{source[0].name}'")
+
+
+def flatten(socket, leaf, issues: Issues, weight=None) -> list:
+    """Walk Mix and Add Shader nodes down from ``socket`` into weighted leaves.
+
+    ``leaf(node, weight)`` turns a closure node into a list of closures with
+    ``weight`` (RGB) applied. An unconnected shader socket contributes nothing, as
+    in Cycles.
+    """
+    weight = np.ones(3) if weight is None else weight
+    source = linked_from(socket)
+    if source is None:
+        return []
+    node, output = source
+    if node.mute:  # Blender passes a muted node's matching input through, if it has one
+        inputs = [link.from_socket for link in node.internal_links if link.to_socket == output]
+        return flatten(inputs[0], leaf, issues, weight) if inputs else []
+    kind = node.bl_idname
+    if kind == "ShaderNodeMixShader":
+        fac = float(np.clip(input_value(node, issues, 0.5, "Fac", "Factor"), 0.0, 1.0))
+        shaders = [s for s in node.inputs if s.type == "SHADER"]
+        return flatten(shaders[0], leaf, issues, weight * (1.0 - fac)) + flatten(
+            shaders[1], leaf, issues, weight * fac
+        )
+    if kind == "ShaderNodeAddShader":
+        shaders = [s for s in node.inputs if s.type == "SHADER"]
+        return flatten(shaders[0], leaf, issues, weight) + flatten(shaders[1], leaf, issues, weight)
+    return leaf(node, weight)
