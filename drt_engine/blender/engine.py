@@ -1,0 +1,152 @@
+"""The DRT RenderEngine: export the depsgraph, trace it, hand the passes back to Blender.
+
+Blender calls ``render`` once per view layer with that layer's depsgraph (stereo views
+are not rendered separately yet). With border render on, Blender's render result covers only the border (it
+pastes the result into the full frame itself when "Crop to Render Region" is off), so
+the engine always writes the ``camera.window`` rectangle at (0, 0) of its result.
+"""
+import time
+import traceback
+
+import bpy
+import numpy as np
+
+from ..core.errors import DRTError, RenderCancelled
+from .properties import enabled_passes, pass_layout, settings_from_scene
+
+DISPLAY_INTERVAL = 1.0
+"""Seconds between refreshes of the image on screen while rendering."""
+
+
+def render_window(render, width: int, height: int) -> tuple[int, int, int, int]:
+    """The pixel rectangle (x0, y0, x1, y1) Blender allocates for a render, rows from the bottom.
+
+    ``width``, ``height`` are the full image after the resolution percentage
+    (``RenderEngine.resolution_x/y``). Blender truncates border * size in single
+    precision (render_init_from_main in pipeline.cc), so this does the same.
+    """
+    if not render.use_border:
+        return 0, 0, width, height
+    border = np.array([render.border_min_x, render.border_min_y, render.border_max_x, render.border_max_y],
+                      np.float32)
+    x0, y0, x1, y1 = (int(v) for v in border * np.array([width, height, width, height], np.float32))
+    return x0, y0, x1, y1
+
+
+def write_passes(result, passes: dict) -> None:
+    """Copy the core's (h, w, C) arrays, rows bottom-to-top like Blender's, into a render result."""
+    layer_passes = result.layers[0].passes
+    for name, pixels in passes.items():
+        target = layer_passes.get(name)
+        if target is not None:
+            target.rect.foreach_set(np.ascontiguousarray(pixels, dtype=np.float32).ravel())
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+class DRTRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "DRT"
+    bl_label = "DRT"
+    bl_use_shading_nodes_custom = False
+    bl_use_preview = True
+    bl_use_postprocess = True
+    bl_use_eevee_viewport = True
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+
+    def render(self, depsgraph):
+        try:
+            self._render(depsgraph)
+        except RenderCancelled:
+            pass
+        except DRTError as error:
+            self.report({"ERROR"}, _one_line(str(error)))
+        except Exception as error:  # a bug of ours: one line for the user, details in the console
+            print(f"DRT: unexpected error while rendering\n{traceback.format_exc()}")
+            self.report({"ERROR"}, _one_line(f"DRT internal error: {type(error).__name__}: {error}"))
+
+    def _render(self, depsgraph):
+        from ..core.render import Renderer
+        from .export import export_scene
+
+        scene = depsgraph.scene
+        view_layer = depsgraph.view_layer
+        self.update_stats("", "Exporting scene")
+        scene_data = export_scene(depsgraph, camera_object=self.camera_override, cancel=self.test_break)
+        self._warn(scene_data.warnings)
+        if self.test_break():
+            return
+        self._check_window(scene_data.camera, scene.render)
+
+        settings = settings_from_scene(scene, view_layer)
+        self.update_stats("", "Preparing the render")
+        renderer = Renderer(scene_data, settings)
+        if self.test_break():
+            return
+
+        width, height = scene_data.camera.window_size
+        result = self.begin_result(0, 0, width, height, layer=view_layer.name)
+        try:
+            outcome = renderer.render(progress=self._progress_callback(result))
+            write_passes(result, outcome.passes)
+        finally:
+            self.end_result(result)
+        self._warn([w for w in getattr(outcome, "warnings", ()) if w not in scene_data.warnings])
+        if not outcome.cancelled:
+            self.update_progress(1.0)
+        stats = outcome.stats
+        state = "Cancelled" if outcome.cancelled else "Done"
+        self.update_stats("", f"{state} | {stats.get('samples', settings.samples)} samples "
+                          f"| {stats.get('elapsed', 0.0):.2f} s")
+
+    def _warn(self, warnings):
+        if not self.is_preview:  # material thumbnails would repeat the same warnings endlessly
+            for warning in warnings:
+                self.report({"WARNING"}, _one_line(warning))
+
+    def _progress_callback(self, result):
+        """The core's progress callback: progress bar, stats, progressive image, cancel."""
+        last_display = time.monotonic()
+
+        def progress(update) -> bool:
+            nonlocal last_display
+            self.update_progress(min(max(update.fraction, 0.0), 1.0))
+            self.update_stats("", f"Sample {update.samples_done}/{update.samples_total} "
+                              f"| Elapsed {update.elapsed:.1f} s")
+            now = time.monotonic()
+            if now - last_display >= DISPLAY_INTERVAL:
+                write_passes(result, {"Combined": update.passes()["Combined"]})
+                self.update_result(result)
+                last_display = now
+            return not self.test_break()
+
+        return progress
+
+    def _check_window(self, camera, render):
+        """The export's pixel rectangle must be the one Blender allocated for the result."""
+        expected = render_window(render, self.resolution_x, self.resolution_y)
+        if tuple(camera.resolution) != (self.resolution_x, self.resolution_y) or tuple(camera.window) != expected:
+            raise DRTError(
+                f"DRT internal error: exported image {camera.resolution} window {camera.window} "
+                f"differs from Blender's {(self.resolution_x, self.resolution_y)} window {expected}"
+            )
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        for name in enabled_passes(renderlayer):
+            self.register_pass(scene, renderlayer, name, *pass_layout(name))
+
+
+classes = (DRTRenderEngine,)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

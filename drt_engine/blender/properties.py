@@ -1,0 +1,214 @@
+"""DRT's settings in Blender: ``scene.drt`` and ``view_layer.drt``, and their plain-data mirror.
+
+Only settings Blender does not already have live here. Resolution, border, film
+transparency, filter width and motion blur are read from ``scene.render`` so DRT and
+Cycles share one set of knobs.
+"""
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+from ..core.settings import PASS_CHANNELS, PASSES, RenderSettings
+
+BLENDER_PASS_TOGGLES = {
+    "Depth": "use_pass_z",
+    "Normal": "use_pass_normal",
+    "Position": "use_pass_position",
+    "DiffCol": "use_pass_diffuse_color",
+    "GlossCol": "use_pass_glossy_color",
+    "Emit": "use_pass_emit",
+    "Env": "use_pass_environment",
+}
+"""Passes Blender has its own view-layer toggle for (the compositor knows them by these names)."""
+
+DRT_PASS_TOGGLES = {
+    "Sample Count": "use_pass_sample_count",
+    "Noise": "use_pass_noise",
+}
+"""DRT's own passes, toggled by ``view_layer.drt.<property>``."""
+
+_PASS_TYPES = {"RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "Z": "VALUE", "X": "VALUE"}
+
+
+def pass_enabled(view_layer, name: str) -> bool:
+    """Whether the view layer asks for pass ``name`` (Combined always)."""
+    if name == "Combined":
+        return True
+    if name in BLENDER_PASS_TOGGLES:
+        return bool(getattr(view_layer, BLENDER_PASS_TOGGLES[name], False))
+    return bool(getattr(view_layer.drt, DRT_PASS_TOGGLES[name]))
+
+
+def enabled_passes(view_layer) -> tuple[str, ...]:
+    """The passes to render and write for this view layer, in ``PASSES`` order."""
+    return tuple(name for name in PASSES if pass_enabled(view_layer, name))
+
+
+def pass_layout(name: str) -> tuple[int, str, str]:
+    """(channel count, channel ids, Blender pass type) for ``RenderEngine.register_pass``."""
+    chan_id = PASS_CHANNELS[name]
+    return len(chan_id), chan_id, _PASS_TYPES[chan_id]
+
+
+def settings_from_scene(scene, view_layer) -> RenderSettings:
+    """The core's RenderSettings for one view layer of ``scene``."""
+    drt = scene.drt
+    return RenderSettings(
+        samples=drt.samples,
+        seed=drt.seed,
+        sampling_pattern=drt.sampling_pattern,
+        max_depth=drt.max_depth,
+        clamp=drt.clamp,
+        threads=drt.threads,
+        filter_type=drt.filter_type,
+        filter_size=scene.render.filter_size,
+        passes=enabled_passes(view_layer),
+        use_adaptive_sampling=drt.use_adaptive_sampling,
+        adaptive_threshold=drt.adaptive_threshold,
+        adaptive_min_samples=drt.adaptive_min_samples,
+        time_limit=drt.time_limit,
+        target_error=drt.target_error,
+    )
+
+
+def _update_render_passes(self, context):
+    """Tell Blender the view layer's pass list changed so the compositor's sockets follow."""
+    for view_layer in self.id_data.view_layers:
+        if view_layer.drt.as_pointer() == self.as_pointer():
+            view_layer.update_render_passes()
+
+
+class DRTSceneSettings(bpy.types.PropertyGroup):
+    samples: IntProperty(
+        name="Samples",
+        description="Samples per pixel. Each sample traces one camera ray and its whole "
+        "specular and glossy ray tree; noise falls as one over the square root of this",
+        default=64,
+        min=1,
+        soft_max=4096,
+    )
+    seed: IntProperty(
+        name="Seed",
+        description="Seed of every random number. The same settings and seed give the "
+        "same image, bit for bit; change it to get independent noise",
+        default=0,
+        min=0,
+    )
+    sampling_pattern: EnumProperty(
+        name="Pattern",
+        description="How sample positions are chosen in the pixel, lens, shutter time and "
+        "light dimensions",
+        items=(
+            ("GRID", "Grid", "Regular n×n supersampling, averaged down (aliases on fine detail)"),
+            ("JITTERED", "Jittered", "n×n strata with one random sample in each"),
+            ("SOBOL", "Sobol", "Owen-scrambled Sobol sequence, decorrelated per pixel and "
+             "per dimension; converges fastest"),
+        ),
+        default="SOBOL",
+    )
+    max_depth: IntProperty(
+        name="Max Depth",
+        description="Longest chain of specular and glossy reflections and refractions "
+        "followed from the camera (diffuse surfaces take direct light only)",
+        default=8,
+        min=0,
+        soft_max=64,
+        max=1024,
+    )
+    clamp: FloatProperty(
+        name="Clamp",
+        description="Largest radiance one sample may contribute, to tame fireflies at the "
+        "cost of bias; 0 turns clamping off",
+        default=0.0,
+        min=0.0,
+        soft_max=100.0,
+    )
+    threads: IntProperty(
+        name="Threads",
+        description="Threads tracing rays; 0 uses all processor cores. The image does not "
+        "depend on it",
+        default=0,
+        min=0,
+        max=1024,
+    )
+    filter_type: EnumProperty(
+        name="Filter",
+        description="Pixel reconstruction filter; its width is the render's Filter Size",
+        items=(
+            ("BOX", "Box", "Every sample in the filter square counts equally (sharpest, aliases)"),
+            ("GAUSSIAN", "Gaussian", "Gaussian falloff (soft)"),
+            ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris window, as Cycles "
+             "(sharp with little ringing)"),
+        ),
+        default="BLACKMAN_HARRIS",
+    )
+    use_adaptive_sampling: BoolProperty(
+        name="Adaptive Sampling",
+        description="Stop sampling pixels whose estimated error is below the noise threshold",
+        default=False,
+    )
+    adaptive_threshold: FloatProperty(
+        name="Noise Threshold",
+        description="Relative standard error of a pixel below which it gets no more samples",
+        default=0.01,
+        min=0.0,
+        soft_min=0.001,
+        max=1.0,
+        precision=4,
+    )
+    adaptive_min_samples: IntProperty(
+        name="Min Samples",
+        description="Samples every pixel takes before the threshold is tested; 0 chooses "
+        "automatically from the threshold",
+        default=0,
+        min=0,
+    )
+    time_limit: FloatProperty(
+        name="Time Limit",
+        description="Stop the render after this many seconds with the image so far; "
+        "0 means no limit",
+        default=0.0,
+        min=0.0,
+        subtype="TIME_ABSOLUTE",
+        unit="TIME_ABSOLUTE",
+    )
+    target_error: FloatProperty(
+        name="Target Error",
+        description="Stop the render once the estimated mean relative error of the image "
+        "falls below this; 0 means no target",
+        default=0.0,
+        min=0.0,
+        soft_max=0.1,
+        precision=4,
+    )
+
+
+class DRTViewLayerSettings(bpy.types.PropertyGroup):
+    use_pass_sample_count: BoolProperty(
+        name="Sample Count",
+        description="Write the number of samples each pixel took",
+        default=False,
+        update=_update_render_passes,
+    )
+    use_pass_noise: BoolProperty(
+        name="Noise",
+        description="Write each pixel's standard error of the Combined estimate",
+        default=False,
+        update=_update_render_passes,
+    )
+
+
+classes = (DRTSceneSettings, DRTViewLayerSettings)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.drt = PointerProperty(type=DRTSceneSettings, name="DRT", description="DRT render settings")
+    bpy.types.ViewLayer.drt = PointerProperty(type=DRTViewLayerSettings, name="DRT", description="DRT pass settings")
+
+
+def unregister():
+    del bpy.types.ViewLayer.drt
+    del bpy.types.Scene.drt
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,222 @@
+"""DRT's panels, and Blender's own panels opened to DRT through their COMPAT_ENGINES.
+
+DRT reads the camera, lights, materials, world and output settings Blender already
+has, so it shows Blender's panels for them rather than copies. Panels are found by
+class name and missing ones are skipped: names move between Blender 4.2 and 5.0.
+"""
+import bpy
+
+ENGINE = "DRT"
+
+SHARED_PANELS = (
+    # camera: lens, sensor, depth of field
+    "DATA_PT_context_camera",
+    "DATA_PT_lens",
+    "DATA_PT_camera",
+    "DATA_PT_camera_dof",
+    "DATA_PT_camera_dof_aperture",
+    # light: type, colour, power, radius, shape and size, spot cone
+    "DATA_PT_context_light",
+    "DATA_PT_EEVEE_light",
+    "DATA_PT_spot",
+    "DATA_PT_area",
+    # material: slots and the surface node tree
+    "EEVEE_MATERIAL_PT_context_material",
+    "MATERIAL_PT_preview",
+    "EEVEE_MATERIAL_PT_surface",
+    # world: the surface node tree
+    "WORLD_PT_context_world",
+    "EEVEE_WORLD_PT_surface",
+    # output and colour
+    "RENDER_PT_format",
+    "RENDER_PT_frame_range",
+    "RENDER_PT_output",
+    "RENDER_PT_color_management",
+    "VIEWLAYER_PT_layer",
+)
+"""Blender panels DRT needs, by class name."""
+
+GENERIC_MARKER = "BLENDER_RENDER"
+"""Blender tags engine-agnostic panels (mesh data, physics, particles...) with this name."""
+
+GENERIC_EXCLUDED = (
+    "DATA_PT_light",  # type only; DATA_PT_EEVEE_light draws the full light
+    "NODE_DATA_PT_light",
+    "RENDER_PT_freestyle",  # DRT draws no Freestyle lines and no grease pencil
+    "MATERIAL_PT_freestyle_line",
+    "RENDER_PT_gpencil",
+)
+GENERIC_EXCLUDED_PREFIXES = (
+    "VIEWLAYER_PT_freestyle",
+    "RENDER_PT_grease_pencil",
+    "RENDER_PT_simplify",  # registered before DRT's panels, it would sit above Sampling (Cycles hides it too)
+)
+
+
+_opened: list[type] = []
+"""Panels whose COMPAT_ENGINES got DRT from us, so unregister takes it out of exactly those."""
+
+
+def _shared_panels() -> list[type]:
+    named = (getattr(bpy.types, name, None) for name in SHARED_PANELS)
+    panels = [p for p in named if p is not None and hasattr(p, "COMPAT_ENGINES")]
+    for panel in bpy.types.Panel.__subclasses__():
+        engines = getattr(panel, "COMPAT_ENGINES", None)
+        name = panel.__name__
+        if engines and GENERIC_MARKER in engines and name not in GENERIC_EXCLUDED:
+            if not name.startswith(GENERIC_EXCLUDED_PREFIXES):
+                panels.append(panel)
+    return list(dict.fromkeys(panels))
+
+
+class DRTButtonsPanel:
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class DRT_PT_sampling(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        drt = context.scene.drt
+        col = layout.column()
+        col.prop(drt, "samples")
+        col.prop(drt, "sampling_pattern")
+        col.prop(drt, "seed")
+        col = layout.column()
+        col.prop(drt, "time_limit")
+        col.prop(drt, "target_error")
+
+
+class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Adaptive Sampling"
+    bl_parent_id = "DRT_PT_sampling"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.drt, "use_adaptive_sampling", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        drt = context.scene.drt
+        layout.active = drt.use_adaptive_sampling
+        col = layout.column()
+        col.prop(drt, "adaptive_threshold")
+        col.prop(drt, "adaptive_min_samples")
+
+
+class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Light Paths"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        drt = context.scene.drt
+        col = layout.column()
+        col.prop(drt, "max_depth")
+        col.prop(drt, "clamp")
+
+
+class DRT_PT_film(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Film"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        scene = context.scene
+        col = layout.column()
+        col.prop(scene.drt, "filter_type")
+        col.prop(scene.render, "filter_size", text="Width")
+        col.prop(scene.render, "film_transparent", text="Transparent")
+
+
+class DRT_PT_motion_blur(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Motion Blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.render, "use_motion_blur", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        render = context.scene.render
+        layout.active = render.use_motion_blur
+        col = layout.column()
+        if hasattr(render, "motion_blur_position"):
+            col.prop(render, "motion_blur_position", text="Position")
+        col.prop(render, "motion_blur_shutter")
+
+
+class DRT_PT_performance(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Performance"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.drt, "threads")
+
+
+class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Passes"
+    bl_context = "view_layer"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        view_layer = context.view_layer
+        col = layout.column(heading="Data", align=True)
+        col.prop(view_layer, "use_pass_z")
+        col.prop(view_layer, "use_pass_normal")
+        col.prop(view_layer, "use_pass_position")
+        col = layout.column(heading="Light", align=True)
+        col.prop(view_layer, "use_pass_diffuse_color", text="Diffuse Color")
+        col.prop(view_layer, "use_pass_glossy_color", text="Glossy Color")
+        col.prop(view_layer, "use_pass_emit", text="Emission")
+        col.prop(view_layer, "use_pass_environment")
+        col = layout.column(heading="Sampling", align=True)
+        col.prop(view_layer.drt, "use_pass_sample_count")
+        col.prop(view_layer.drt, "use_pass_noise")
+
+
+classes = (
+    DRT_PT_sampling,
+    DRT_PT_sampling_adaptive,
+    DRT_PT_light_paths,
+    DRT_PT_film,
+    DRT_PT_motion_blur,
+    DRT_PT_performance,
+    DRT_PT_passes,
+)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    for panel in _shared_panels():
+        if ENGINE not in panel.COMPAT_ENGINES:
+            panel.COMPAT_ENGINES.add(ENGINE)
+            _opened.append(panel)
+
+
+def unregister():
+    while _opened:
+        _opened.pop().COMPAT_ENGINES.discard(ENGINE)
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,190 @@
+"""``python -m drt_engine render FILE.blend -o OUT``: render a .blend with DRT through the bpy module.
+
+Blender prints freely on both streams. While it works, file descriptor 2 points at
+stdout, so the real stderr carries exactly one line from us when something is wrong
+(and nothing otherwise); the exit code says which.
+"""
+import argparse
+import os
+import re
+import sys
+import time
+from pathlib import Path
+
+EXIT_ERROR = 1
+EXIT_USAGE = 2
+BLEND_MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")  # plain, gzip, zstd
+MIN_SIDE = 4  # the smallest image side Blender renders
+
+
+class CLIError(Exception):
+    """Bad input: the message is the one line the user sees."""
+
+    def __init__(self, message: str, code: int = EXIT_ERROR):
+        super().__init__(message)
+        self.code = code
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise CLIError(message, EXIT_USAGE)
+
+
+def _resolution(text: str) -> tuple[int, int]:
+    match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not match:
+        raise argparse.ArgumentTypeError(f"must look like WxH, e.g. 640x480, got {text!r}")
+    width, height = int(match[1]), int(match[2])
+    if min(width, height) < MIN_SIDE:
+        raise argparse.ArgumentTypeError(f"each side must be at least {MIN_SIDE} pixels, got {text!r}")
+    return width, height
+
+
+def _at_least(minimum: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be at least {minimum}, got {value}")
+        return value
+
+    return parse
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="python -m drt_engine", description="DRT, a distribution ray tracer for Blender scenes.")
+    commands = parser.add_subparsers(dest="command", metavar="{render}", required=True, parser_class=_Parser)
+    render = commands.add_parser(
+        "render",
+        help="render a .blend file with DRT",
+        description="Render FILE.blend with DRT and write OUT: a multilayer EXR with every pass "
+        "enabled on the view layers (.exr) or a PNG through the scene's view transform (.png). "
+        "Overrides change the scene in memory only; the .blend file is never saved.",
+    )
+    render.add_argument("blend", metavar="FILE.blend", help="the scene to render (its active scene and camera)")
+    render.add_argument("-o", "--output", required=True, metavar="OUT", help="output file, .exr or .png")
+    render.add_argument("--samples", type=_at_least(1), metavar="N", help="samples per pixel (scene.drt.samples)")
+    render.add_argument("--seed", type=_at_least(0), metavar="S", help="random seed (scene.drt.seed)")
+    render.add_argument("--frame", type=int, metavar="F", help="frame to render (default: the file's current frame)")
+    render.add_argument("--resolution", type=_resolution, metavar="WxH", help="image size in pixels (at 100%%)")
+    render.add_argument("--engine-threads", type=_at_least(0), metavar="T", help="render threads, 0 = all cores")
+    return parser
+
+
+def _check_paths(blend: Path, output: Path) -> None:
+    if not blend.is_file():
+        raise CLIError(f"no such file: {blend}")
+    with open(blend, "rb") as f:
+        head = f.read(7)
+    if not head.startswith(BLEND_MAGIC):
+        raise CLIError(f"not a .blend file: {blend}")
+    if output.suffix.lower() not in (".exr", ".png"):
+        raise CLIError(f"output must end in .exr or .png: {output}")
+    try:
+        output.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise CLIError(f"cannot create output folder {output.parent}: {error.strerror or error}") from None
+    if output.is_dir():
+        raise CLIError(f"output is a folder: {output}")
+    if not os.access(output.parent, os.W_OK):
+        raise CLIError(f"output folder is not writable: {output.parent}")
+
+
+def _blender_message(error: Exception) -> str:
+    """Blender's operator errors read 'Error: message\\n...': keep the message."""
+    lines = [line.strip() for line in str(error).splitlines() if line.strip()]
+    text = lines[0] if lines else type(error).__name__
+    return re.sub(r"^(Error|Warning):\s*", "", text)
+
+
+def _set_output_format(image_settings, exr: bool) -> None:
+    has_media_type = hasattr(image_settings, "media_type")  # Blender 5.0+
+    if exr:
+        if has_media_type:
+            image_settings.media_type = "MULTI_LAYER_IMAGE"
+        image_settings.file_format = "OPEN_EXR_MULTILAYER"
+        image_settings.color_depth = "32"
+    else:
+        if has_media_type:
+            image_settings.media_type = "IMAGE"
+        image_settings.file_format = "PNG"
+
+
+def _render(args) -> str:
+    blend = Path(args.blend).expanduser().resolve()
+    output = Path(args.output).expanduser().resolve()
+    _check_paths(blend, output)
+
+    import bpy
+
+    from . import register
+
+    register()
+    try:
+        bpy.ops.wm.open_mainfile(filepath=str(blend), load_ui=False)
+    except RuntimeError as error:
+        raise CLIError(f"cannot open {blend}: {_blender_message(error)}") from None
+    scene = bpy.context.scene
+    if args.frame is not None:
+        scene.frame_set(args.frame)
+    if scene.camera is None:
+        raise CLIError(f"scene {scene.name!r} in {blend.name} has no camera")
+    render = scene.render
+    render.engine = "DRT"
+    if args.resolution:
+        render.resolution_x, render.resolution_y = args.resolution
+        render.resolution_percentage = 100
+    if args.samples is not None:
+        scene.drt.samples = args.samples
+    if args.seed is not None:
+        scene.drt.seed = args.seed
+    if args.engine_threads is not None:
+        scene.drt.threads = args.engine_threads
+
+    start = time.perf_counter()
+    try:
+        bpy.ops.render.render(write_still=False, scene=scene.name)
+    except RuntimeError as error:
+        raise CLIError(f"render failed: {_blender_message(error)}") from None
+    elapsed = time.perf_counter() - start
+
+    exr = output.suffix.lower() == ".exr"
+    _set_output_format(render.image_settings, exr)
+    try:
+        bpy.data.images["Render Result"].save_render(filepath=str(output), scene=scene)
+    except RuntimeError as error:
+        raise CLIError(f"cannot write {output}: {_blender_message(error)}") from None
+    if not output.is_file():
+        raise CLIError(f"cannot write {output}")
+    width, height = (side * render.resolution_percentage // 100 for side in (render.resolution_x, render.resolution_y))
+    return f"DRT: wrote {output} ({width}x{height}, {scene.drt.samples} samples, {elapsed:.1f} s)"
+
+
+def main(argv=None) -> int:
+    stderr = os.fdopen(os.dup(2), "w")
+    saved_stderr = os.dup(2)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.dup2(1, 2)  # Blender's own messages, Python's included, go to stdout from here on
+    try:
+        args = build_parser().parse_args(argv)
+        print(_render(args), flush=True)
+        return 0
+    except CLIError as error:
+        stderr.write(f"drt: error: {error}\n")
+        return error.code
+    except Exception as error:  # a bug of ours: still one line, the details on stdout
+        import traceback
+
+        traceback.print_exc(file=sys.stdout)
+        stderr.write(f"drt: internal error: {type(error).__name__}: {error}\n")
+        return EXIT_ERROR
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        stderr.flush()
+        os.dup2(saved_stderr, 2)
+        os.close(saved_stderr)
+        stderr.close()

@@ -1,0 +1,148 @@
+"""``python -m drt_engine render``: real subprocesses on small .blend files written by the test.
+
+Success writes the file and nothing on stderr; bad input exits non-zero with exactly
+one line on stderr (Blender's own chatter goes to stdout).
+"""
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+STRENGTH = 0.5
+
+
+def run_cli(*args, timeout=120):
+    return subprocess.run(
+        [sys.executable, "-m", "drt_engine", *map(str, args)],
+        cwd=ROOT, capture_output=True, text=True, timeout=timeout,
+    )
+
+
+def assert_one_line_error(result, *words):
+    assert result.returncode != 0
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("drt: error:")
+    for word in words:
+        assert word in lines[0]
+
+
+@pytest.fixture
+def blend(bl, tmp_path):
+    """An emitter of strength 0.5 filling the view, 16x12, Depth and Noise enabled, Standard view."""
+    scene = bl.emission_scene(strength=STRENGTH, samples=2)
+    scene.view_layers["ViewLayer"].use_pass_z = True
+    scene.view_layers["ViewLayer"].drt.use_pass_noise = True
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    path = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    return path
+
+
+def test_help():
+    result = run_cli("render", "--help", timeout=60)
+    assert result.returncode == 0
+    for option in ("--samples", "--seed", "--frame", "--resolution", "--engine-threads", "-o"):
+        assert option in result.stdout
+    assert result.stderr == ""
+
+
+def test_render_to_multilayer_exr_with_overrides(bl, blend, tmp_path):
+    before = hashlib.sha256(blend.read_bytes()).hexdigest()
+    out = tmp_path / "new folder" / "out.exr"
+    result = run_cli("render", blend, "-o", out, "--samples", 3, "--seed", 5, "--resolution", "20x8",
+                     "--engine-threads", 1, "--frame", 1)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert result.stderr == ""
+    channels = bl.read_channels(out)
+    assert bl.passes_in(channels, "ViewLayer") == {"Combined", "Depth", "Noise"}
+    combined = bl.pass_pixels(channels, "ViewLayer", "Combined")
+    assert combined.shape == (8, 20, 4)
+    np.testing.assert_allclose(combined[..., :3], STRENGTH, rtol=1e-4)
+    np.testing.assert_allclose(bl.pass_pixels(channels, "ViewLayer", "Depth"), bl.camera_height, rtol=1e-4)
+    assert hashlib.sha256(blend.read_bytes()).hexdigest() == before
+
+
+def test_render_to_png_through_the_view_transform(bl, blend, tmp_path):
+    out = tmp_path / "out.png"
+    result = run_cli("render", blend, "-o", out)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert result.stderr == ""
+    channels = bl.read_channels(out)
+    rgb = np.stack([channels[c] for c in "RGB"], axis=-1)
+    assert rgb.shape == (12, 16, 3)
+    srgb = 1.055 * STRENGTH ** (1 / 2.4) - 0.055  # Standard view: the sRGB curve, 0.5 -> 0.735
+    np.testing.assert_allclose(rgb, srgb, atol=2 / 255)
+
+
+def test_frame_override_moves_to_that_frame(bl, tmp_path):
+    scene = bl.emission_scene(strength=STRENGTH, world=(0.25, 0.25, 0.25), samples=1)
+    plane = bpy.data.objects["Emitter"]
+    plane.keyframe_insert("location", frame=1)
+    plane.location.x = 100.0  # out of view at frame 5
+    plane.keyframe_insert("location", frame=5)
+    scene.frame_set(1)
+    path = tmp_path / "animated.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    out = tmp_path / "frame5.exr"
+    result = run_cli("render", path, "-o", out, "--frame", 5)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    combined = bl.pass_pixels(bl.read_channels(out), "ViewLayer", "Combined")
+    np.testing.assert_allclose(combined[..., :3], 0.25, rtol=1e-4)
+
+
+def test_missing_file(tmp_path):
+    assert_one_line_error(run_cli("render", tmp_path / "nope.blend", "-o", tmp_path / "o.exr"), "no such file")
+
+
+def test_not_a_blend_file(tmp_path):
+    fake = tmp_path / "fake.blend"
+    fake.write_text("not a blend file\n")
+    assert_one_line_error(run_cli("render", fake, "-o", tmp_path / "o.exr"), "not a .blend file")
+
+
+def test_no_camera(bl, tmp_path):
+    scene = bl.emission_scene()
+    scene.camera = None
+    bpy.data.objects.remove(bpy.data.objects["Camera"])
+    path = tmp_path / "nocamera.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    out = tmp_path / "o.exr"
+    assert_one_line_error(run_cli("render", path, "-o", out), "no camera")
+    assert not out.exists()
+
+
+def test_scene_the_engine_rejects(bl, tmp_path):
+    scene = bl.emission_scene()
+    scene.camera.data.type = "PANO"
+    path = tmp_path / "panorama.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    out = tmp_path / "o.exr"
+    assert_one_line_error(run_cli("render", path, "-o", out), "render failed", "perspective and orthographic")
+    assert not out.exists()
+
+
+def test_unwritable_output(blend, tmp_path):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("a file where the output folder should be\n")
+    assert_one_line_error(run_cli("render", blend, "-o", blocker / "o.exr"), "cannot create output folder")
+
+
+def test_unsupported_output_format(blend, tmp_path):
+    assert_one_line_error(run_cli("render", blend, "-o", tmp_path / "o.jpg"), ".exr or .png")
+
+
+@pytest.mark.parametrize("resolution", ["abc", "16", "3x10", "16x-2"])
+def test_bad_resolution(blend, tmp_path, resolution):
+    assert_one_line_error(run_cli("render", blend, "-o", tmp_path / "o.exr", "--resolution", resolution),
+                          "--resolution")
+
+
+def test_missing_output_argument(blend):
+    assert_one_line_error(run_cli("render", blend), "-o/--output")

@@ -1,0 +1,239 @@
+"""The DRT RenderEngine inside Blender: images, passes, view layers, border, errors, progress, cancel.
+
+Scenes are an emissive plane (strength 2) filling the view of a camera 5 m above it,
+so every pixel's Combined is exactly 2, its depth exactly 5 and its normal +Z, at
+any sample count: the facts below do not depend on noise.
+"""
+import time
+from types import SimpleNamespace
+
+import bpy
+import numpy as np
+import pytest
+
+import drt_engine.blender.engine as engine_module
+from drt_engine.blender.engine import DRTRenderEngine, render_window
+from drt_engine.core.render import WAVE, Renderer
+from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
+from drt_engine.core.settings import PASSES, RenderSettings
+
+STRENGTH = 2.0
+LAYER = "ViewLayer"
+
+
+def test_engine_is_a_render_engine_subclass(drt):
+    assert DRTRenderEngine in bpy.types.RenderEngine.__subclasses__()
+    assert DRTRenderEngine.is_registered
+
+
+def test_render_operator_gives_the_emitted_radiance(bl, tmp_path):
+    scene = bl.emission_scene(strength=STRENGTH)
+    channels = bl.render_exr(scene, tmp_path / "out.exr")
+    combined = bl.pass_pixels(channels, LAYER, "Combined")
+    assert combined.shape == (12, 16, 4)
+    np.testing.assert_allclose(combined[..., :3], STRENGTH, rtol=1e-4)
+    np.testing.assert_allclose(combined[..., 3], 1.0, rtol=1e-5)
+
+
+def test_enabled_passes_are_written_and_disabled_ones_are_not(bl, tmp_path):
+    scene = bl.emission_scene(strength=STRENGTH)
+    view_layer = scene.view_layers[LAYER]
+    view_layer.use_pass_z = True
+    view_layer.use_pass_normal = True
+    view_layer.drt.use_pass_noise = True
+    channels = bl.render_exr(scene, tmp_path / "some.exr")
+    assert bl.passes_in(channels, LAYER) == {"Combined", "Depth", "Normal", "Noise"}
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Depth")[..., 0], bl.camera_height, rtol=1e-4)
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Normal"), np.broadcast_to([0, 0, 1], (12, 16, 3)),
+                               atol=1e-4)
+    noise = bl.pass_pixels(channels, LAYER, "Noise")
+    assert np.all(np.isfinite(noise)) and np.all(noise >= 0)
+
+
+def test_all_passes_are_written_and_finite(bl, tmp_path):
+    scene = bl.emission_scene(strength=STRENGTH)
+    view_layer = scene.view_layers[LAYER]
+    for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_diffuse_color",
+                 "use_pass_glossy_color", "use_pass_emit", "use_pass_environment"):
+        setattr(view_layer, attr, True)
+    view_layer.drt.use_pass_sample_count = True
+    view_layer.drt.use_pass_noise = True
+    channels = bl.render_exr(scene, tmp_path / "all.exr")
+    assert bl.passes_in(channels, LAYER) == set(PASSES)
+    for name in PASSES:
+        assert np.all(np.isfinite(bl.pass_pixels(channels, LAYER, name))), name
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Emit"), STRENGTH, rtol=1e-4)
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Env"), 0.0, atol=1e-6)
+    np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Sample Count"), scene.drt.samples)
+    position = bl.pass_pixels(channels, LAYER, "Position")
+    np.testing.assert_allclose(position[..., 2], 0.0, atol=1e-4)
+    assert np.all(np.abs(position[..., :2]) <= 2.0)
+
+
+def test_every_view_layer_renders_into_its_own_result(bl, tmp_path):
+    world = (0.1, 0.2, 0.3)
+    scene = bl.emission_scene(strength=STRENGTH, world=world)
+    scene.view_layers[LAYER].use_pass_z = True
+    background_only = scene.view_layers.new("Background")
+    background_only.layer_collection.children["Subject"].exclude = True
+    background_only.use_pass_environment = True
+    channels = bl.render_exr(scene, tmp_path / "layers.exr")
+    assert bl.passes_in(channels, LAYER) == {"Combined", "Depth"}
+    assert bl.passes_in(channels, "Background") == {"Combined", "Env"}
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Combined")[..., :3], STRENGTH, rtol=1e-4)
+    np.testing.assert_allclose(bl.pass_pixels(channels, "Background", "Combined")[..., :3],
+                               np.broadcast_to(world, (12, 16, 3)), rtol=1e-4)
+    np.testing.assert_allclose(bl.pass_pixels(channels, "Background", "Env"),
+                               np.broadcast_to(world, (12, 16, 3)), rtol=1e-4)
+
+
+@pytest.mark.parametrize("crop", [False, True])
+def test_border_render_fills_exactly_blenders_region(bl, tmp_path, crop):
+    # Blender computes the region in single precision: 0.7 * 20 = 14 (13 in double precision).
+    scene = bl.emission_scene(width=20, height=10, strength=STRENGTH)
+    render = scene.render
+    render.use_border = True
+    render.use_crop_to_border = crop
+    render.border_min_x, render.border_max_x = 0.25, 0.7
+    render.border_min_y, render.border_max_y = 0.5, 1.0
+    assert render_window(render, 20, 10) == (5, 5, 14, 10)
+    combined = bl.pass_pixels(bl.render_exr(scene, tmp_path / "border.exr"), LAYER, "Combined")
+    if crop:
+        assert combined.shape == (5, 9, 4)
+        np.testing.assert_allclose(combined[..., :3], STRENGTH, rtol=1e-4)
+        return
+    assert combined.shape == (10, 20, 4)
+    inside = np.zeros((10, 20), bool)
+    inside[0:5, 5:14] = True  # file rows run top to bottom: Blender's rows 5..9 are the top five
+    np.testing.assert_allclose(combined[inside][:, :3], STRENGTH, rtol=1e-4)
+    np.testing.assert_allclose(combined[inside][:, 3], 1.0, rtol=1e-5)
+    np.testing.assert_array_equal(combined[~inside], 0.0)
+
+
+def test_scene_error_is_one_report_without_traceback(bl, tmp_path, capfd):
+    scene = bl.emission_scene()
+    scene.camera.data.type = "PANO"
+    with pytest.raises(RuntimeError) as error:
+        bpy.ops.render.render(scene=scene.name)
+    message = str(error.value).strip()
+    assert "perspective and orthographic" in message
+    assert len(message.splitlines()) == 1
+    captured = capfd.readouterr()
+    assert "Traceback" not in captured.out + captured.err
+
+
+def test_unexpected_error_is_one_report(bl, monkeypatch):
+    def broken_export(*args, **kwargs):
+        raise ValueError("synthetic failure")
+
+    monkeypatch.setattr("drt_engine.blender.export.export_scene", broken_export)
+    scene = bl.emission_scene()
+    with pytest.raises(RuntimeError) as error:
+        bpy.ops.render.render(scene=scene.name)
+    message = str(error.value).strip()
+    assert len(message.splitlines()) == 1
+    assert "ValueError: synthetic failure" in message
+
+
+def test_export_warnings_are_reported(bl, tmp_path, capfd):
+    scene = bl.emission_scene()
+    tree = bpy.data.materials["Emitter"].node_tree
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Color"], tree.nodes["Emission"].inputs["Color"])
+    bl.render_exr(scene, tmp_path / "warn.exr")
+    out = capfd.readouterr().out
+    assert any(line.startswith("Warning:") and "Emitter" in line for line in out.splitlines()), out
+
+
+class RecordingEngine:
+    """Stands in for Blender's side of the engine: Blender's RNA methods cannot be patched on the class."""
+
+    def __init__(self, cancel_after_updates=None):
+        self.progress, self.stats, self.displayed = [], [], []
+        self.cancel_after_updates = cancel_after_updates
+
+    def update_progress(self, value):
+        self.progress.append(value)
+
+    def update_stats(self, stats, info):
+        self.stats.append(info)
+
+    def test_break(self):
+        return self.cancel_after_updates is not None and len(self.progress) >= self.cancel_after_updates
+
+    def update_result(self, result):
+        self.displayed.append(result.layers[0].passes.get("Combined").rect.pixels.copy())
+
+
+class RecordingResult:
+    """A render result whose passes keep what foreach_set wrote."""
+
+    def __init__(self, names):
+        passes = {name: SimpleNamespace(rect=_Rect()) for name in names}
+        self.layers = [SimpleNamespace(passes=passes)]
+
+
+class _Rect:
+    pixels = None
+
+    def foreach_set(self, values):
+        self.pixels = np.array(values)
+
+
+def emitter_scene_data(size=64):
+    """SceneData of the emission scene: a 4x4 m plane of radiance 2 filling a 50 mm camera's view at 5 m."""
+    camera_matrix = np.eye(4)
+    camera_matrix[2, 3] = 5.0
+    half = 18.0 / 50.0
+    plane = Mesh("Emitter", [(-2, -2, 0), (2, -2, 0), (2, 2, 0), (-2, 2, 0)], [(0, 1, 2), (0, 2, 3)], [1])
+    emitter = Material("Emitter", [Closure("EMISSION", emission=(STRENGTH,) * 3)])
+    return SceneData(Camera(camera_matrix[None], (-half, half, -half, half), (size, size)),
+                     meshes=[plane], instances=[Instance(0, np.eye(4))], materials=[DEFAULT_MATERIAL, emitter])
+
+
+def test_progress_callback_reports_and_refreshes_the_image(monkeypatch):
+    monkeypatch.setattr(engine_module, "DISPLAY_INTERVAL", 0.0)
+    fake, result = RecordingEngine(), RecordingResult(["Combined"])
+    per_wave = WAVE // 64**2
+    samples = 3 * per_wave  # the core calls back between its three waves
+    renderer = Renderer(emitter_scene_data(), RenderSettings(samples=samples, threads=1))
+    outcome = renderer.render(progress=DRTRenderEngine._progress_callback(fake, result))
+    assert not outcome.cancelled
+    assert fake.progress == pytest.approx([1 / 3, 2 / 3])
+    assert fake.stats[0].startswith(f"Sample {per_wave}/{samples} | Elapsed ") and fake.stats[0].endswith(" s")
+    assert len(fake.displayed) == 2
+    for image in fake.displayed:
+        np.testing.assert_allclose(image.reshape(64, 64, 4)[..., :3], STRENGTH, rtol=1e-4)
+
+
+def test_cancel_returns_promptly_with_the_image_so_far():
+    fake = RecordingEngine(cancel_after_updates=1)
+    result = RecordingResult(["Combined", "Sample Count"])
+    settings = RenderSettings(samples=1_000_000, threads=1, passes=("Combined", "Sample Count"))
+    renderer = Renderer(emitter_scene_data(), settings)  # hours of work if it were not cancelled
+    start = time.perf_counter()
+    outcome = renderer.render(progress=DRTRenderEngine._progress_callback(fake, result))
+    assert time.perf_counter() - start < 10.0
+    assert outcome.cancelled and len(fake.progress) == 1
+    np.testing.assert_allclose(outcome.passes["Combined"][..., :3], STRENGTH, rtol=1e-4)
+    counts = outcome.passes["Sample Count"]
+    assert np.all(counts == WAVE // 64**2)  # the first wave, then the stop
+
+
+def test_pass_toggles_update_the_compositor_sockets(bl):
+    scene = bl.emission_scene()
+    scene.compositing_node_group = bpy.data.node_groups.new("Compositing", "CompositorNodeTree")
+    node = scene.compositing_node_group.nodes.new("CompositorNodeRLayers")
+    node.scene, node.layer = scene, LAYER
+    view_layer = scene.view_layers[LAYER]
+
+    def sockets():
+        return {socket.name for socket in node.outputs if socket.enabled}
+
+    assert sockets() == {"Image", "Alpha"}
+    view_layer.drt.use_pass_noise = True
+    view_layer.drt.use_pass_sample_count = True
+    view_layer.use_pass_normal = True
+    assert sockets() == {"Image", "Alpha", "Noise", "Sample Count", "Normal"}
+    view_layer.drt.use_pass_noise = False
+    assert sockets() == {"Image", "Alpha", "Sample Count", "Normal"}
