@@ -1,9 +1,20 @@
-"""World-space triangles and batched ray queries through Embree.
+"""Triangles in Embree scenes, and batched ray queries at each ray's own time.
 
-Embree works in float32 with tnear fixed at 0, so precision is ours to manage:
-geometry is kept in float64 and handed to Embree relative to a centre (the camera),
-hit points are rebuilt in float64 from barycentrics, and new rays leave a surface
-offset along the geometric normal by a bound on the float32 error of the hit.
+Embree works in float32 with tnear fixed at 0 and has no motion in this binding, so
+precision and motion are ours to manage:
+
+- static geometry is flattened to world space in one Embree scene, relative to a
+  centre (the camera), and hit points are rebuilt in float64 from barycentrics;
+- a rigidly moving instance keeps its own object-space scene; rays are carried into
+  object space at their own time (the direction is not renormalised, so distances
+  along the ray stay world distances);
+- a deforming mesh is baked into one scene per time bucket; a ray uses the bucket of
+  its time, and the time dimension is stratified, so buckets are too;
+- new rays leave a surface offset along the geometric normal by a bound on the
+  float32 error of the hit.
+
+Triangles of all parts share one global numbering, so materials, normals and lights
+index the same arrays whatever part a hit came from.
 """
 from __future__ import annotations
 
@@ -13,11 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import SceneError
+from .motion import Motion
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
 _CHUNK = 1 << 15  # rays per Embree call per thread
 _FAR = np.float32(3.0e38)
+DEFORM_BUCKETS = 8
 
 
 @dataclass
@@ -34,140 +47,296 @@ class Hits:
         return self.prim >= 0
 
 
-class Geometry:
-    """All instanced triangles flattened to world space, with Embree on top.
+@dataclass
+class _Part:
+    kind: str  # "static" | "rigid" | "deform"
+    base: int  # first global triangle id
+    count: int
+    center: np.ndarray
+    scenes: list
+    motion: Motion | None = None
+    buckets: list | None = None  # deform: (world vertices of the part, mirrored) per time bucket
+    first_vertex: int = 0
 
-    Per triangle: vertex indices into ``vertices`` (float64, world), geometric normal
-    ``ng`` (oriented by winding, flipped under mirroring transforms so it agrees with
-    the shading normals), shading normals per corner ``ns`` and ``material``.
+
+def _embree(vertices: np.ndarray, triangles: np.ndarray):
+    from embreex import rtcore_scene
+    from embreex.mesh_construction import TriangleMesh
+
+    v = vertices.astype(np.float32)
+    if not np.isfinite(v).all():
+        raise SceneError("geometry too far from the camera to be represented in single precision")
+    scene = rtcore_scene.EmbreeScene()
+    TriangleMesh(scene, np.ascontiguousarray(v), np.ascontiguousarray(triangles, dtype=np.int32))
+    return scene
+
+
+def _cross_normals(p: np.ndarray):
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    return n, length
+
+
+class Geometry:
+    """All instanced triangles and the Embree scenes that answer ray queries.
+
+    Global per-triangle arrays: ``triangles`` (indices into ``vertices``: world space
+    for static and deforming parts, object space for rigid ones), ``material``,
+    ``part``, ``ng``/``ns`` in the same space as the vertices, and mid-shutter world
+    copies ``world_vertices``, ``world_ng``, ``area`` for light sampling.
     """
 
     def __init__(self, scene: SceneData, center: np.ndarray, pool: ThreadPoolExecutor | None = None):
         self.center = np.asarray(center, dtype=np.float64)
         self.pool = pool
         self.warnings: list[str] = []
-        vertices, triangles, normals, materials, flips = [], [], [], [], []
-        offset = 0
-        dropped = 0
+        self.parts: list[_Part] = []
+        verts, world_verts, tris, mats, normals, flips = [], [], [], [], [], []
+        self._dropped = 0
+        static = []
+        moving = []
         for inst in scene.instances:
             mesh = scene.meshes[inst.mesh]
             if len(mesh.triangles) == 0:
                 continue
-            m = inst.matrix
-            linear = m[:3, :3]
-            v = mesh.vertices @ linear.T + m[:3, 3]
+            motion = Motion(inst.matrices)
+            deforming = mesh.motion_vertices is not None and not np.allclose(
+                mesh.motion_vertices, mesh.motion_vertices[:1])
+            (moving if motion.moving or deforming else static).append((inst, mesh, motion, deforming))
+
+        def add(mesh, linear, translation, in_world):
+            """Append one mesh's triangles; returns the (kept) triangle count."""
+            v_obj = mesh.vertices
+            v_world = v_obj @ linear.T + translation
+            v = v_world if in_world else v_obj
+            bad = ~np.isfinite(v_world).all(axis=1)
             tri = mesh.triangles
-            bad_vertex = ~np.isfinite(v).all(axis=1)
-            keep = ~bad_vertex[tri].any(axis=1)
-            dropped += int((~keep).sum())
+            keep = ~bad[tri].any(axis=1)
+            p = v_world[tri]
+            keep &= _cross_normals(np.where(np.isfinite(p), p, 0.0))[1] > 0
+            self._dropped += int((~keep & bad[tri].any(axis=1)).sum())
+            offset = sum(len(x) for x in verts)
+            verts.append(np.where(bad[:, None], 0.0, v))
+            world_verts.append(np.where(bad[:, None], 0.0, v_world))
+            tris.append(tri[keep] + offset)
+            mats.append(mesh.material_indices[keep])
+            det = np.linalg.det(linear)
             if mesh.corner_normals is not None:
-                normal_matrix = _normal_matrix(linear)
-                ns = mesh.corner_normals.astype(np.float64) @ normal_matrix.T
+                ns = mesh.corner_normals[keep].astype(np.float64)
+                if in_world:
+                    ns = ns @ _normal_matrix(linear).T
+                normals.append(ns)
             else:
-                ns = None
-            v = np.where(bad_vertex[:, None], 0.0, v)
-            vertices.append(v)
-            triangles.append(tri[keep] + offset)
-            normals.append(ns[keep] if ns is not None else None)
-            materials.append(mesh.material_indices[keep])
-            flips.append(np.full(int(keep.sum()), np.linalg.det(linear) < 0))
-            offset += len(v)
-        if dropped:
-            self.warnings.append(f"{dropped} triangles with NaN or infinite vertex coordinates were left out")
-        self.vertices = np.concatenate(vertices) if vertices else np.zeros((0, 3))
-        tri = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int32)
+                normals.append(int(keep.sum()))
+            # baked world triangles wind backwards under mirroring; object-space ones do not
+            flips.append(np.full(int(keep.sum()), in_world and det < 0))
+            return int(keep.sum()), offset
+
+        count = 0
+        if static:
+            start = count
+            for inst, mesh, motion, _ in static:
+                n, _ = add(mesh, motion.linear[0], motion.translation[0], True)
+                count += n
+            self.parts.append(_Part("static", start, count - start, self.center, []))
+        for inst, mesh, motion, deforming in moving:
+            if deforming:
+                mid = motion.matrix_at(0.5)
+                n, first = add(_mid_mesh(mesh), mid[:3, :3], mid[:3, 3], True)
+                part = _Part("deform", count, n, self.center, [], first_vertex=first)
+                part.buckets = [(mesh, motion)]
+            else:
+                n, first = add(mesh, motion.linear[len(motion.linear) // 2],
+                               motion.translation[len(motion.translation) // 2], False)
+                lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+                part = _Part("rigid", count, n, 0.5 * (lo + hi), [], motion=motion, first_vertex=first)
+            count += n
+            self.parts.append(part)
+
+        if self._dropped:
+            self.warnings.append(f"{self._dropped} triangles with NaN or infinite vertex coordinates were left out")
+        self.vertices = np.concatenate(verts) if verts else np.zeros((0, 3))
+        self.world_vertices = np.concatenate(world_verts) if world_verts else np.zeros((0, 3))
+        self.triangles = np.concatenate(tris) if tris else np.zeros((0, 3), np.int32)
+        self.material = np.concatenate(mats) if mats else np.zeros(0, np.int32)
         flip = np.concatenate(flips) if flips else np.zeros(0, bool)
-        material = np.concatenate(materials) if materials else np.zeros(0, np.int32)
-        p = self.vertices[tri]
-        ng = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-        length = np.linalg.norm(ng, axis=1)
-        # Zero-area triangles can never be seen and only cause trouble: leave them out.
-        keep = length > 0
-        self.triangles = tri[keep]
-        self.material = material[keep]
-        self.ng = ng[keep] / length[keep, None] * np.where(flip[keep], -1.0, 1.0)[:, None]
-        if any(n is not None for n in normals):
-            ns = np.full((len(tri), 3, 3), np.nan)
-            start = 0
-            for n, t in zip(normals, triangles):
-                if n is not None:
-                    ns[start:start + len(t)] = n
-                start += len(t)
-            ns = ns[keep]
-            ns_len = np.linalg.norm(ns, axis=2, keepdims=True)
-            good = (ns_len > 1e-12) & np.isfinite(ns_len)
-            flat = np.repeat(self.ng[:, None, :], 3, axis=1)
-            self.ns = np.where(good, ns / np.where(good, ns_len, 1.0), flat)
-        else:
-            self.ns = None
-        rel = self.vertices[self.triangles] - self.center
+        self.part = np.zeros(len(self.triangles), np.int64)
+        for k, part in enumerate(self.parts):
+            self.part[part.base:part.base + part.count] = k
+
+        n_local, length = _cross_normals(self.vertices[self.triangles])
+        self.ng = n_local / np.maximum(length, 1e-300)[:, None] * np.where(flip, -1.0, 1.0)[:, None]
+        n_world, world_len = _cross_normals(self.world_vertices[self.triangles])
+        self.area = 0.5 * world_len
+        self.world_ng = self._mid_world_normals(n_world / np.maximum(world_len, 1e-300)[:, None])
+        self.ns = self._shading_normals(normals)
+        rel = self.world_vertices[self.triangles] - self.center
         self.tri_scale = np.abs(rel).max(axis=(1, 2)) if len(rel) else np.zeros(0)
-        self.area = 0.5 * length[keep]
-        self._embree = None
-        if len(self.triangles):
-            self._build_embree()
+        for part in self.parts:
+            self._build(part)
 
-    def _build_embree(self):
-        from embreex import rtcore_scene
-        from embreex.mesh_construction import TriangleMesh
+    # -- construction helpers ------------------------------------------------------
+    def _mid_world_normals(self, n_world):
+        """World normals at mid-shutter, oriented like ``ng`` (outward under mirroring)."""
+        out = n_world.copy()
+        for part in self.parts:
+            s = slice(part.base, part.base + part.count)
+            det = np.linalg.det(part.motion.linear[len(part.motion.linear) // 2]) if part.motion else 1.0
+            if part.kind == "rigid" and det < 0:
+                out[s] = -out[s]
+            elif part.kind != "rigid":
+                out[s] = self.ng[s]
+        return out
 
-        rel = (self.vertices - self.center).astype(np.float32)
-        if not np.isfinite(rel).all():
-            raise SceneError("geometry too far from the camera to be represented in single precision")
-        self._embree = rtcore_scene.EmbreeScene()
-        TriangleMesh(self._embree, np.ascontiguousarray(rel), np.ascontiguousarray(self.triangles, dtype=np.int32))
+    def _shading_normals(self, normals):
+        """Corner normals per triangle; ``normals`` holds an array, or a flat mesh's count."""
+        if all(isinstance(n, int) for n in normals):
+            return None
+        ns = np.repeat(self.ng[:, None, :], 3, axis=1)
+        start = 0
+        for n in normals:
+            if isinstance(n, int):
+                start += n
+                continue
+            seg = ns[start:start + len(n)]
+            length = np.linalg.norm(n, axis=2, keepdims=True)
+            good = (length > 1e-12) & np.isfinite(length)
+            ns[start:start + len(n)] = np.where(good, n / np.where(good, length, 1.0), seg)
+            start += len(n)
+        return ns
 
+    def _build(self, part: _Part):
+        tri = self.triangles[part.base:part.base + part.count]
+        if part.count == 0:
+            return
+        if part.kind == "static":
+            part.scenes = [_embree(self.vertices - part.center, tri)]
+        elif part.kind == "rigid":
+            part.scenes = [_embree(self.vertices - part.center, tri)]
+        else:
+            mesh, motion = part.buckets[0]
+            part.buckets = []
+            keep_tri = tri - part.first_vertex
+            for b in range(DEFORM_BUCKETS):
+                time = (b + 0.5) / DEFORM_BUCKETS
+                m = motion.matrix_at(time)
+                v = _vertices_at(mesh, time) @ m[:3, :3].T + m[:3, 3]
+                part.buckets.append((v, np.linalg.det(m[:3, :3]) < 0))
+                part.scenes.append(_embree(v - part.center, keep_tri))
+
+    # -- queries ---------------------------------------------------------------------
     @property
     def triangle_count(self) -> int:
         return len(self.triangles)
 
-    def _run(self, origins, directions, tmax, query):
-        o = np.ascontiguousarray(origins - self.center, dtype=np.float32)
+    @property
+    def moving(self) -> bool:
+        return any(p.kind != "static" for p in self.parts)
+
+    def _run(self, scene, origins, directions, tmax, query):
+        o = np.ascontiguousarray(origins, dtype=np.float32)
         d = np.ascontiguousarray(directions, dtype=np.float32)
         far = np.minimum(tmax, _FAR).astype(np.float32)
         n = len(o)
         output = 1 if query == "INTERSECT" else 0
         if self.pool is None or n <= _CHUNK:
-            return [self._embree.run(o, d, dists=far, query=query, output=output)]
-        bounds = range(0, n, _CHUNK)
-        jobs = [self.pool.submit(self._embree.run, o[a:a + _CHUNK], d[a:a + _CHUNK],
-                                 far[a:a + _CHUNK], query, output) for a in bounds]
+            return [scene.run(o, d, dists=far, query=query, output=output)]
+        jobs = [self.pool.submit(scene.run, o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query, output)
+                for a in range(0, n, _CHUNK)]
         return [j.result() for j in jobs]
 
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> Hits:
-        n = len(origins)
-        if self._embree is None or n == 0:
-            return Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
-        parts = self._run(origins, directions, tmax, "INTERSECT")
-        prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
-        t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
-        u = np.concatenate([p["u"] for p in parts]).astype(np.float64)
-        v = np.concatenate([p["v"] for p in parts]).astype(np.float64)
-        t[prim < 0] = np.inf
-        return Hits(t, prim, u, v)
+    def _rays_in(self, part: _Part, origins, directions, time, index):
+        """(scene, origins, directions) of rays ``index`` in the part's Embree frame."""
+        if part.kind == "rigid":
+            linear, translation = part.motion.at(time[index])
+            inv = np.linalg.inv(linear)
+            o = np.einsum("nij,nj->ni", inv, origins[index] - translation) - part.center
+            d = np.einsum("nij,nj->ni", inv, directions[index])
+            return o, d
+        return origins[index] - part.center, directions[index]
 
-    def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
-        n = len(origins)
-        if self._embree is None or n == 0:
-            return np.zeros(n, dtype=bool)
-        parts = self._run(origins, directions, tmax, "OCCLUDED")
-        return np.concatenate(parts) >= 0
+    def _groups(self, part: _Part, n: int, time):
+        """(scene, ray indices) pairs a part must answer for n rays."""
+        if part.kind != "deform":
+            return [(part.scenes[0], np.arange(n))]
+        bucket = np.minimum((np.asarray(time) * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
+        return [(part.scenes[b], np.flatnonzero(bucket == b)) for b in range(DEFORM_BUCKETS)]
 
-    def surface(self, hits: Hits, index: np.ndarray):
-        """Float64 position, geometric and shading normal of hits[index]."""
+    def intersect(self, origins, directions, tmax, time=None) -> Hits:
+        n = len(origins)
+        best = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
+        limit = np.array(tmax, dtype=np.float64, copy=True)
+        for part in self.parts:
+            if not part.scenes:
+                continue
+            for scene, idx in self._groups(part, n, time):
+                if len(idx) == 0:
+                    continue
+                o, d = self._rays_in(part, origins, directions, time, idx)
+                parts = self._run(scene, o, d, limit[idx], "INTERSECT")
+                prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
+                t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
+                closer = (prim >= 0) & (t < best.t[idx])
+                k = idx[closer]
+                best.t[k] = t[closer]
+                best.prim[k] = prim[closer] + part.base
+                best.u[k] = np.concatenate([p["u"] for p in parts])[closer]
+                best.v[k] = np.concatenate([p["v"] for p in parts])[closer]
+                limit[k] = t[closer]
+        return best
+
+    def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
+        n = len(origins)
+        blocked = np.zeros(n, dtype=bool)
+        for part in self.parts:
+            if not part.scenes:
+                continue
+            for scene, idx in self._groups(part, n, time):
+                idx = idx[~blocked[idx]]
+                if len(idx) == 0:
+                    continue
+                o, d = self._rays_in(part, origins, directions, time, idx)
+                blocked[idx] = np.concatenate(self._run(scene, o, d, tmax[idx], "OCCLUDED")) >= 0
+        return blocked
+
+    def surface(self, hits: Hits, index: np.ndarray, time=None):
+        """Float64 world position, geometric and shading normal of hits[index]."""
         prim = hits.prim[index]
         u, v = hits.u[index], hits.v[index]
         w = 1.0 - u - v
+        bary = np.stack([w, u, v], axis=1)
         p = self.vertices[self.triangles[prim]]
-        pos = w[:, None] * p[:, 0] + u[:, None] * p[:, 1] + v[:, None] * p[:, 2]
-        ng = self.ng[prim]
-        if self.ns is None:
-            ns = ng.copy()
-        else:
-            c = self.ns[prim]
-            ns = w[:, None] * c[:, 0] + u[:, None] * c[:, 1] + v[:, None] * c[:, 2]
-            ns /= np.maximum(np.linalg.norm(ns, axis=1, keepdims=True), 1e-30)
+        ng = self.ng[prim].copy()
+        ns = self._interpolated_normals(prim, bary, ng)
+        for k, part in enumerate(self.parts):
+            if part.kind == "static":
+                continue
+            sel = np.flatnonzero(self.part[prim] == k)
+            if len(sel) == 0:
+                continue
+            t_sel = np.asarray(time)[index][sel]
+            if part.kind == "rigid":
+                linear, translation = part.motion.at(t_sel)
+                normal_matrix = np.transpose(np.linalg.inv(linear), (0, 2, 1))
+                p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
+                ng[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ng[sel]))
+                ns[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ns[sel]))
+            else:
+                bucket = np.minimum((t_sel * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
+                for b in np.unique(bucket):
+                    world, mirrored = part.buckets[b]
+                    s = sel[bucket == b]
+                    p[s] = world[self.triangles[prim[s]] - part.first_vertex]
+                    n_b, length = _cross_normals(p[s])
+                    ng[s] = n_b / np.maximum(length, 1e-300)[:, None] * (-1.0 if mirrored else 1.0)
+        pos = np.einsum("ni,nij->nj", bary, p)
         return pos, ng, ns
+
+    def _interpolated_normals(self, prim, bary, ng):
+        if self.ns is None:
+            return ng.copy()
+        c = self.ns[prim]
+        return _unit(np.einsum("ni,nij->nj", bary, c))
 
     def offset_scale(self, prim: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Distance that safely clears the surface of triangle ``prim`` at ``pos``."""
@@ -181,9 +350,29 @@ def spawn(pos: np.ndarray, ng: np.ndarray, direction: np.ndarray, scale: np.ndar
     return pos + ng * (side * scale)[:, None]
 
 
+def _unit(v):
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-300)
+
+
 def _normal_matrix(linear: np.ndarray) -> np.ndarray:
     """Inverse transpose: keeps normals perpendicular, and outward under mirroring."""
     try:
         return np.linalg.inv(linear).T
     except np.linalg.LinAlgError:
         return np.eye(3)
+
+
+def _vertices_at(mesh, time: float) -> np.ndarray:
+    """Object-space vertices of a deforming mesh at a shutter fraction (linear between steps)."""
+    steps = mesh.motion_vertices
+    x = np.clip(time, 0.0, 1.0) * (len(steps) - 1)
+    i = min(int(x), len(steps) - 2)
+    u = x - i
+    return (1 - u) * steps[i] + u * steps[i + 1]
+
+
+def _mid_mesh(mesh):
+    """The mesh with its mid-shutter vertices (for normals, areas and light sampling)."""
+    from dataclasses import replace
+
+    return replace(mesh, vertices=_vertices_at(mesh, 0.5), motion_vertices=None)

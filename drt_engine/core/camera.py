@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import microfacet as mf
+from .motion import Motion
 from .scene import Camera
 
 
@@ -22,8 +23,32 @@ class CameraRays:
     depth_per_t: np.ndarray
 
 
-def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | None) -> CameraRays:
-    """Rays through continuous image coordinates (px, py) in pixels, y from the bottom."""
+def aperture_point(camera: Camera, u: np.ndarray) -> np.ndarray:
+    """Uniform point on the aperture: a disk, or a regular polygon with ``blades`` sides."""
+    if camera.blades >= 3:
+        n = camera.blades
+        k = np.minimum((u[:, 0] * n).astype(np.int64), n - 1)
+        u0 = u[:, 0] * n - k  # reuse the leftover of the choice, keeping stratification
+        a0 = camera.blade_rotation + 2 * np.pi * k / n
+        a1 = a0 + 2 * np.pi / n
+        su = np.sqrt(u0)
+        b1, b2 = su * (1 - u[:, 1]), su * u[:, 1]  # uniform in the triangle (centre, corner k, corner k+1)
+        p = (b1[:, None] * np.stack([np.cos(a0), np.sin(a0)], 1) + b2[:, None] * np.stack([np.cos(a1), np.sin(a1)], 1))
+    else:
+        p = mf.concentric_disk(u)
+    p = p * camera.aperture_radius
+    p[:, 0] /= max(camera.aperture_ratio, 1e-6)
+    return p
+
+
+def moves(camera: Camera) -> bool:
+    return Motion(camera.matrices).moving
+
+
+def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | None,
+             time: np.ndarray | None = None) -> CameraRays:
+    """Rays through continuous image coordinates (px, py) in pixels, y from the bottom,
+    at shutter fractions ``time`` when the camera moves."""
     w, h = camera.resolution
     left, right, bottom, top = camera.frame
     sx = left + (px / w) * (right - left)
@@ -34,7 +59,7 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         d = mf.normalize(d)
         o = np.zeros((n, 3))
         if lens is not None and camera.aperture_radius > 0:
-            disk = mf.concentric_disk(lens) * camera.aperture_radius
+            disk = aperture_point(camera, lens)
             focus = d * (camera.focus_distance / -d[:, 2])[:, None]
             o = np.concatenate([disk, np.zeros((n, 1))], axis=1)
             d = mf.normalize(focus - o)
@@ -47,7 +72,13 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         axial = np.ones(n)
         t_start = np.full(n, camera.clip_start)
         t_end = np.full(n, camera.clip_end)
-    m = camera.matrix
-    o_w = o @ m[:3, :3].T + m[:3, 3]
-    d_w = mf.normalize(d @ m[:3, :3].T)
+    if time is not None and moves(camera):
+        linear, translation = Motion(camera.matrices).at(time)
+        linear = linear / np.linalg.norm(linear, axis=1, keepdims=True)  # drop any scale
+        o_w = np.einsum("nij,nj->ni", linear, o) + translation
+        d_w = mf.normalize(np.einsum("nij,nj->ni", linear, d))
+    else:
+        m = camera.matrix
+        o_w = o @ m[:3, :3].T + m[:3, 3]
+        d_w = mf.normalize(d @ m[:3, :3].T)
     return CameraRays(o_w + d_w * t_start[:, None], d_w, np.maximum(t_end - t_start, 0.0), t_start, axial)

@@ -226,14 +226,14 @@ class Lights:
         g = self.geometry
         pick = self.emissive[np.minimum(np.searchsorted(self.emissive_cdf, u_pick, side="right"),
                                         len(self.emissive) - 1)]
-        p = g.vertices[g.triangles[pick]]
+        p = g.world_vertices[g.triangles[pick]]
         su = np.sqrt(u[:, 0])
         b0, b1 = 1.0 - su, u[:, 1] * su
         q = b0[:, None] * p[:, 0] + b1[:, None] * p[:, 1] + (1.0 - b0 - b1)[:, None] * p[:, 2]
         to = q - pos
         dist = np.linalg.norm(to, axis=1)
         wi = to / np.maximum(dist, _TINY)[:, None]
-        cos_l = np.abs(mf.dot(wi, g.ng[pick]))
+        cos_l = np.abs(mf.dot(wi, g.world_ng[pick]))
         pdf_area = self.emissive_prob[pick] / g.area[pick]
         pdf = dist * dist / np.maximum(cos_l, _TINY) * pdf_area
         value = np.where((cos_l > 0)[:, None],
@@ -331,7 +331,7 @@ class Lights:
 
     def pdf_emissive(self, prim, dirs, t):
         g = self.geometry
-        cos_l = np.maximum(np.abs(mf.dot(dirs, g.ng[prim])), _TINY)
+        cos_l = np.maximum(np.abs(mf.dot(dirs, g.world_ng[prim])), _TINY)
         return self.emissive_prob[prim] / g.area[prim] * t * t / cos_l
 
     @staticmethod

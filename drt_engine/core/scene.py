@@ -92,6 +92,8 @@ class Mesh:
     ``corner_normals`` (T, 3, 3) hold the shading normal of each triangle corner in
     object space (smooth, flat or custom split normals alike); ``None`` means flat.
     ``material_indices`` (T,) index ``SceneData.materials``. ``uvs`` (T, 3, 2) or None.
+    ``motion_vertices`` (S, V, 3): object-space vertices at S evenly spaced shutter times
+    for a mesh that deforms (same topology throughout), else None.
     """
 
     name: str
@@ -100,9 +102,12 @@ class Mesh:
     material_indices: np.ndarray
     corner_normals: np.ndarray | None = None
     uvs: np.ndarray | None = None
+    motion_vertices: np.ndarray | None = None
 
     def __post_init__(self):
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        if self.motion_vertices is not None:
+            self.motion_vertices = np.asarray(self.motion_vertices, dtype=np.float64).reshape(-1, len(self.vertices), 3)
         self.triangles = np.ascontiguousarray(self.triangles, dtype=np.int32).reshape(-1, 3)
         self.material_indices = np.ascontiguousarray(self.material_indices, dtype=np.int32).reshape(-1)
         if self.material_indices.size == 1 and len(self.triangles) != 1:
@@ -226,6 +231,12 @@ class Camera:
     window: tuple[int, int, int, int] | None = None
     aperture_radius: float = 0.0
     focus_distance: float = 10.0
+    """Distance of the plane in focus along the view axis (focus is planar, as in Cycles)."""
+    blades: int = 0
+    """Aperture polygon sides (0 or fewer than 3: a round aperture), rotated by ``blade_rotation``."""
+    blade_rotation: float = 0.0
+    aperture_ratio: float = 1.0
+    """Anamorphic bokeh: the aperture's x extent is divided by this ratio."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)

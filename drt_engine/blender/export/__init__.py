@@ -16,6 +16,7 @@ from .camera import export_camera
 from .geometry import GeometryExporter
 from .lights import export_light
 from .materials import MaterialTable
+from .motion import add_motion, instance_key
 from .world import export_world
 
 CANCEL_CHECK_INTERVAL = 256
@@ -23,12 +24,16 @@ CANCEL_CHECK_INTERVAL = 256
 
 
 def export_scene(
-    depsgraph, camera_object=None, cancel: Callable[[], bool] | None = None
+    depsgraph,
+    camera_object=None,
+    cancel: Callable[[], bool] | None = None,
+    frame_set: Callable[[int, float], None] | None = None,
 ) -> SceneData:
     """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
 
-    Raises ``SceneError`` for a scene that cannot be rendered and ``RenderCancelled``
-    when ``cancel()`` returns True.
+    With ``frame_set`` (the render engine's) and motion blur on, motion over the
+    shutter is sampled too. Raises ``SceneError`` for a scene that cannot be rendered
+    and ``RenderCancelled`` when ``cancel()`` returns True.
     """
     scene = depsgraph.scene
     camera_object = camera_object or scene.camera
@@ -51,9 +56,9 @@ def export_scene(
             if light is not None:
                 lights.append(light)
         else:
-            geometry.add(obj, matrix)
+            geometry.add(obj, matrix, instance_key(instance))
     geometry.finish()
-    return SceneData(
+    scene_data = SceneData(
         camera=camera,
         meshes=geometry.meshes,
         instances=geometry.instances,
@@ -63,3 +68,6 @@ def export_scene(
         film_transparent=scene.render.film_transparent,
         warnings=warnings,
     )
+    if frame_set is not None:
+        add_motion(scene_data, depsgraph, frame_set, geometry.keys, camera_object.name)
+    return scene_data

@@ -103,4 +103,7 @@ def export_camera(scene, camera_object) -> Camera:
         window=border_window(render, width, height),
         aperture_radius=aperture,
         focus_distance=focus,
+        blades=int(dof.aperture_blades),
+        blade_rotation=float(dof.aperture_rotation),
+        aperture_ratio=float(dof.aperture_ratio),
     )

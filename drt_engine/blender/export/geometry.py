@@ -85,6 +85,8 @@ class GeometryExporter:
         self.material_override = material_override
         self.meshes: list[Mesh] = []
         self.instances: list[Instance] = []
+        self.keys: list = []
+        """Per instance, the key that finds it again at other shutter times."""
         self._mesh_index: dict[tuple, int] = {}
         self._metaballs: list = []
         self._meshed: set[int] = set()
@@ -98,22 +100,22 @@ class GeometryExporter:
             return np.zeros(1, np.int32)
         return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
 
-    def add(self, obj, matrix: np.ndarray) -> None:
+    def add(self, obj, matrix: np.ndarray, key=None) -> None:
         """Add one evaluated object placed by ``matrix``; non-geometry objects are ignored."""
         if obj.type == "META":
-            self._metaballs.append((obj, matrix))
+            self._metaballs.append((obj, matrix, key))
         elif isinstance(obj.data, bpy.types.Mesh):
             self._meshed.add(obj.original.as_pointer())
-            self._place(obj, matrix, ("mesh", obj.data.as_pointer()))
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key)
 
     def finish(self) -> None:
         """Add metaballs that the depsgraph did not already hand over as mesh instances."""
-        for obj, matrix in self._metaballs:
+        for obj, matrix, key in self._metaballs:
             if obj.original.as_pointer() not in self._meshed:
-                self._place(obj, matrix, ("meta", obj.original.as_pointer()))
+                self._place(obj, matrix, ("meta", obj.original.as_pointer()), key)
         self._metaballs.clear()
 
-    def _place(self, obj, matrix, source) -> None:
+    def _place(self, obj, matrix, source, key) -> None:
         slot_materials = self._slot_materials(obj)
         key = source + (slot_materials.tobytes(),)
         index = self._mesh_index.get(key)
@@ -121,6 +123,7 @@ class GeometryExporter:
             index = self._mesh_index[key] = self._export(obj, slot_materials)
         if index >= 0:
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
+            self.keys.append(key)
 
     def _export(self, obj, slot_materials) -> int:
         if obj.type == "META":
