@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import SceneError
-from .motion import Motion
+from .motion import Motion, inverse3
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
@@ -249,7 +249,7 @@ class Geometry:
         """(scene, origins, directions) of rays ``index`` in the part's Embree frame."""
         if part.kind == "rigid":
             linear, translation = part.motion.at(time[index])
-            inv = np.linalg.inv(linear)
+            inv = inverse3(linear)
             o = np.einsum("nij,nj->ni", inv, origins[index] - translation) - part.center
             d = np.einsum("nij,nj->ni", inv, directions[index])
             return o, d
@@ -317,7 +317,7 @@ class Geometry:
             t_sel = np.asarray(time)[index][sel]
             if part.kind == "rigid":
                 linear, translation = part.motion.at(t_sel)
-                normal_matrix = np.transpose(np.linalg.inv(linear), (0, 2, 1))
+                normal_matrix = np.transpose(inverse3(linear), (0, 2, 1))
                 p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
                 ng[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ng[sel]))
                 ns[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ns[sel]))

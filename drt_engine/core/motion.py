@@ -90,6 +90,21 @@ class Motion:
         return m
 
 
+def inverse3(m: np.ndarray) -> np.ndarray:
+    """Inverses of a stack of 3x3 matrices by cofactors (LAPACK per matrix is far slower)."""
+    a, b, c = m[:, 0, 0], m[:, 0, 1], m[:, 0, 2]
+    d, e, f = m[:, 1, 0], m[:, 1, 1], m[:, 1, 2]
+    g, h, i = m[:, 2, 0], m[:, 2, 1], m[:, 2, 2]
+    co = np.stack([
+        np.stack([e * i - f * h, c * h - b * i, b * f - c * e], -1),
+        np.stack([f * g - d * i, a * i - c * g, c * d - a * f], -1),
+        np.stack([d * h - e * g, b * g - a * h, a * e - b * d], -1),
+    ], axis=1)
+    det = a * co[:, 0, 0] + b * co[:, 1, 0] + c * co[:, 2, 0]
+    safe = np.where(np.abs(det) > _TINY, det, _TINY)
+    return co / safe[:, None, None]
+
+
 def _slerp(q0: np.ndarray, q1: np.ndarray, u: np.ndarray) -> np.ndarray:
     cos = np.clip(np.sum(q0 * q1, axis=1), -1.0, 1.0)
     theta = np.arccos(cos)

@@ -117,10 +117,10 @@ class GeometryExporter:
 
     def _place(self, obj, matrix, source, key) -> None:
         slot_materials = self._slot_materials(obj)
-        key = source + (slot_materials.tobytes(),)
-        index = self._mesh_index.get(key)
+        mesh_key = source + (slot_materials.tobytes(),)
+        index = self._mesh_index.get(mesh_key)
         if index is None:
-            index = self._mesh_index[key] = self._export(obj, slot_materials)
+            index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
             self.keys.append(key)
