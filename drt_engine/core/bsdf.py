@@ -69,10 +69,10 @@ def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
     return lambda c: mf.fresnel_dielectric(c, eta)[:, None] * tint
 
 
-def _reflect_lobe(weight, alpha, fresnel, layer=None) -> Lobe:
+def _reflect_lobe(weight, alpha, fresnel, layer=None, multiscatter=True) -> Lobe:
     mu, e = mf.directional_albedo(alpha, fresnel)
     lobe = Lobe("reflect", np.asarray(weight, float), layer=layer, alpha=alpha, fresnel=fresnel)
-    if alpha >= mf.DELTA_ALPHA:
+    if multiscatter and alpha >= mf.DELTA_ALPHA:
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
         _, e1 = mf.directional_albedo(alpha, lambda c: np.ones_like(c))
@@ -131,7 +131,8 @@ def _principled_lobes(c: Closure) -> list[Lobe]:
     transmission = float(np.clip(c.transmission, 0, 1))
     if metallic > 0:
         f82 = np.clip(c.specular_tint, 0, 1)
-        lobes.append(_reflect_lobe(w * metallic, alpha, lambda x: mf.fresnel_f82(x, base, f82), base_layer))
+        lobes.append(_reflect_lobe(w * metallic, alpha, lambda x: mf.fresnel_f82(x, base, f82), base_layer,
+                                   c.multiscatter))
     dielectric = 1.0 - metallic
     ior = max(float(c.ior), 1.0 + 1e-6)
     if dielectric * transmission > 0:
@@ -144,7 +145,8 @@ def _principled_lobes(c: Closure) -> list[Lobe]:
         spec_tint = np.clip(c.specular_tint, 0, None)
         diffuse_layer = base_layer
         if f0 > 0:
-            spec = _reflect_lobe(w * opaque, alpha, _dielectric_fresnel(mf.ior_from_f0(f0), spec_tint), base_layer)
+            spec = _reflect_lobe(w * opaque, alpha, _dielectric_fresnel(mf.ior_from_f0(f0), spec_tint), base_layer,
+                                 c.multiscatter)
             lobes.append(spec)
             diffuse_layer = _chain(base_layer, _layer_under(spec, 1.0))
         lobes.append(Lobe("diffuse", w * opaque, layer=diffuse_layer, albedo=base))
@@ -162,7 +164,8 @@ def lobes_of(material: Material) -> list[Lobe]:
             lobes.append(Lobe("diffuse", c.weight, albedo=np.clip(c.color, 0, 1)))
         elif c.kind == "GLOSSY":
             tint = np.clip(c.color, 0, 1)
-            lobes.append(_reflect_lobe(c.weight, _alpha(c.roughness), lambda x, t=tint: np.ones((len(x), 1)) * t))
+            lobes.append(_reflect_lobe(c.weight, _alpha(c.roughness), lambda x, t=tint: np.ones((len(x), 1)) * t,
+                                       multiscatter=c.multiscatter))
         elif c.kind in ("GLASS", "REFRACTION"):
             tint = np.clip(c.color, 0, 1)
             lobes.append(Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1.0 + 1e-6),

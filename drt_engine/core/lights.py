@@ -44,6 +44,60 @@ def _orthonormal(n):
     return t, bt
 
 
+class _SphericalRectangle:
+    """Uniform sampling of the solid angle a rectangle subtends (Urena et al. 2013).
+
+    Where the solid angle is too small for the method's precision, ``usable`` is False
+    and the caller samples by area instead (both strategies are exact there).
+    """
+
+    MIN_SOLID_ANGLE = 1e-5
+
+    def __init__(self, c, ex, ey, ez, sx, sy, origins):
+        corner = c - 0.5 * sx * ex - 0.5 * sy * ey
+        d = corner - origins
+        z0 = d @ ez
+        self.flip = np.where(z0 > 0, -1.0, 1.0)  # local z points away from the rectangle
+        self.z0 = z0 * self.flip
+        self.x0, self.y0 = d @ ex, d @ ey
+        self.x1, self.y1 = self.x0 + sx, self.y0 + sy
+        self.ex, self.ey, self.ez, self.origins = ex, ey, ez, origins
+        z0, x0, y0, x1, y1 = self.z0, self.x0, self.y0, self.x1, self.y1
+        n0 = _unit(np.stack([np.zeros_like(z0), z0, -y0], 1))
+        n1 = _unit(np.stack([-z0, np.zeros_like(z0), x1], 1))
+        n2 = _unit(np.stack([np.zeros_like(z0), -z0, y1], 1))
+        n3 = _unit(np.stack([z0, np.zeros_like(z0), -x0], 1))
+        g0 = np.arccos(np.clip(-mf.dot(n0, n1), -1, 1))
+        g1 = np.arccos(np.clip(-mf.dot(n1, n2), -1, 1))
+        g2 = np.arccos(np.clip(-mf.dot(n2, n3), -1, 1))
+        g3 = np.arccos(np.clip(-mf.dot(n3, n0), -1, 1))
+        self.b0, self.b1 = n0[:, 2], n2[:, 2]
+        self.k = 2 * np.pi - g2 - g3
+        self.solid_angle = g0 + g1 - self.k
+        self.usable = (self.solid_angle > self.MIN_SOLID_ANGLE) & (np.abs(z0) > 0) & np.isfinite(self.solid_angle)
+
+    def sample(self, u, index):
+        z0, x0, y0, x1, y1 = (a[index] for a in (self.z0, self.x0, self.y0, self.x1, self.y1))
+        b0, b1, k, s = self.b0[index], self.b1[index], self.k[index], self.solid_angle[index]
+        au = u[:, 0] * s + k
+        sin_au = np.where(np.abs(np.sin(au)) > 1e-12, np.sin(au), 1e-12)
+        fu = (np.cos(au) * b0 - b1) / sin_au
+        cu = np.clip(np.sign(fu) / np.sqrt(fu * fu + b0 * b0), -1.0, 1.0)
+        xu = np.clip(-(cu * z0) / np.maximum(np.sqrt(1.0 - cu * cu), 1e-12), x0, x1)
+        dd = np.sqrt(xu * xu + z0 * z0)
+        h0 = y0 / np.sqrt(dd * dd + y0 * y0)
+        h1 = y1 / np.sqrt(dd * dd + y1 * y1)
+        hv = h0 + u[:, 1] * (h1 - h0)
+        yv = np.where(hv * hv < 1 - 1e-12, hv * dd / np.sqrt(np.maximum(1.0 - hv * hv, 1e-24)), y1)
+        yv = np.clip(yv, y0, y1)
+        z_axis = self.ez * self.flip[index][:, None]
+        return self.origins[index] + xu[:, None] * self.ex + yv[:, None] * self.ey + z0[:, None] * z_axis
+
+
+def _unit(v):
+    return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), _TINY)
+
+
 def _spread(spread: float, cos_l: np.ndarray) -> np.ndarray:
     """Cycles' area light spread: emission narrowed to a cone, normalised to keep power.
 
@@ -127,8 +181,8 @@ class Lights:
             sample = self._sample_facing_disk(light, pos, wi, d, u)
         else:
             sample = self._sample_sphere(light, pos, wi, d, u)
-        if spot:
-            sample.value = sample.value * self._spot(light, -wi)[:, None]
+        if spot:  # the cone is evaluated along each sampled ray, as Cycles does
+            sample.value = sample.value * self._spot(light, -sample.wi)[:, None]
         return sample
 
     def _sample_spot(self, light, pos, u):
@@ -207,19 +261,26 @@ class Lights:
         return light.position, ex, ey, ez, sx, sy, disk, area
 
     def _sample_area(self, light, pos, u):
+        """Rectangles by solid angle (spherical rectangles), disks and ellipses by area."""
         c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
         if disk:
             p2 = mf.concentric_disk(u) * 0.5
+            q = c + (p2[:, :1] * sx) * ex + (p2[:, 1:] * sy) * ey
         else:
-            p2 = u - 0.5
-        q = c + (p2[:, :1] * sx) * ex + (p2[:, 1:] * sy) * ey
+            q = c + ((u[:, :1] - 0.5) * sx) * ex + ((u[:, 1:] - 0.5) * sy) * ey
+            rect = _SphericalRectangle(c, ex, ey, ez, sx, sy, pos)
+            solid = rect.usable
+            if solid.any():
+                q[solid] = rect.sample(u[solid], solid)
         to = q - pos
         dist = np.linalg.norm(to, axis=1)
         wi = to / np.maximum(dist, _TINY)[:, None]
         cos_l = wi @ ez  # the light emits along -Z: seen from the front when wi . ez > 0
         front = cos_l > 0
         pdf = np.where(front, dist * dist / np.maximum(cos_l * area, _TINY), 0.0)
-        value = np.where(front[:, None], light.radiance * (area * cos_l / np.maximum(dist * dist, _TINY))[:, None], 0.0)
+        if not disk:
+            pdf = np.where(rect.usable & front, 1.0 / np.maximum(rect.solid_angle, _TINY), pdf)
+        value = np.where(front[:, None], light.radiance / np.maximum(pdf, _TINY)[:, None], 0.0)
         return LightSample(wi, dist, value * _spread(light.spread, cos_l)[:, None], pdf)
 
     def _sample_emissive(self, pos, u, u_pick):
@@ -305,8 +366,12 @@ class Lights:
         """Solid-angle density with which light sampling picks dirs from origins."""
         light = self.lights[light_index]
         if light.kind == "AREA":
-            *_, ez, _sx, _sy, _disk, area = self._area_frame(light)
-            return t * t / (np.maximum(dirs @ ez, _TINY) * area)
+            c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
+            pdf = t * t / (np.maximum(dirs @ ez, _TINY) * area)
+            if not disk:
+                rect = _SphericalRectangle(c, ex, ey, ez, sx, sy, origins)
+                pdf = np.where(rect.usable, 1.0 / np.maximum(rect.solid_angle, _TINY), pdf)
+            return pdf
         oc = light.position - origins
         d2 = mf.dot(oc, oc)
         r = light.radius

@@ -42,6 +42,8 @@ class Closure:
     coat_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
     emission: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
+    multiscatter: bool = True
+    """GGX lobes get Cycles' multiple-scattering energy compensation ("Multiscatter GGX")."""
 
     def __post_init__(self):
         if self.kind not in CLOSURE_KINDS:

@@ -22,6 +22,15 @@ def uses_nodes(idblock) -> bool:
     return bpy.app.version >= (5, 0, 0) or idblock.use_nodes
 
 
+def _multiscatter(node, issues) -> bool:
+    """Cycles compensates multiple scattering only for "Multiscatter GGX"; DRT's lobes are
+    GGX, so Beckmann and Ashikhmin-Shirley render as GGX (with a warning)."""
+    distribution = getattr(node, "distribution", "MULTI_GGX")
+    if distribution not in ("GGX", "MULTI_GGX"):
+        issues.add(f"'{node.name}' {distribution.replace('_', '-').title()} distribution (rendered as GGX)")
+    return distribution == "MULTI_GGX"
+
+
 def _principled(node, weight, issues):
     def value(default, *names):
         return input_value(node, issues, default, *names)
@@ -50,6 +59,7 @@ def _principled(node, weight, issues):
         coat_ior=value(1.5, "Coat IOR"),
         coat_tint=rgb(value(1.0, "Coat Tint")),
         emission=rgb(value(1.0, "Emission Color", "Emission")) * value(0.0, "Emission Strength"),
+        multiscatter=_multiscatter(node, issues),
     )
     closures = [principled] if alpha > 0.0 else []
     if alpha < 1.0:
@@ -62,6 +72,8 @@ def _bsdf(kind):
         closure = Closure(kind, weight=weight, color=rgb(input_value(node, issues, 0.8, "Color")))
         if kind != "TRANSPARENT":
             closure.roughness = input_value(node, issues, 0.5, "Roughness")
+        if kind in ("GLOSSY", "GLASS", "REFRACTION"):
+            closure.multiscatter = _multiscatter(node, issues)
         if kind in ("GLASS", "REFRACTION"):
             closure.ior = input_value(node, issues, 1.5, "IOR")
         if kind == "DIFFUSE" and closure.roughness > 0.0:

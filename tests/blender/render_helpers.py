@@ -1,0 +1,150 @@
+"""Render the in-memory scene with DRT or with Cycles through ``bpy.ops.render.render`` and read
+the written EXR back as float arrays, so DRT and Cycles are compared like for like.
+
+Cycles is set up the way DRT traces light (distribution ray tracing): no indirect diffuse
+light, glossy and transmission chains as long as ``scene.drt.max_depth``, no glossy
+blur, no clamping, no denoising, no adaptive sampling, CPU, and DRT's pixel filter.
+Nothing here saves the .blend: settings change only the scene in memory.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import bpy
+import numpy as np
+import OpenImageIO as oiio
+
+ROOT = Path(__file__).resolve().parents[2]
+
+PASS_TOGGLES = {
+    "Depth": ("use_pass_z", "Z"),
+    "Normal": ("use_pass_normal", "XYZ"),
+    "DiffCol": ("use_pass_diffuse_color", "RGB"),
+    "GlossCol": ("use_pass_glossy_color", "RGB"),
+    "Emit": ("use_pass_emit", "RGB"),
+    "Env": ("use_pass_environment", "RGB"),
+}
+"""Passes both renderers write, by Blender's view-layer toggle and channel ids."""
+
+BLENDER5_NAMES = {"DiffCol": "Diffuse Color", "GlossCol": "Glossy Color", "Emit": "Emission", "Env": "Environment"}
+"""Names Cycles in Blender 5.0 writes for the passes Blender 4 (and DRT) call by their short names."""
+
+
+@dataclass
+class Render:
+    """One render: ``passes`` name -> (h, w, C) float32, top row first; wall time in seconds."""
+
+    passes: dict
+    seconds: float
+    samples: int
+
+    @property
+    def rgb(self) -> np.ndarray:
+        return self.passes["Combined"][..., :3]
+
+
+def open_scene(path) -> bpy.types.Scene:
+    """Load a .blend into this bpy session (the file on disk is never written)."""
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+    return bpy.context.scene
+
+
+def set_resolution(scene, width: int, height: int) -> None:
+    render = scene.render
+    render.resolution_x, render.resolution_y = width, height
+    render.resolution_percentage = 100
+    render.use_border = False
+
+
+def configure_cycles(scene, samples: int, seed: int) -> None:
+    """Cycles as a distribution ray tracer with DRT's depth, filter and no noise tricks."""
+    cycles = scene.cycles
+    depth = scene.drt.max_depth
+    cycles.device = "CPU"
+    cycles.samples = samples
+    cycles.seed = seed
+    cycles.use_animated_seed = False
+    cycles.use_adaptive_sampling = False
+    cycles.use_denoising = False
+    cycles.diffuse_bounces = 0
+    cycles.glossy_bounces = depth
+    cycles.transmission_bounces = depth
+    cycles.transparent_max_bounces = depth
+    cycles.volume_bounces = 0
+    cycles.max_bounces = depth
+    cycles.caustics_reflective = True
+    cycles.caustics_refractive = True
+    cycles.blur_glossy = 0.0
+    cycles.sample_clamp_direct = 0.0
+    cycles.sample_clamp_indirect = 0.0
+    cycles.pixel_filter_type = scene.drt.filter_type
+    cycles.filter_width = scene.render.filter_size
+
+
+def configure_drt(scene, samples: int, seed: int) -> None:
+    drt = scene.drt
+    drt.samples = samples
+    drt.seed = seed
+    drt.use_adaptive_sampling = False
+    drt.time_limit = 0.0
+    drt.target_error = 0.0
+    drt.clamp = 0.0
+
+
+def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name="render") -> Render:
+    """Render ``scene`` with ``engine`` ('DRT' or 'CYCLES') to a multilayer EXR and read it back."""
+    if engine == "CYCLES":
+        configure_cycles(scene, samples, seed)
+    else:
+        configure_drt(scene, samples, seed)
+    scene.render.engine = engine
+    view_layer = scene.view_layers[0]
+    for layer in scene.view_layers:
+        layer.use = layer == view_layer
+    for pass_name, (toggle, _) in PASS_TOGGLES.items():
+        setattr(view_layer, toggle, pass_name in passes)
+    settings = scene.render.image_settings
+    settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    path = Path(out_dir) / f"{name}-{engine.lower()}-{seed}.exr"
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    start = time.perf_counter()
+    result = bpy.ops.render.render(write_still=True, scene=scene.name)
+    seconds = time.perf_counter() - start
+    assert result == {"FINISHED"} and path.exists(), f"{engine} did not write {path}"
+    channels = read_channels(path)
+    images = {"Combined": _pass(channels, view_layer.name, "Combined", "RGBA")}
+    for pass_name in passes:
+        images[pass_name] = _pass(channels, view_layer.name, pass_name, PASS_TOGGLES[pass_name][1])
+    return Render(images, seconds, samples)
+
+
+def read_channels(path) -> dict:
+    """Every channel of an EXR, all parts (Blender 5 writes one part per pass): name -> (h, w)."""
+    image = oiio.ImageInput.open(str(path))
+    assert image is not None, oiio.geterror()
+    channels = {}
+    try:
+        index = 0
+        while image.seek_subimage(index, 0):
+            spec = image.spec()
+            pixels = image.read_image(format="float").reshape(spec.height, spec.width, spec.nchannels)
+            for c, channel in enumerate(spec.channelnames):
+                channels[channel] = pixels[..., c]
+            index += 1
+    finally:
+        image.close()
+    return channels
+
+
+def _pass(channels: dict, layer: str, name: str, ids: str) -> np.ndarray:
+    if f"{layer}.{name}.{ids[0]}" not in channels and name in BLENDER5_NAMES:
+        name = BLENDER5_NAMES[name]
+    keys = [f"{layer}.{name}.{c}" for c in ids]
+    missing = [k for k in keys if k not in channels]
+    assert not missing, f"channels {missing} not in the file: {sorted(channels)}"
+    return np.stack([channels[k] for k in keys], axis=-1)
