@@ -38,7 +38,7 @@ def hash_combine(*values) -> np.ndarray:
     """Hash of several integers or integer arrays (broadcast together)."""
     h = np.zeros(1, dtype=_U32)
     for v in values:
-        v = np.asarray(v)
+        v = np.atleast_1d(np.asarray(v))  # arrays wrap silently; 0-d scalars would warn
         v = (v.astype(np.int64) & 0xFFFFFFFF).astype(_U32) if v.dtype != _U32 else v
         h = hash_u32(h ^ (v + _U32(0x9E3779B9) + (h << _U32(6)) + (h >> _U32(2))))
     return h

@@ -75,3 +75,71 @@ def test_principled_dielectric_diffuse_is_reduced_by_specular_albedo():
     diff, gloss = shader.colors(np.array([1.0]))
     assert gloss[0, 0] == pytest.approx(0.04, abs=0.01)
     assert diff[0, 0] == pytest.approx(0.8 * (1 - gloss[0, 0]), rel=1e-6)
+
+
+def _chi2_p_value(stat, df):
+    """Upper tail of the chi-square distribution (Wilson-Hilferty normal approximation)."""
+    from math import erfc, sqrt
+    z = ((stat / df) ** (1 / 3) - (1 - 2 / (9 * df))) / sqrt(2 / (9 * df))
+    return 0.5 * erfc(z / sqrt(2))
+
+
+@pytest.mark.parametrize("closure", [
+    Closure("GLOSSY", color=(1, 1, 1), roughness=0.3, multiscatter=False),
+    Closure("GLOSSY", color=(1, 1, 1), roughness=0.8, multiscatter=False),
+    Closure("GLASS", color=(1, 1, 1), roughness=0.4, ior=1.5),
+    Closure("PRINCIPLED", color=(0.5, 0.5, 0.5), roughness=0.5, coat_weight=1.0, coat_roughness=0.2),
+], ids=["ggx-0.3", "ggx-0.8", "rough-glass", "coated"])
+@pytest.mark.parametrize("inside", [False, True])
+def test_sampled_directions_follow_the_evaluated_density(closure, inside):
+    """Chi-square test of sample() against the pdf evaluate() reports, over the whole sphere."""
+    if inside and closure.kind != "GLASS":
+        pytest.skip("only glass is entered from below")
+    shader = MaterialShader(Material("m", [closure]))
+    n, mu = 200_000, 0.6
+    wo = np.tile([np.sqrt(1 - mu * mu), 0.0, mu], (n, 1))
+    ins = np.full(n, inside)
+    wi, w, pdf, delta, ok, _ = shader.sample(wo, RNG.random(n), RNG.random((n, 2)), ins)
+    wi = wi[ok]
+    nz, nphi = 24, 48
+    zi = np.clip(((wi[:, 2] + 1) / 2 * nz).astype(int), 0, nz - 1)
+    pi = np.clip(((np.arctan2(wi[:, 1], wi[:, 0]) + np.pi) / (2 * np.pi) * nphi).astype(int), 0, nphi - 1)
+    observed = np.bincount(zi * nphi + pi, minlength=nz * nphi).astype(float)
+    # expected counts: the density integrated over each bin (8 x 8 midpoints per bin)
+    k = 8
+    z = -1 + (np.arange(nz * k) + 0.5) * 2 / (nz * k)
+    phi = -np.pi + (np.arange(nphi * k) + 0.5) * 2 * np.pi / (nphi * k)
+    zz, pp = np.meshgrid(z, phi, indexing="ij")
+    r = np.sqrt(1 - zz**2)
+    dirs = np.stack([r * np.cos(pp), r * np.sin(pp), zz], -1).reshape(-1, 3)
+    m = len(dirs)
+    _, _, density = shader.evaluate(np.tile(wo[0], (m, 1)), dirs, dirs[:, 2] > 0, np.full(m, inside))
+    cell = (2 / (nz * k)) * (2 * np.pi / (nphi * k))
+    expected = (density * cell).reshape(nz, k, nphi, k).sum(axis=(1, 3)).ravel() * n
+    assert observed.sum() == pytest.approx(expected.sum(), rel=0.01)  # failures match the missing mass
+    big = expected >= 5
+    stat = np.sum((observed[big] - expected[big]) ** 2 / expected[big])
+    rest_o, rest_e = observed[~big].sum(), expected[~big].sum()
+    df = big.sum()
+    if rest_e >= 5:
+        stat += (rest_o - rest_e) ** 2 / rest_e
+        df += 1
+    assert _chi2_p_value(stat, df - 1) > 1e-4
+
+
+@pytest.mark.parametrize("closure", [
+    Closure("GLOSSY", color=(0.9, 0.6, 0.3), roughness=0.4, multiscatter=False),
+    Closure("PRINCIPLED", color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.6, multiscatter=False),
+], ids=["glossy", "metal"])
+def test_single_scatter_reflection_is_reciprocal(closure):
+    shader = MaterialShader(Material("m", [closure]))
+    n = 1000
+    a = RNG.normal(size=(n, 3))
+    b = RNG.normal(size=(n, 3))
+    a[:, 2], b[:, 2] = np.abs(a[:, 2]), np.abs(b[:, 2])
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b /= np.linalg.norm(b, axis=1, keepdims=True)
+    up, out = np.ones(n, bool), np.zeros(n, bool)
+    _, f_ab, _ = shader.evaluate(a, b, up, out)
+    _, f_ba, _ = shader.evaluate(b, a, up, out)
+    assert np.allclose(f_ab / b[:, 2:], f_ba / a[:, 2:], rtol=1e-9, atol=1e-12)
