@@ -75,7 +75,7 @@ def _reflect_lobe(weight, alpha, fresnel, layer=None, multiscatter=True) -> Lobe
     if multiscatter and alpha >= mf.DELTA_ALPHA:
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
-        _, e1 = mf.directional_albedo(alpha, lambda c: np.ones_like(c))
+        _, e1 = mf.white_albedo(float(alpha))
         e_avg = _cosine_average(mu, e1)
         f_avg = _cosine_average(mu, np.asarray(fresnel(mu)).mean(axis=-1))
         f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg))

@@ -133,6 +133,15 @@ def light_power_zero(light: Light) -> bool:
     return not np.any(light.radiance > 0) or light.size_x <= 0 or light.size_y <= 0
 
 
+SELECT_ABOVE = 256
+"""With more lights than this, each shading point samples ``SELECT_SLOTS`` lights chosen by
+estimated contribution instead of all of them. Measured at equal time (random point lights
+over a floor with occluders, 4 to 256 lights): one shadow ray to every light was 2x to 12x
+more efficient (1 / (MSE x time)) than 1 to 16 chosen lights, so choosing only bounds the
+cost of scenes with very many lights."""
+SELECT_SLOTS = 16
+
+
 class Lights:
     """All next-event strategies of a scene."""
 
@@ -155,18 +164,84 @@ class Lights:
             self.emissive_prob[self.emissive] = power[self.emissive] / cdf[-1]
         self.tri_emission = tri_emission
         self.world = scene.world.radiance if np.any(scene.world.radiance > 0) else None
-        self.strategies = len(self.lights) + (1 if len(self.emissive) else 0) + (1 if self.world is not None else 0)
+        self.selecting = len(self.lights) > SELECT_ABOVE
+        self.light_slots = min(SELECT_SLOTS, len(self.lights)) if self.selecting else len(self.lights)
+        self.strategies = self.light_slots + (1 if len(self.emissive) else 0) + (1 if self.world is not None else 0)
+        if self.selecting:
+            self._prepare_selection()
 
     # -- next-event estimation ----------------------------------------------------
-    def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray) -> LightSample:
-        """Strategy k for shading points ``pos``; ``normal`` faces the incoming ray."""
-        if k < len(self.lights):
-            light = self.lights[k]
-            return getattr(self, "_sample_" + light.kind.lower())(light, pos, u)
-        k -= len(self.lights)
+    def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray,
+               u_light: np.ndarray | None = None) -> LightSample:
+        """Strategy k for shading points ``pos``; ``normal`` faces the incoming ray.
+
+        With many lights, strategies below ``light_slots`` each pick one light per point
+        by estimated contribution (``u_light``) and divide by the chance of that pick.
+        """
+        if k < self.light_slots:
+            if not self.selecting:
+                return self._sample_light(k, pos, u)
+            return self._sample_selected(pos, u, u_light)
+        k -= self.light_slots
         if len(self.emissive) and k == 0:
             return self._sample_emissive(pos, u, u_pick)
         return self._sample_world(normal, u)
+
+    def _sample_light(self, index: int, pos, u) -> LightSample:
+        light = self.lights[index]
+        return getattr(self, "_sample_" + light.kind.lower())(light, pos, u)
+
+    # -- choosing among many lights ---------------------------------------------------
+    def _prepare_selection(self):
+        lum = np.array([0.2126, 0.7152, 0.0722])
+        self._sel_pos = np.array([light.position for light in self.lights])
+        self._sel_power = np.empty(len(self.lights))
+        self._sel_distant = np.array([light.kind == "SUN" for light in self.lights])
+        self._sel_size2 = np.empty(len(self.lights))
+        for i, light in enumerate(self.lights):
+            if light.kind == "SUN":
+                self._sel_power[i] = light.irradiance @ lum
+                self._sel_size2[i] = 0.0
+            elif light.kind == "AREA":
+                *_, sx, sy, _disk, area = self._area_frame(light)
+                self._sel_power[i] = (light.radiance @ lum) * area
+                self._sel_size2[i] = 0.25 * (sx * sx + sy * sy)
+            else:
+                self._sel_power[i] = light.intensity @ lum
+                self._sel_size2[i] = light.radius**2
+
+    def selection_probability(self, pos: np.ndarray) -> np.ndarray:
+        """(N, lights) chance that one slot picks each light at ``pos``.
+
+        Estimated contribution: power over squared distance (clamped by the light's size),
+        with no visibility or orientation terms, so no light that can contribute is ever
+        given zero probability (the estimate stays unbiased).
+        """
+        d2 = ((pos[:, None, :] - self._sel_pos[None]) ** 2).sum(axis=2)
+        d2 = np.maximum(d2, self._sel_size2[None] + 1e-12)
+        weight = np.where(self._sel_distant[None], self._sel_power[None], self._sel_power[None] / d2)
+        weight = np.maximum(weight, 1e-12 * weight.max(axis=1, keepdims=True) + 1e-300)
+        return weight / weight.sum(axis=1, keepdims=True)
+
+    def _sample_selected(self, pos, u, u_light) -> LightSample:
+        prob = self.selection_probability(pos)
+        pick = np.minimum((u_light[:, None] >= np.cumsum(prob, axis=1)).sum(axis=1), len(self.lights) - 1)
+        n = len(pos)
+        out = LightSample(np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3)), np.zeros(n))
+        for i in np.unique(pick):
+            idx = np.flatnonzero(pick == i)
+            ls = self._sample_light(i, pos[idx], u[idx])
+            out.wi[idx], out.dist[idx], out.value[idx], out.pdf[idx] = ls.wi, ls.dist, ls.value, ls.pdf
+        chosen = np.take_along_axis(prob, pick[:, None], 1)[:, 0] * self.light_slots
+        out.value /= chosen[:, None]
+        out.pdf = out.pdf * chosen  # density of the whole selection strategy, for MIS
+        return out
+
+    def pick_factor(self, light_index: int, origins: np.ndarray) -> np.ndarray | float:
+        """Expected number of samples light sampling spends on ``light_index`` from origins."""
+        if not self.selecting:
+            return 1.0
+        return self.selection_probability(origins)[:, light_index] * self.light_slots
 
     def _sample_point(self, light: Light, pos, u, spot=False):
         c = light.position
@@ -364,6 +439,9 @@ class Lights:
 
     def pdf(self, light_index, origins, dirs, t):
         """Solid-angle density with which light sampling picks dirs from origins."""
+        return self._pdf_shape(light_index, origins, dirs, t) * self.pick_factor(light_index, origins)
+
+    def _pdf_shape(self, light_index, origins, dirs, t):
         light = self.lights[light_index]
         if light.kind == "AREA":
             c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
@@ -381,17 +459,18 @@ class Lights:
         cos_max = np.sqrt(np.clip(1.0 - r * r / np.maximum(d2, _TINY), 0.0, 1.0))
         return 1.0 / (2.0 * np.pi * np.maximum(1.0 - cos_max, _TINY))
 
-    def suns_seen(self, dirs):
+    def suns_seen(self, origins, dirs):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs."""
         radiance = np.zeros((len(dirs), 3))
         pdf = np.zeros(len(dirs))
-        for light in self.lights:
+        for i, light in enumerate(self.lights):
             half = min(light.angle, np.pi) / 2.0
             if light.kind != "SUN" or half <= 0:
                 continue
             inside = dirs @ -light.direction > np.cos(half)
             radiance[inside] += light.irradiance / (np.pi * np.sin(half) ** 2)
-            pdf[inside] = 1.0 / (2.0 * np.pi * (1.0 - np.cos(half)))
+            factor = self.pick_factor(i, origins[inside])
+            pdf[inside] = factor / (2.0 * np.pi * (1.0 - np.cos(half)))
         return radiance, pdf
 
     def pdf_emissive(self, prim, dirs, t):

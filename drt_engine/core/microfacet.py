@@ -7,6 +7,8 @@ lobe keeps its total reflectance, so brightness is continuous across the switch.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 DELTA_ALPHA = 1e-4
@@ -133,15 +135,16 @@ def concentric_disk(u: np.ndarray) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
 
 
-def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 1024) -> tuple[np.ndarray, np.ndarray]:
+def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 4096) -> tuple[np.ndarray, np.ndarray]:
     """Albedo E(mu) of a GGX reflection lobe with the given Fresnel(cos_h) -> (N,) or (N,3).
 
     Computed once per material with a fixed stratified pattern (deterministic),
     tabulated at ``n_mu`` cosines; returns (mu, E).
     """
     mu = np.linspace(0.5 / n_mu, 1.0, n_mu)
-    side = int(np.sqrt(n_samples))
-    g = (np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2) + 0.5) / side
+    from .sampling import Sampler  # deterministic Owen-scrambled Sobol points
+
+    g = Sampler("SOBOL", n_samples, seed=0x5AB1E).get2d(np.zeros(n_samples, np.int64), np.arange(n_samples), 0)
     m = len(g)
     wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=1)
     wo_r = np.repeat(wo, m, axis=0)
@@ -162,6 +165,12 @@ def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 1
     else:
         e = (f * weight).reshape(n_mu, m).mean(axis=1)
     return mu, e
+
+
+@functools.lru_cache(maxsize=256)
+def white_albedo(alpha: float) -> tuple[np.ndarray, np.ndarray]:
+    """Single-scatter albedo of GGX with F = 1, shared by every lobe of that roughness."""
+    return directional_albedo(alpha, lambda c: np.ones_like(c))
 
 
 def lookup(mu_table: np.ndarray, values: np.ndarray, mu: np.ndarray) -> np.ndarray:

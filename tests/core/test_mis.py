@@ -73,3 +73,35 @@ def test_lights_are_hidden_from_the_camera_unless_visible_camera():
     assert mean(scene, samples=4) == 0.0
     light.visible_camera = True
     assert mean(scene, samples=4) == pytest.approx(L)
+
+
+def _tiled_lights(n_side, size=4000.0, height=1.5):
+    tile = size / n_side
+    return [Light("AREA", translation(-size / 2 + (i + 0.5) * tile, -size / 2 + (j + 0.5) * tile, height),
+                  radiance=np.full(3, L), size_x=tile, size_y=tile) for i in range(n_side) for j in range(n_side)]
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.3])
+def test_lights_chosen_by_contribution_stay_unbiased_under_mis(monkeypatch, roughness):
+    """The huge sky split into 25 tiles and only 2 tiles sampled per point: still L."""
+    from drt_engine.core import lights as lights_module
+    monkeypatch.setattr(lights_module, "SELECT_ABOVE", 4)
+    monkeypatch.setattr(lights_module, "SELECT_SLOTS", 2)
+    scene = glossy_plane_scene(roughness, _tiled_lights(5))
+    assert Renderer(scene, RenderSettings(samples=1, threads=1)).lights.selecting
+    assert mean(scene, samples=64) == pytest.approx(L, rel=0.01)
+
+
+def test_lights_chosen_by_contribution_light_a_diffuse_plane_like_all_lights(monkeypatch):
+    from drt_engine.core import lights as lights_module
+    rng = np.random.default_rng(5)
+    lights = [Light("POINT", translation(*rng.uniform([-3, -3, 0.5], [3, 3, 2])), intensity=rng.uniform(0.5, 2, 3))
+              for _ in range(12)]
+    mats = [Material("white", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])]
+    scene = SceneData(top_camera(height=1.0, half_width=2.0, res=16), [plane(20)], [Instance(0, np.eye(4))], mats,
+                      lights)
+    every = Renderer(scene, RenderSettings(samples=4, threads=1)).render().passes["Combined"][..., :3]
+    monkeypatch.setattr(lights_module, "SELECT_ABOVE", 4)
+    monkeypatch.setattr(lights_module, "SELECT_SLOTS", 3)
+    chosen = Renderer(scene, RenderSettings(samples=256, threads=1)).render().passes["Combined"][..., :3]
+    assert chosen.mean() == pytest.approx(every.mean(), rel=0.01)
