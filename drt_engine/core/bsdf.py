@@ -288,6 +288,9 @@ class MaterialShader:
                 diff += lobe.albedo_at(mu_o)
             elif lobe.kind == "reflect":
                 gloss += lobe.albedo_at(mu_o)
+            elif lobe.kind == "glass" and not lobe.refract_only:
+                # Cycles reports the reflected share of glass as its glossy colour
+                gloss += lobe.scale(mu_o) * lobe.tint_r * mf.fresnel_dielectric(mu_o, lobe.eta)[:, None]
         return diff, gloss
 
 
