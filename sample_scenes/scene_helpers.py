@@ -83,7 +83,8 @@ def drt_engine_or_cycles() -> str:
 def set_world(scene, color, strength: float) -> None:
     """A uniform world: Background node with an explicit color and strength."""
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    if world.node_tree is None:  # Blender 4.x; 5.0 always has nodes and deprecates use_nodes
+        world.use_nodes = True
     background = world.node_tree.nodes["Background"]
     background.inputs["Color"].default_value = (*color, 1.0)
     background.inputs["Strength"].default_value = strength
@@ -93,7 +94,8 @@ def set_world(scene, color, strength: float) -> None:
 def _material(name: str, node_type: str, inputs: dict) -> bpy.types.Material:
     """A material whose output is one shader node with constant inputs."""
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    if material.node_tree is None:  # Blender 4.x; 5.0 always has nodes and deprecates use_nodes
+        material.use_nodes = True
     nodes = material.node_tree.nodes
     for node in list(nodes):
         if node.type != "OUTPUT_MATERIAL":

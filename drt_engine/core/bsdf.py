@@ -35,7 +35,8 @@ class Lobe:
     tint_r: np.ndarray = field(default_factory=lambda: np.ones(3))
     tint_t: np.ndarray = field(default_factory=lambda: np.ones(3))
     refract_only: bool = False
-    table: tuple | None = None  # (mu, E rgb): total albedo of the lobe, for selection and layering
+    table: tuple | None = None  # (mu, E rgb): total albedo of the lobe, for lobe selection
+    layer_table: tuple | None = None  # (mu, E rgb): albedo as Cycles estimates it for layering and GlossCol
     ms: tuple | None = None  # (mu, factor): multiple-scattering compensation of f
 
     @property
@@ -72,16 +73,21 @@ def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
 def _reflect_lobe(weight, alpha, fresnel, layer=None, multiscatter=True) -> Lobe:
     mu, e = mf.directional_albedo(alpha, fresnel)
     lobe = Lobe("reflect", np.asarray(weight, float), layer=layer, alpha=alpha, fresnel=fresnel)
+    _, e1 = mf.white_albedo(float(alpha))
     if multiscatter and alpha >= mf.DELTA_ALPHA:
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
-        _, e1 = mf.white_albedo(float(alpha))
         e_avg = _cosine_average(mu, e1)
         f_avg = _cosine_average(mu, np.asarray(fresnel(mu)).mean(axis=-1))
         f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg))
         factor = 1.0 + f_ms * (1.0 - e1) / np.maximum(e1, 1e-3)
         lobe.ms = (mu, factor)
         e = e * factor[:, None]
+        lobe.layer_table = (mu, e)
+    else:
+        # Cycles' albedo estimate for plain GGX is the lobe-averaged Fresnel, without the
+        # energy masking loses (measured: diffuse weight 0.9595 under a 0.5-rough, IOR 1.5 layer)
+        lobe.layer_table = (mu, e / np.maximum(e1, 1e-6)[:, None])
     lobe.table = (mu, e)
     return lobe
 
@@ -95,7 +101,7 @@ def _cosine_average(mu: np.ndarray, values: np.ndarray) -> float:
 
 def _layer_under(upper: Lobe, weight_scalar: float, tint: np.ndarray | None = None) -> Callable:
     """Attenuation of what lies below ``upper``: 1 - weight * max albedo(mu_o), times a tint."""
-    mu, e = upper.table
+    mu, e = upper.layer_table
     emax = e.max(axis=1) * weight_scalar
     tint = np.ones(3) if tint is None else tint
     return lambda m: np.clip(1.0 - np.interp(m, mu, emax), 0.0, 1.0)[:, None] * tint
@@ -287,7 +293,7 @@ class MaterialShader:
             if lobe.kind == "diffuse":
                 diff += lobe.albedo_at(mu_o)
             elif lobe.kind == "reflect":
-                gloss += lobe.albedo_at(mu_o)
+                gloss += lobe.scale(mu_o) * mf.lookup(*lobe.layer_table, mu_o)
             elif lobe.kind == "glass" and not lobe.refract_only:
                 # Cycles reports the reflected share of glass as its glossy colour
                 gloss += lobe.scale(mu_o) * lobe.tint_r * mf.fresnel_dielectric(mu_o, lobe.eta)[:, None]

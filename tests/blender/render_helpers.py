@@ -148,3 +148,31 @@ def _pass(channels: dict, layer: str, name: str, ids: str) -> np.ndarray:
     missing = [k for k in keys if k not in channels]
     assert not missing, f"channels {missing} not in the file: {sorted(channels)}"
     return np.stack([channels[k] for k in keys], axis=-1)
+
+
+COMPARE_DIR = ROOT / "out" / "compare"
+"""Side-by-side images of the comparisons (the repository's out/ is git-ignored)."""
+
+
+def save_side_by_side(name: str, left: np.ndarray, right: np.ndarray, folder=COMPARE_DIR) -> Path:
+    """PNG of ``left | right | |left - right| x 10`` (RGB, top row first), for looking at by eye.
+
+    One exposure for all three panels: the right image's 99th percentile maps to white, then
+    the sRGB transfer curve; 2-pixel grey gaps separate the panels.
+    """
+    scale = 1.0 / max(float(np.percentile(right, 99)), 1e-6)
+    diff = 10.0 * np.abs(left - right)
+    gap = np.full((left.shape[0], 2, 3), 0.5)
+    panels = [np.clip(image * scale, 0.0, 1.0) for image in (left, right, diff)]
+    linear = np.concatenate([panels[0], gap, panels[1], gap, panels[2]], axis=1)
+    srgb = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1 / 2.4) - 0.055)
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}.png"
+    pixels = np.ascontiguousarray((srgb * 255 + 0.5).astype(np.uint8))
+    output = oiio.ImageOutput.create(str(path))
+    assert output is not None, oiio.geterror()
+    output.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], 3, "uint8"))
+    output.write_image(pixels)
+    output.close()
+    return path

@@ -29,13 +29,22 @@ scene (the spot light's cone edge, see test_spot_light_blend_region) and 0.43% o
 (its smooth-shaded 32-sided cone near the terminator: Cycles evaluates BSDFs without testing
 the light direction against the geometric normal and lifts shadow-ray origins by the object's
 shadow terminator geometry offset; DRT tests against the geometric normal and has no offset).
+On the Ignis roughness sphere (highlight left out, see highlight()) 0.17%, on the rough glass of
+Ignis flipped-prim 0.79% (image means -0.47%, the same at 64 and 128 spp). Ignis box is a known
+difference (KNOWN_DIFFERENCES): DRT's Principled dielectric with GGX is Multiscatter GGX's, +1.4%
+on the image mean (on a sphere under a uniform white world, base colour 0.8, roughness 0.5, IOR
+1.45: DRT/Cycles 1.003 facing the camera up to 1.026 at grazing view, where Multiscatter GGX
+agrees within 0.04% to 0.45%).
 
 Depth of field and motion blur are switched off in both renderers in the main cases: DRT's
 thin lens is in the core, but matching Cycles' lens and shutter details belongs to the
 distribution-effects issue. Two extra cases render them on as saved: the lens (it matches
-already) and the shutter (an expected failure until DRT blurs motion). The Ignis scenes' ground is checker-textured; textures come in a later issue, so the
-main comparison unlinks the texture in both renderers (both then use the Diffuse BSDF's own
-colour) and the textured originals are expected failures.
+already) and the shutter (an expected failure until DRT blurs motion). The Ignis scenes' ground is checker-textured (and the roughness sphere's Base Color comes
+from an image through a Mix node); textures come in a later issue, so the main comparison
+unlinks the texture in both renderers (both then use the BSDF's own colour) and the textured
+originals are expected failures.
+
+Each comparison saves ``out/compare/<case>.png`` (DRT | Cycles | |difference| x 10).
 
 The focused scenes at the end (one light or one material, built in code) pin down single
 behaviours where the sample scenes are not sensitive enough: lights invisible to camera rays,
@@ -82,6 +91,23 @@ def untextured_ground(scene):
         tree.links.remove(link)
 
 
+def untextured_sphere(scene):
+    """Unlink the Image Texture's Mix (Lighten) from the roughness sphere's Base Color (both
+    renderers then use the Principled BSDF's own Base Color)."""
+    tree = bpy.data.materials["Material"].node_tree
+    links = [link for link in tree.links if link.to_socket.name == "Base Color" and link.from_node.type == "MIX"]
+    assert links, "the Ignis roughness sphere is expected to take its Base Color from a Mix node"
+    for link in links:
+        tree.links.remove(link)
+
+
+def local_texture(scene):
+    """Point the roughness sphere's image at tests/data (the .blend's relative path leads out of it)."""
+    image = bpy.data.images["grid_weight.png"]
+    image.filepath = str(DATA / "grid_weight.png")
+    image.reload()
+
+
 @dataclass(frozen=True)
 class Case:
     name: str
@@ -89,6 +115,7 @@ class Case:
     drt_samples: int
     cycles_samples: int
     prepare: tuple[Callable, ...] = ()
+    mask_highlight: bool = False  # leave a point light's sub-pixel highlight out (see highlight())
 
 
 # Samples per seed, chosen so that each case's block noise is about 0.3% (measured).
@@ -99,6 +126,15 @@ CASES = (
     Case("motion_blur", SAMPLE_SCENES / "motion_blur.blend", 64, 256, (no_motion_blur,)),
     Case("ignis_lights", DATA / "lights.blend", 64, 1024, (untextured_ground,)),
     Case("ignis_sun", DATA / "sun.blend", 64, 256, (untextured_ground,)),
+    Case("ignis_roughness", DATA / "roughness.blend", 64, 256, (untextured_ground, untextured_sphere),
+         mask_highlight=True),
+    Case("ignis_flipped_prim", DATA / "flipped-prim.blend", 128, 512),
+)
+
+# Known differences, beyond noise: each an expected failure naming its cause.
+KNOWN_DIFFERENCES = (
+    # Principled with plain GGX: Cycles layers the diffuse under the lobe-averaged Fresnel
+    pytest.param(Case("ignis_box", DATA / "box.blend", 64, 256), id="ignis_box"),
 )
 
 # The effects on, as the scenes are saved: the thin lens and the shutter (block MARD 0.27% and
@@ -181,6 +217,10 @@ def compare(name: str, drt: list, cycles: list) -> Comparison:
     )
 
 
+def average(renders: list) -> np.ndarray:
+    return np.mean([r.rgb.astype(np.float64) for r in renders], axis=0)
+
+
 @pytest.fixture(scope="module")
 def table():
     """Rows of the comparison table, printed at the end of the module (see them with -s)."""
@@ -193,13 +233,46 @@ def table():
             print(row.row())
 
 
-@pytest.mark.parametrize("case", CASES + EFFECT_CASES, ids=lambda case: case.name)
+HIGHLIGHT = 10.0  # a pixel this many times the image's 90th percentile (Cycles) belongs to a highlight
+HIGHLIGHT_MARGIN = 2  # pixels around it, beyond the pixel filter's reach
+
+
+def highlight(cycles: list) -> np.ndarray:
+    """Pixels of a delta light's highlight on a near-mirror, and a margin around them.
+
+    The Ignis roughness sphere (GGX alpha 0.0036) shows its point light as a highlight of 5
+    pixels at 64 px (7 to 240 times the brightest other pixel) that holds about half of the
+    image's energy. Its estimates are heavy-tailed (rare samples near the peak of the
+    distribution): measured 9x9-pixel window sums, two seeds,
+    DRT 4357, 3985 at 256 spp and 6960, 6428 at 1024; Cycles 6143, 6552 at 1024 and 6667, 6532
+    at 4096. Agreeing at 1024 and beyond, but no sample count in the time budget resolves 1%
+    there, and it would swamp every statistic of the rest of the image.
+    """
+    image = np.mean([r.rgb.astype(np.float64).sum(axis=-1) for r in cycles], axis=0)
+    m = HIGHLIGHT_MARGIN
+    padded = np.pad(image > HIGHLIGHT * np.percentile(image, 90), m)
+    h, w = image.shape
+    return np.any([padded[dy:dy + h, dx:dx + w] for dy in range(2 * m + 1) for dx in range(2 * m + 1)], axis=0)
+
+
+def without(renders: list, mask: np.ndarray) -> list:
+    """The renders with the masked pixels black in every channel (left out of all statistics)."""
+    return [rh.Render({"Combined": np.where(mask[..., None], 0.0, r.passes["Combined"])}, r.seconds, r.samples)
+            for r in renders]
+
+
+@pytest.mark.parametrize("case", CASES + EFFECT_CASES + KNOWN_DIFFERENCES, ids=lambda case: case.name)
 def test_matches_cycles(drt, tmp_path, table, case):
     scene = load(case)
     drt_renders = [rh.render(scene, "DRT", case.drt_samples, seed, tmp_path) for seed in (0, 1)]
     cycles_renders = [rh.render(scene, "CYCLES", case.cycles_samples, seed, tmp_path) for seed in (0, 1)]
     for render in drt_renders + cycles_renders:
         assert np.isfinite(render.passes["Combined"]).all()
+    rh.save_side_by_side(case.name, average(drt_renders), average(cycles_renders))
+    if case.mask_highlight:
+        mask = highlight(cycles_renders)
+        assert 0 < mask.sum() <= 0.02 * mask.size, f"{mask.sum()} highlight pixels"
+        drt_renders, cycles_renders = without(drt_renders, mask), without(cycles_renders, mask)
     result = compare(case.name, drt_renders, cycles_renders)
     table.append(result)
     print("\n" + HEADER + "\n" + result.row())
@@ -215,7 +288,11 @@ def test_matches_cycles(drt, tmp_path, table, case):
         f"MARD {result.mard:.2%} > {pixel_tolerance:.2%} (noise alone: {result.mard_noise:.2%})")
 
 
-TEXTURED = (Case("ignis_lights", DATA / "lights.blend", 16, 64), Case("ignis_sun", DATA / "sun.blend", 16, 64))
+TEXTURED = (
+    Case("ignis_lights", DATA / "lights.blend", 16, 64),
+    Case("ignis_sun", DATA / "sun.blend", 16, 64),
+    Case("ignis_roughness", DATA / "roughness.blend", 16, 64, (local_texture,)),
+)
 
 
 @pytest.mark.xfail(strict=True, reason="textures are a later issue: DRT shades the ground with the Diffuse "

@@ -1,0 +1,109 @@
+"""DRT against Mitsuba 3's motion-blur regression references, by Mitsuba's own per-pixel z-test.
+
+The scenes (../shared/scenes/mitsuba-motion-blur) are rebuilt in Blender by
+sample_scenes/build_mitsuba_motion.py and rendered by DRT at 48x48 with SPP samples per pixel.
+Each pixel channel passes when z = |mean - ref|·sqrt(SPP / max(var, 1e-4)) is below the normal
+quantile of a two-sided test at α = 0.01 with Šidák's correction over all 48·48·3 channels; the
+image passes when at least 99.75% of its channels pass (mitsuba3 src/render/tests/test_renders.py).
+DRT's samples are stratified, so its mean is less noisy than var/SPP says: the test is then
+conservative about noise and at least as sensitive to bias as with independent samples.
+
+Two references, both in tests/data/mitsuba_motion (README.md says how they were made):
+
+- ``*_direct``: Mitsuba 3.9.1 with ``max_depth`` 2, direct light only, as DRT traces diffuse
+  surfaces (distribution ray tracing). This is the like-for-like test.
+- ``*_ref_rgb``: the public references (``path``, ``max_depth`` 3: one indirect diffuse
+  bounce), with a per-sample variance re-rendered by Mitsuba 3.9.1 (``*_depth3_var``): the
+  published variance images are negative in 8-35% of their channels (second moments gathered
+  in XYZ, converted to RGB), and there even Mitsuba 3.9.1's own re-render fails the test
+  (98.1%, 98.5%, 89.6% of channels pass); with the valid variance it passes 100%, 99.99%, 99.97%.
+  Indirect light is 0.9-1.3% of simple_motion's image (per channel), 0.1-0.2% of complex_motion's
+  and 1.8-2.6% of emitters'; DRT lacks it by design, which fails simple_motion's test where the
+  green cube lights the blue cylinder (99.58% of channels pass, measured at 256 spp).
+
+``emitters`` moves its point and spot lights over the shutter; DRT holds each light at the
+frame's time (core.scene.Light has one matrix), so the test is an expected failure until lights
+move (it passes 50% of channels). Its spot cone is also only approximated: Mitsuba's falloff is
+linear in angle, Blender's a smoothstep in cosine over the same angles. Against a Mitsuba render
+with both lights held at time 0 (direct light, 2048 samples, not kept) DRT passes 98.55% of the
+channels, 87 of the 100 failures green, on the rim of the spot's cone.
+"""
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+import pytest
+
+import render_helpers as rh
+
+sys.path.insert(0, str(rh.ROOT / "sample_scenes"))
+import build_mitsuba_motion  # noqa: E402
+
+DATA = rh.ROOT / "tests" / "data" / "mitsuba_motion"
+SPP = 256
+ALPHA = 0.01
+PASS_FRACTION = 0.9975
+MOVING_LIGHTS = pytest.mark.xfail(strict=True, reason="DRT exports lights at the frame's time only "
+                                  "(core.scene.Light has one matrix): the point and spot lights do not move")
+
+
+def read_rgb(path) -> np.ndarray:
+    channels = rh.read_channels(path)
+    return np.stack([channels[c] for c in "RGB"], axis=-1).astype(np.float64)
+
+
+def z_test(mean: np.ndarray, spp: int, reference: np.ndarray, variance: np.ndarray) -> np.ndarray:
+    """Per-channel pass mask of Mitsuba's z-test, Šidák-corrected over all channels."""
+    z = np.abs(mean - reference) * np.sqrt(spp / np.maximum(variance, 1e-4))
+    p_value = np.vectorize(math.erfc)(z / math.sqrt(2.0))  # two-sided normal tail
+    alpha = 1.0 - (1.0 - ALPHA) ** (1.0 / mean.size)
+    return p_value > alpha
+
+
+@pytest.fixture(scope="module")
+def drt_images(drt, tmp_path_factory):
+    """DRT's render of each scene, made once for the module: name -> (48, 48, 3) float64."""
+    cache = {}
+    folder = tmp_path_factory.mktemp("mitsuba_motion")
+
+    def image(name: str) -> np.ndarray:
+        if name not in cache:
+            scene = build_mitsuba_motion.build(name)
+            cache[name] = rh.render(scene, "DRT", SPP, 0, folder, name=name).rgb.astype(np.float64)
+        return cache[name]
+
+    return image
+
+
+def check(name: str, image: np.ndarray, reference: np.ndarray, variance: np.ndarray, label: str) -> None:
+    passed = z_test(image, SPP, reference, variance)
+    fraction = float(passed.mean())
+    rh.save_side_by_side(f"mitsuba_{name}_{label}", image, reference)
+    print(f"\n{name} vs {label}: {fraction:.2%} of channels pass "
+          f"(DRT mean {image.mean():.5f}, reference {reference.mean():.5f})")
+    failing = np.argwhere(~passed)
+    assert fraction >= PASS_FRACTION, (
+        f"{fraction:.2%} of pixel channels pass the z-test (need {PASS_FRACTION:.2%}); "
+        f"first failing (row, column, channel): {failing[:6].tolist()}")
+
+
+@pytest.mark.parametrize("name", [
+    "simple_motion", "complex_motion", pytest.param("emitters", marks=MOVING_LIGHTS)])
+def test_matches_direct_light_reference(drt_images, name):
+    """Against Mitsuba with direct light only (max_depth 2): what DRT computes."""
+    check(name, drt_images(name), read_rgb(DATA / f"{name}_direct.exr"),
+          read_rgb(DATA / f"{name}_direct_var.exr"), "direct")
+
+
+@pytest.mark.parametrize("name", [
+    pytest.param("simple_motion", marks=pytest.mark.xfail(
+        strict=True, reason="one indirect diffuse bounce in the reference (green cube onto blue cylinder); "
+        "DRT traces direct light on diffuse surfaces")),
+    "complex_motion",
+    pytest.param("emitters", marks=MOVING_LIGHTS)])
+def test_matches_public_reference(drt_images, name):
+    """Against the published means (path tracer, max_depth 3), with a valid variance."""
+    check(name, drt_images(name), read_rgb(DATA / f"{name}_ref_rgb.exr"),
+          read_rgb(DATA / f"{name}_depth3_var.exr"), "public")
