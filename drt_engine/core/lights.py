@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from dataclasses import replace
+
 from . import microfacet as mf
 from .errors import SceneError
+from .motion import Motion
 from .scene import Light, SceneData
 
 _TINY = 1e-30
@@ -169,10 +172,29 @@ class Lights:
         self.strategies = self.light_slots + (1 if len(self.emissive) else 0) + (1 if self.world is not None else 0)
         if self.selecting:
             self._prepare_selection()
+        # a moving light is sampled and hit in its own frame: a copy of it that stays put
+        self.motions = {i: Motion(light.matrices) for i, light in enumerate(self.lights)
+                        if light.matrices is not None and Motion(light.matrices).moving}
+        self.static_copies = {i: replace(self.lights[i], matrix=np.eye(4), matrices=None) for i in self.motions}
+
+    @property
+    def moving(self) -> bool:
+        return bool(self.motions)
+
+    def _local(self, i, points, dirs, time):
+        """(light, points, directions, rotation) in the frame where light i stands still."""
+        motion = self.motions.get(i)
+        if motion is None or time is None:
+            return self.lights[i], points, dirs, None
+        linear, centre = motion.at(time)
+        rotation = linear / np.maximum(np.linalg.norm(linear, axis=1, keepdims=True), _TINY)
+        p = np.einsum("nji,nj->ni", rotation, points - centre)
+        d = None if dirs is None else np.einsum("nji,nj->ni", rotation, dirs)
+        return self.static_copies[i], p, d, rotation
 
     # -- next-event estimation ----------------------------------------------------
     def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray,
-               u_light: np.ndarray | None = None) -> LightSample:
+               u_light: np.ndarray | None = None, time: np.ndarray | None = None) -> LightSample:
         """Strategy k for shading points ``pos``; ``normal`` faces the incoming ray.
 
         With many lights, strategies below ``light_slots`` each pick one light per point
@@ -180,16 +202,19 @@ class Lights:
         """
         if k < self.light_slots:
             if not self.selecting:
-                return self._sample_light(k, pos, u)
-            return self._sample_selected(pos, u, u_light)
+                return self._sample_light(k, pos, u, time)
+            return self._sample_selected(pos, u, u_light, time)
         k -= self.light_slots
         if len(self.emissive) and k == 0:
             return self._sample_emissive(pos, u, u_pick)
         return self._sample_world(normal, u)
 
-    def _sample_light(self, index: int, pos, u) -> LightSample:
-        light = self.lights[index]
-        return getattr(self, "_sample_" + light.kind.lower())(light, pos, u)
+    def _sample_light(self, index: int, pos, u, time=None) -> LightSample:
+        light, local, _, rotation = self._local(index, pos, None, time)
+        sample = getattr(self, "_sample_" + light.kind.lower())(light, local, u)
+        if rotation is not None:
+            sample.wi = np.einsum("nij,nj->ni", rotation, sample.wi)
+        return sample
 
     # -- choosing among many lights ---------------------------------------------------
     def _prepare_selection(self):
@@ -223,14 +248,14 @@ class Lights:
         weight = np.maximum(weight, 1e-12 * weight.max(axis=1, keepdims=True) + 1e-300)
         return weight / weight.sum(axis=1, keepdims=True)
 
-    def _sample_selected(self, pos, u, u_light) -> LightSample:
+    def _sample_selected(self, pos, u, u_light, time=None) -> LightSample:
         prob = self.selection_probability(pos)
         pick = np.minimum((u_light[:, None] >= np.cumsum(prob, axis=1)).sum(axis=1), len(self.lights) - 1)
         n = len(pos)
         out = LightSample(np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3)), np.zeros(n))
         for i in np.unique(pick):
             idx = np.flatnonzero(pick == i)
-            ls = self._sample_light(i, pos[idx], u[idx])
+            ls = self._sample_light(i, pos[idx], u[idx], None if time is None else time[idx])
             out.wi[idx], out.dist[idx], out.value[idx], out.pdf[idx] = ls.wi, ls.dist, ls.value, ls.pdf
         chosen = np.take_along_axis(prob, pick[:, None], 1)[:, 0] * self.light_slots
         out.value /= chosen[:, None]
@@ -385,7 +410,7 @@ class Lights:
         return LightSample(wi, np.full(len(u), np.inf), value, pdf)
 
     # -- lights hit by rays (multiple importance sampling) --------------------------
-    def intersect(self, origins, dirs, tmax):
+    def intersect(self, origins, dirs, tmax, time=None):
         """Nearest light body along each ray before tmax: (t, light index or -1, radiance).
 
         Area lights are one-sided rectangles, disks and ellipses; point and spot lights
@@ -397,11 +422,11 @@ class Lights:
         best = np.full(n, -1)
         radiance = np.zeros((n, 3))
         for i in self.hittable:
-            light = self.lights[i]
+            light, o, d, _ = self._local(i, origins, dirs, time)
             if light.kind == "AREA":
-                t, le = self._hit_area(light, origins, dirs)
+                t, le = self._hit_area(light, o, d)
             else:
-                t, le = self._hit_round(light, origins, dirs)
+                t, le = self._hit_round(light, o, d)
             ok = (t > 0) & (t < best_t)
             best_t[ok] = t[ok]
             best[ok] = i
@@ -437,12 +462,12 @@ class Lights:
             le = le * self._spot(light, -dirs)[:, None]
         return t, le
 
-    def pdf(self, light_index, origins, dirs, t):
+    def pdf(self, light_index, origins, dirs, t, time=None):
         """Solid-angle density with which light sampling picks dirs from origins."""
-        return self._pdf_shape(light_index, origins, dirs, t) * self.pick_factor(light_index, origins)
+        light, o, d, _ = self._local(light_index, origins, dirs, time)
+        return self._pdf_shape(light, o, d, t) * self.pick_factor(light_index, origins)
 
-    def _pdf_shape(self, light_index, origins, dirs, t):
-        light = self.lights[light_index]
+    def _pdf_shape(self, light, origins, dirs, t):
         if light.kind == "AREA":
             c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
             pdf = t * t / (np.maximum(dirs @ ez, _TINY) * area)
@@ -459,7 +484,7 @@ class Lights:
         cos_max = np.sqrt(np.clip(1.0 - r * r / np.maximum(d2, _TINY), 0.0, 1.0))
         return 1.0 / (2.0 * np.pi * np.maximum(1.0 - cos_max, _TINY))
 
-    def suns_seen(self, origins, dirs):
+    def suns_seen(self, origins, dirs, time=None):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs."""
         radiance = np.zeros((len(dirs), 3))
         pdf = np.zeros(len(dirs))
@@ -467,7 +492,8 @@ class Lights:
             half = min(light.angle, np.pi) / 2.0
             if light.kind != "SUN" or half <= 0:
                 continue
-            inside = dirs @ -light.direction > np.cos(half)
+            light, _, d, _ = self._local(i, origins, dirs, time)
+            inside = d @ -light.direction > np.cos(half)
             radiance[inside] += light.irradiance / (np.pi * np.sin(half) ** 2)
             factor = self.pick_factor(i, origins[inside])
             pdf[inside] = factor / (2.0 * np.pi * (1.0 - np.cos(half)))

@@ -180,6 +180,9 @@ class Light:
     spread: float = np.pi
     visible_camera: bool = False
     """Seen by camera rays (Blender's ray visibility; off for lights by default)."""
+    matrices: np.ndarray | None = None
+    """(S, 4, 4) light-to-world transforms at S evenly spaced shutter times for a light
+    that moves (scale removed, like ``matrix``), else None."""
     name: str = ""
 
     def __post_init__(self):
@@ -188,6 +191,8 @@ class Light:
         if self.shape not in AREA_SHAPES:
             raise ValueError(f"unknown area light shape {self.shape!r}")
         self.matrix = np.asarray(self.matrix, dtype=np.float64).reshape(4, 4)
+        if self.matrices is not None:
+            self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
         for name in ("intensity", "irradiance", "radiance"):
             setattr(self, name, _vec3(getattr(self, name)))
 

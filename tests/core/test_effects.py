@@ -152,3 +152,32 @@ def test_defocus_converges_faster_with_chained_sobol_than_independent_samples():
     fit = lambda e: np.polyfit(np.log2(counts), np.log2(e), 1)[0]  # noqa: E731
     assert fit(sobol) <= -0.7
     assert -0.62 <= fit(random) <= -0.38
+
+
+def test_moving_light_lights_like_the_average_of_its_positions():
+    """A point light sliding over a plane during the shutter gives the time average of the
+    irradiance of its positions, whether sampled by light or (as a sphere) hit in a mirror."""
+    from drt_engine.core.scene import Light, World  # noqa: F401
+    mats = [Material("white", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])]
+    cam = Camera(translation(0, 0, 1.0)[None], (-0.01, 0.01, -0.01, 0.01), (4, 4))
+    path = [translation(x, 0, 2.0) for x in np.linspace(-1.0, 1.0, 5)]
+    moving = Light("POINT", path[2], intensity=np.full(3, 10.0), matrices=np.stack(path))
+    scene = SceneData(cam, [plane(20.0)], [Instance(0, np.eye(4))], mats, [moving])
+    value = render(scene, samples=256).mean()
+    xs = np.linspace(-1.0, 1.0, 2001)
+    expected = np.mean(0.5 / np.pi * 10.0 * 2.0 / (xs**2 + 4.0) ** 1.5)  # albedo/pi * I cos / d^2
+    assert value == pytest.approx(expected, rel=0.01)
+    assert Renderer(scene, RenderSettings(samples=1)).timed
+
+
+def test_moving_area_light_seen_in_a_mirror_sweeps_its_path():
+    """A small area light sliding above a mirror: the mirror pixel under its path is lit for
+    the fraction of the shutter the light covers it."""
+    from drt_engine.core.scene import Light
+    mirror = [Material("mirror", [Closure("GLOSSY", color=(1, 1, 1), roughness=0.0)])]
+    cam = Camera(translation(0, 0, 1.0)[None], (-1e-4, 1e-4, -1e-4, 1e-4), (4, 4))
+    path = [translation(x, 0, 2.0) for x in np.linspace(-1.0, 1.0, 5)]
+    light = Light("AREA", path[2], radiance=np.full(3, 3.0), size_x=0.2, size_y=0.2, matrices=np.stack(path))
+    scene = SceneData(cam, [plane(20.0)], [Instance(0, np.eye(4))], mirror, [light])
+    # the mirrored view ray meets the light plane at x = 0: covered while |x_light| < 0.1, 10% of the time
+    assert render(scene, samples=256).mean() == pytest.approx(0.3, rel=0.03)

@@ -44,6 +44,7 @@ def export_scene(
     materials = MaterialTable(warnings)
     geometry = GeometryExporter(materials, depsgraph.view_layer.material_override)
     lights = []
+    light_keys = []
     for count, instance in enumerate(depsgraph.object_instances):
         if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
             raise RenderCancelled("Render cancelled during scene export")
@@ -55,6 +56,7 @@ def export_scene(
             light = export_light(obj, matrix, warnings)
             if light is not None:
                 lights.append(light)
+                light_keys.append(instance_key(instance))
         else:
             geometry.add(obj, matrix, instance_key(instance))
     geometry.finish()
@@ -69,5 +71,5 @@ def export_scene(
         warnings=warnings,
     )
     if frame_set is not None:
-        add_motion(scene_data, depsgraph, frame_set, geometry.keys, camera_object.name)
+        add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)
     return scene_data

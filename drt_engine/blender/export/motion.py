@@ -50,8 +50,8 @@ def _vertices(obj) -> np.ndarray | None:
 
 
 def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], instance_keys: list,
-               camera_name: str) -> None:
-    """Fill instance and camera matrices over the shutter, and deforming meshes' vertices."""
+               light_keys: list, camera_name: str) -> None:
+    """Fill instance, light and camera matrices over the shutter, and deforming meshes' vertices."""
     times = shutter_times(depsgraph.scene)
     if times is None:
         return
@@ -62,6 +62,10 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
     matrices = np.repeat(np.stack([inst.matrices[0] for inst in scene_data.instances])[:, None], steps, 1) \
         if scene_data.instances else np.zeros((0, steps, 4, 4))
     seen = np.zeros((len(instance_keys), steps), bool)
+    light_index = {key: i for i, key in enumerate(light_keys)}
+    light_matrices = np.repeat(np.stack([light.matrix for light in scene_data.lights])[:, None], steps, 1) \
+        if scene_data.lights else np.zeros((0, steps, 4, 4))
+    light_seen = np.zeros((len(light_keys), steps), bool)
     vertices: dict[int, list] = {}
     camera = np.repeat(scene_data.camera.matrices[:1], steps, 0)
     frame, subframe = scene.frame_current, scene.frame_subframe
@@ -70,7 +74,13 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
             whole = math.floor(t)
             frame_set(int(whole), float(t - whole))
             for instance in depsgraph.object_instances:
-                i = wanted.get(instance_key(instance))
+                key = instance_key(instance)
+                j = light_index.get(key) if instance.object.type == "LIGHT" else None
+                if j is not None:
+                    light_matrices[j, k] = without_scale(instance.matrix_world)
+                    light_seen[j, k] = True
+                    continue
+                i = wanted.get(key)
                 if i is None:
                     continue
                 matrices[i, k] = np.array(instance.matrix_world, dtype=np.float64)
@@ -89,6 +99,9 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
         if seen[i].all():
             inst.matrices = matrices[i]
     scene_data.camera.matrices = camera
+    for j, light in enumerate(scene_data.lights):
+        if light_seen[j].all() and not np.allclose(light_matrices[j], light_matrices[j][:1]):
+            light.matrices = light_matrices[j]
     for mesh_index, per_step in vertices.items():
         if all(v is not None for v in per_step):
             stack = np.stack(per_step)
