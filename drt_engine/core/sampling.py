@@ -6,10 +6,11 @@ sample id down its whole ray tree (ray-id chaining); each effect draws from its 
 dimension, so pixel, lens, time, light and lobe are stratified and decorrelated.
 
 Patterns:
-- SOBOL: Owen-scrambled Sobol (Burley 2020, "Practical Hash-based Owen Scrambling"),
-  padded in pairs: each pair of dimensions uses Sobol dimensions 0 and 1 (a (0, 2)
-  sequence) with the sample index shuffled by a nested uniform scramble seeded per
-  pixel and pair, so every pair is perfectly stratified and pairs are decorrelated.
+- SOBOL: Owen-scrambled Sobol (Burley 2020, "Practical Hash-based Owen Scrambling").
+  Pixel and lens (dimensions 0-3) form one 4D Sobol net; later dimensions are padded in
+  pairs, each from Sobol dimensions 0 and 1 (a (0, 2) sequence) with the sample index
+  shuffled by a nested uniform scramble seeded per pixel and pair, so every pair is
+  perfectly stratified and pairs are decorrelated.
 - JITTERED: n x n stratified jitter for each pair of dimensions, strata visited in a
   per-pixel, per-pair random order.
 - GRID: regular n x n supersampling (stratum centres); only square counts.
@@ -69,13 +70,20 @@ def nested_uniform_scramble(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
 
 
 def _sobol_matrices() -> np.ndarray:
-    """Generator matrices (2, 32) of Sobol dimensions 0 and 1 (van der Corput, Pascal)."""
-    out = np.zeros((2, 32), dtype=np.uint64)
-    v = 1 << 31
-    for k in range(32):
-        out[0, k] = 1 << (31 - k)
-        out[1, k] = v
-        v ^= v >> 1
+    """Generator matrices (4, 32) of Sobol dimensions 0-3 (Joe-Kuo direction numbers)."""
+    params = [(1, 0, [1]), (2, 1, [1, 3]), (3, 1, [1, 3, 1])]
+    out = np.zeros((4, 32), dtype=np.uint64)
+    out[0] = [1 << (31 - k) for k in range(32)]
+    for d, (deg, a, m) in enumerate(params, start=1):
+        v = [0] * 33
+        for i in range(1, 33):
+            if i <= deg:
+                v[i] = m[i - 1] << (32 - i)
+            else:
+                v[i] = v[i - deg] ^ (v[i - deg] >> deg)
+                for k in range(1, deg):
+                    v[i] ^= ((a >> (deg - 1 - k)) & 1) * v[i - k]
+        out[d] = v[1:]
     return out.astype(_U32)
 
 
@@ -97,7 +105,7 @@ _SOBOL = _byte_tables(_sobol_matrices())
 
 
 def sobol_u32(index: np.ndarray, dim: int) -> np.ndarray:
-    """Unscrambled Sobol point ``index`` in dimension ``dim`` (0 or 1) as 32-bit fixed point."""
+    """Unscrambled Sobol point ``index`` in dimension ``dim`` (0-3) as 32-bit fixed point."""
     index = np.asarray(index, dtype=_U32)
     t = _SOBOL[dim]
     return (t[0][index & _U32(0xFF)] ^ t[1][(index >> _U32(8)) & _U32(0xFF)]
@@ -179,13 +187,21 @@ class Sampler:
         return self._stratified(pixel, sample, dim)
 
     def _sobol(self, pixel, sample, dim, components):
-        """Dimensions dim + c for c in components, sharing one shuffled index."""
+        """Dimensions dim + c for c in components, sharing one shuffled index.
+
+        The pixel and lens pairs (dimensions 0-3) are one 4D Sobol net, so defocus, whose
+        integrand couples image position and lens position, is stratified jointly; later
+        pairs are padded from Sobol dimensions 0 and 1 with their own shuffles.
+        """
         pixel_seed = hash_combine(pixel, self.seed)
-        index = nested_uniform_scramble(np.asarray(sample, dtype=_U32), hash_u32(pixel_seed ^ _U32(dim * 0x9E3779B9 & 0xFFFFFFFF)))
+        group = 0 if dim < 4 else dim
+        index = nested_uniform_scramble(np.asarray(sample, dtype=_U32),
+                                        hash_u32(pixel_seed ^ _U32(group * 0x9E3779B9 & 0xFFFFFFFF)))
         out = np.empty((len(index), len(components)))
         for k, c in enumerate(components):
             scramble = hash_u32(pixel_seed ^ _U32((dim + c) * 0x85EBCA6B & 0xFFFFFFFF) ^ _U32(0x0A11))
-            out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, c), scramble))
+            source = dim + c if dim < 4 else c
+            out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, source), scramble))
         return out
 
     def _stratified(self, pixel, sample, dim):
