@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import adaptive
 from . import camera as camera_rays
 from . import microfacet as mf
 from .accel import Geometry, spawn
@@ -23,6 +24,7 @@ from .bsdf import MaterialShader
 from .errors import SceneError
 from .film import Film, PixelFilter
 from .lights import Lights
+from .report import ErrorLog
 from .sampling import Sampler
 from .scene import SceneData
 from .settings import RenderSettings
@@ -38,6 +40,7 @@ class RenderResult:
     stats: dict
     cancelled: bool = False
     warnings: list = field(default_factory=list)
+    log: list = field(default_factory=list)  # report.ErrorLog entries, one per step
 
 
 @dataclass
@@ -47,6 +50,8 @@ class ProgressUpdate:
     samples_total: int
     elapsed: float
     _film: Film
+    error: float = float("inf")  # latest estimated relMSE of the image (inf until known)
+    entry: dict | None = None  # the log entry when a step just ended, else None
 
     def passes(self) -> dict:
         return self._film.images()
@@ -60,21 +65,26 @@ def _power(a, b):
 
 
 class _Dims:
-    """Sample dimensions of a path: pixel, lens, then a fixed stride per depth step."""
+    """Sample dimensions of a path: pixel, lens, shutter time, then a stride per depth step."""
 
-    PIXEL, LENS = 0, 2
+    PIXEL, LENS, TIME = 0, 2, 4
+    _FIRST = 6
 
     def __init__(self, strategies: int):
-        self.stride = 4 + 2 * strategies
+        self.stride = 4 + 4 * strategies
 
     def lobe(self, depth):
-        return 4 + depth * self.stride
+        return self._FIRST + depth * self.stride
 
     def pick(self, depth):
-        return 4 + depth * self.stride + 2
+        return self._FIRST + depth * self.stride + 2
 
     def light(self, depth, k):
-        return 4 + depth * self.stride + 4 + 2 * k
+        return self._FIRST + depth * self.stride + 4 + 4 * k
+
+    def choice(self, depth, k):
+        """Which light strategy k picks, when lights are chosen by contribution."""
+        return self.light(depth, k) + 2
 
 
 class Renderer:
@@ -99,50 +109,117 @@ class Renderer:
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
         self.dims = _Dims(self.lights.strategies)
+        self.timed = self.geometry.moving or camera_rays.moves(self.camera) or self.lights.moving
         w, h = self.camera.window_size
-        self.film = Film(w, h, settings.passes)
+        contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
+        self.film = Film(w, h, settings.passes, track_range=contrast)
         self.warnings = list(scene.warnings) + self.geometry.warnings
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
 
     # -- driver ---------------------------------------------------------------------
     def render(self, progress=None) -> RenderResult:
+        """Trace rounds of samples up to each checkpoint, then log, test and apply the stop rules.
+
+        Sample k of a pixel comes from replicate k % 2 (see adaptive.replicate_samplers),
+        so the film's two halves are independent estimates and its error estimate holds.
+
+        Only active pixels are traced: a round gives every active pixel the samples it
+        lacks to reach the next checkpoint, sample after sample over the active pixels
+        (so a round cut short leaves an even image), in waves of at most WAVE. Each
+        pixel draws sample ids 0, 1, 2, ... in order, so its sequence stays stratified.
+        """
         start = time.perf_counter()
+        s = self.settings
         w, h = self.camera.window_size
         x0, y0, _, _ = self.camera.window
         n_pix = w * h
-        spp = self.sampler.samples
-        per_round = max(1, min(spp, WAVE // n_pix)) if n_pix < WAVE else 1
-        done = 0
-        cancelled = False
+        cap = self.sampler.samples
+        threshold = adaptive.effective_threshold(s.adaptive_threshold, cap)
+        first = adaptive.first_test(adaptive.min_samples(threshold, s.adaptive_min_samples))
+        points = adaptive.checkpoints(cap, first if s.use_adaptive_sampling else cap)
+        log = ErrorLog()
+        replicas = adaptive.replicate_samplers(s.sampling_pattern, cap, s.seed)
+        main_sampler = self.sampler
+        active = np.arange(n_pix)
+        planned = float(n_pix) * cap
+        traced = 0
+        stopped = None
+
+        def trace(pixel, sample):
+            if replicas is None:
+                self._trace(pixel, sample, x0, y0, w)
+                return
+            for r, sampler in enumerate(replicas):
+                sel = (sample & 1) == r
+                if sel.any():
+                    self.sampler, self.film.replicate = sampler, r
+                    self._trace(pixel[sel], sample[sel] >> 1, x0, y0, w)
+            self.sampler, self.film.replicate = main_sampler, None
+
+        def notify(done, entry=None) -> bool:
+            elapsed = time.perf_counter() - start
+            fraction = traced / planned if planned else 1.0
+            if s.time_limit > 0:
+                fraction = max(fraction, elapsed / s.time_limit)
+            last = log.last
+            error = last["relmse"] if last else float("inf")
+            update = ProgressUpdate(min(fraction, 1.0), done, cap, elapsed, self.film, error, entry)
+            return progress is None or progress(update) is not False
+
         try:
-            while done < spp:
-                count = min(per_round, spp - done)
-                total = n_pix * count
-                for a in range(0, total, WAVE):
-                    flat = np.arange(a, min(a + WAVE, total), dtype=np.int64)
-                    pixel = flat % n_pix
-                    sample = done + flat // n_pix
-                    self._trace(pixel, sample, x0, y0, w)
-                    if progress is not None and a + WAVE < total:
-                        frac = (done + (a + WAVE) / n_pix) / spp
-                        if progress(ProgressUpdate(frac, done, spp, time.perf_counter() - start, self.film)) is False:
-                            cancelled = True
-                            break
-                if cancelled:
-                    break
-                done += count
-                if progress is not None and done < spp:
-                    if progress(ProgressUpdate(done / spp, done, spp, time.perf_counter() - start, self.film)) is False:
-                        cancelled = True
+            for target in points:
+                base = self.film.count[active]
+                need = (target - base).astype(np.int64)
+                keep = need > 0
+                pix, base, need = active[keep], base[keep], need[keep]
+                # sample-major order: every pixel's next sample before any pixel's one after
+                step = np.arange(int(need.sum())) - np.repeat(np.cumsum(need) - need, need)
+                order = np.argsort(step, kind="stable")
+                order_pix = np.repeat(pix, need)[order]
+                order_sample = np.repeat(base.astype(np.int64), need)[order] + step[order]
+                for a in range(0, len(order_pix), WAVE):
+                    trace(order_pix[a:a + WAVE], order_sample[a:a + WAVE])
+                    traced += len(order_pix[a:a + WAVE])
+                    if s.time_limit > 0 and time.perf_counter() - start >= s.time_limit:
+                        stopped = "time_limit"
                         break
+                    if a + WAVE < len(order_pix) and not notify(target - 1):
+                        stopped = "cancelled"
+                        break
+                if stopped:
+                    break
+                if s.use_adaptive_sampling and target >= first and target < cap:
+                    mask = adaptive.still_active(self.film, s.adaptive_mode, threshold)
+                    active = np.flatnonzero(mask)
+                entry = log.record(time.perf_counter() - start, self.film, self.rays, len(active) / max(n_pix, 1))
+                if target == cap:
+                    stopped = "samples"
+                elif len(active) == 0:
+                    stopped = "threshold"
+                elif s.target_error > 0 and self.film.count.min() >= 4 and entry["relmse"] < s.target_error:
+                    stopped = "target_error"
+                elif s.time_limit > 0 and entry["elapsed"] >= s.time_limit:
+                    stopped = "time_limit"
+                if not notify(target, entry) and not stopped:
+                    stopped = "cancelled"
+                if stopped:
+                    entry["stopped"] = stopped
+                    break
+            if stopped in ("time_limit", "cancelled") and (not log.last or "stopped" not in log.last):
+                log.record(time.perf_counter() - start, self.film, self.rays, len(active) / max(n_pix, 1), stopped)
         finally:
             if self.pool is not None:
                 self.pool.shutdown(wait=True)
         elapsed = time.perf_counter() - start
-        stats = {"samples": int(self.film.count.max()) if n_pix else 0, "samples_requested": spp,
+        last = log.last or {}
+        stats = {"samples": int(self.film.count.max()) if n_pix else 0, "samples_requested": cap,
+                 "samples_mean": float(self.film.count.mean()) if n_pix else 0.0,
                  "elapsed": elapsed, "rays": dict(self.rays), "threads": self.threads,
-                 "triangles": self.geometry.triangle_count, "light_strategies": self.lights.strategies}
-        return RenderResult(self.film.images(), stats, cancelled, self.warnings)
+                 "triangles": self.geometry.triangle_count, "light_strategies": self.lights.strategies,
+                 "stopped_by": stopped or "samples", "rmse": last.get("rmse"), "relmse": last.get("relmse"),
+                 "adaptive_threshold": threshold if s.use_adaptive_sampling else None,
+                 "adaptive_first_test": first if s.use_adaptive_sampling else None}
+        return RenderResult(self.film.images(), stats, stopped == "cancelled", self.warnings, log.entries)
 
     # -- one wave of camera samples ---------------------------------------------------
     def _trace(self, pixel, sample, x0, y0, w):
@@ -156,7 +233,9 @@ class Renderer:
         px = (pixel % w + x0) + 0.5 + off[:, 0]
         py = (pixel // w + y0) + 0.5 + off[:, 1]
         lens = self.sampler.get2d(seed_pixel, sample, _Dims.LENS) if self.camera.aperture_radius > 0 else None
-        cam = camera_rays.generate(self.camera, px, py, lens)
+        # the shutter is a dimension only when something moves
+        time = self.sampler.get(seed_pixel, sample, _Dims.TIME) if self.timed else np.zeros(n)
+        cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
         self.rays["camera"] += n
 
         radiance = np.zeros((n, 3))
@@ -178,15 +257,18 @@ class Renderer:
         for depth in range(s.max_depth + 1):
             if len(path) == 0:
                 break
-            hits = self.geometry.intersect(origins, dirs, tmax)
-            light_t, light_id, light_le = self.lights.intersect(origins, dirs, np.minimum(hits.t, tmax))
+            ray_time = time[path]
+            hits = self.geometry.intersect(origins, dirs, tmax, ray_time)
+            light_t, light_id, light_le = self.lights.intersect(origins, dirs, np.minimum(hits.t, tmax), ray_time)
+            # a light hidden from the camera is not there for camera rays: they go on past it
+            hidden = straight[path] & ~self.lights.camera_visible[np.maximum(light_id, 0)]
+            light_id = np.where(hidden, -1, light_id)
             on_light = light_id >= 0
             on_surface = hits.hit & ~on_light
             escaped = ~hits.hit & ~on_light
 
             # lights hit directly: always by reflected and refracted rays, by the camera if asked
-            seen = on_light & (~straight[path] | self.lights.camera_visible[np.maximum(light_id, 0)])
-            idx = np.flatnonzero(seen)
+            idx = np.flatnonzero(on_light)
             if len(idx):
                 contrib = light_le[idx].copy()
                 smooth = ~np.isinf(prev_pdf[idx])
@@ -195,7 +277,8 @@ class Renderer:
                     pl = np.zeros(len(k))
                     for li in np.unique(light_id[k]):
                         sel = light_id[k] == li
-                        pl[sel] = self.lights.pdf(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]])
+                        pl[sel] = self.lights.pdf(li, origins[k[sel]], dirs[k[sel]], light_t[k[sel]],
+                                                  ray_time[k[sel]])
                     contrib[smooth] *= _power(prev_pdf[k], pl)[:, None]
                 radiance[path[idx]] += throughput[idx] * contrib
                 if self.scene.film_transparent:
@@ -221,7 +304,7 @@ class Renderer:
                     radiance[path[idx]] += throughput[idx] * world * weight[:, None]
                 bounced = idx[~straight[path[idx]]] if len(idx) else idx
                 if len(bounced):
-                    sun, pdf_sun = self.lights.suns_seen(dirs[bounced])
+                    sun, pdf_sun = self.lights.suns_seen(origins[bounced], dirs[bounced], ray_time[bounced])
                     weight = np.where(np.isinf(prev_pdf[bounced]), 1.0, _power(prev_pdf[bounced], pdf_sun))
                     radiance[path[bounced]] += throughput[bounced] * sun * weight[:, None]
 
@@ -229,7 +312,7 @@ class Renderer:
             if len(surf) == 0:
                 break
             p_ids = path[surf]
-            pos, ng, ns = self.geometry.surface(hits, surf)
+            pos, ng, ns = self.geometry.surface(hits, surf, ray_time)
             prim = hits.prim[surf]
             mat = self.geometry.material[prim]
             wo = -dirs[surf]
@@ -283,12 +366,12 @@ class Renderer:
                     if "GlossCol" in aux:
                         aux["GlossCol"][p_ids[fg]] = gloss
                 shadow.append(self._direct(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o, ns_o,
-                                           tangent, bitangent, wo_l, inside, scale, throughput[surf]))
+                                           tangent, bitangent, wo_l, inside, scale, throughput[surf], time))
                 if shader.can_continue and depth < s.max_depth:
                     next_state.append(self._continue(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o,
                                                      ns_o, tangent, bitangent, wo_l, inside, scale,
                                                      throughput[surf], straight[p_ids]))
-            self._resolve_shadows(shadow, radiance)
+            self._resolve_shadows(shadow, radiance, time)
 
             if not next_state:
                 break
@@ -308,10 +391,11 @@ class Renderer:
         radiance = np.where(np.isfinite(radiance), radiance, 0.0)
         values = {"Combined": np.concatenate([radiance, np.clip(alpha, 0.0, 1.0)[:, None]], axis=1)}
         values.update(aux)
-        self.film.add(pixel, values)
+        self.film.add(pixel, values, sample)
 
     # -- next-event estimation ----------------------------------------------------------
-    def _direct(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale, thr):
+    def _direct(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale, thr,
+                time):
         """Shadow rays (not yet traced) for the hits g of one material, one per light strategy."""
         lights = self.lights
         out = []
@@ -322,7 +406,8 @@ class Renderer:
         u_pick = self.sampler.get(sp, sm, self.dims.pick(depth) + 1)
         for k in range(lights.strategies):
             u = self.sampler.get2d(sp, sm, self.dims.light(depth, k))
-            ls = lights.sample(k, pos[g], ng[g], u, u_pick)
+            u_light = self.sampler.get(sp, sm, self.dims.choice(depth, k)) if lights.selecting else None
+            ls = lights.sample(k, pos[g], ng[g], u, u_pick, u_light, time[pid] if self.timed else None)
             ok = ls.value.max(axis=1) > 0
             if not ok.any():
                 continue
@@ -343,7 +428,7 @@ class Renderer:
             out.append((pid[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel]))
         return out
 
-    def _resolve_shadows(self, shadow, radiance):
+    def _resolve_shadows(self, shadow, radiance, time):
         parts = [item for group in shadow for item in group]
         if not parts:
             return
@@ -353,7 +438,7 @@ class Renderer:
         tmax = np.concatenate([p[3] for p in parts])
         contrib = np.concatenate([p[4] for p in parts])
         self.rays["shadow"] += len(pid)
-        blocked = self.geometry.occluded(origins, dirs, tmax)
+        blocked = self.geometry.occluded(origins, dirs, tmax, time[pid])
         # area lights are not geometry: a nearer area light also blocks (lights cast shadows
         # of each other's bodies in Cycles only when they are meshes, so it does not here)
         visible = ~blocked

@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 
 SAMPLING_PATTERNS = ("GRID", "JITTERED", "SOBOL")
 FILTER_TYPES = ("BOX", "GAUSSIAN", "BLACKMAN_HARRIS")
+ADAPTIVE_MODES = ("NOISE", "CONTRAST")
 
 PASSES = (
     "Combined",  # RGBA
@@ -46,6 +47,7 @@ class RenderSettings:
     use_adaptive_sampling: bool = False
     adaptive_threshold: float = 0.01
     adaptive_min_samples: int = 0
+    adaptive_mode: str = "NOISE"
     time_limit: float = 0.0
     target_error: float = 0.0
     extra: dict = field(default_factory=dict)
@@ -55,6 +57,8 @@ class RenderSettings:
             raise ValueError(f"unknown sampling pattern {self.sampling_pattern!r}")
         if self.filter_type not in FILTER_TYPES:
             raise ValueError(f"unknown filter type {self.filter_type!r}")
+        if self.adaptive_mode not in ADAPTIVE_MODES:
+            raise ValueError(f"unknown adaptive mode {self.adaptive_mode!r}")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         unknown = set(self.passes) - set(PASSES)

@@ -1,0 +1,151 @@
+"""When to stop sampling a pixel, and how wrong the image is.
+
+Two modes decide which pixels keep receiving samples after the minimum:
+
+- NOISE, with Cycles' semantics so its settings carry over (kernel/film/adaptive_sampling.h,
+  scene/integrator.cpp): a pixel converges when the sum over RGB of its standard
+  error, divided by sqrt(R+G+B) below 1 and by R+G+B above, is under 5 x threshold;
+  threshold 0 means max(0.001, 1 / samples); 0 min samples means
+  max(4, ceil(16 / threshold^0.3)); the first test is at sample ((min + 1) | 15) + 1,
+  then every 16 samples; unconverged pixels keep their neighbours sampling (a
+  one-pixel dilation), and a converged pixel is tested again at every step.
+- CONTRAST, the classic refinement of Mitchell (1987): a pixel keeps sampling while
+  the samples in its 3x3 neighbourhood differ, i.e. (max - min) / (max + min) of some
+  channel exceeds Mitchell's thresholds (0.4, 0.3, 0.6 for R, G, B). It looks at
+  sample values only, not at the error of the mean, so it never calls a pixel done
+  because it has enough samples; the cap, time and target error end it.
+
+The error of the whole image comes from the film's per-pixel variance estimate:
+RMSE over pixels and RGB channels, and relMSE = mean of variance / (value^2 + 0.01)
+(Rousselle et al. 2011), the same measure the benchmark computes against a reference.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .film import Film
+from .sampling import Sampler, hash_combine
+
+ADAPTIVE_STEP = 16
+"""Samples between two convergence tests (Cycles' adaptive_step)."""
+
+THRESHOLD_SCALE = 5.0
+"""Cycles multiplies the user's noise threshold by this before testing."""
+
+MITCHELL_CONTRAST = np.array([0.4, 0.3, 0.6])
+RELMSE_EPSILON = 1e-2
+
+
+def replicate_samplers(pattern: str, cap: int, seed: int) -> list[Sampler] | None:
+    """Two independently scrambled samplers of half the samples each (None for GRID).
+
+    A pixel's sample k is sample k // 2 of replicate k % 2, so both replicates grow
+    together and each stays a stratified prefix of its own sequence; the two
+    replicate means are independent, which makes the film's error estimate unbiased.
+    """
+    if pattern == "GRID":
+        return None
+    half = -(-cap // 2)
+    return [Sampler(pattern, half, int(hash_combine(*(np.full(1, v) for v in (seed, r, 0x4E91)))[0])) for r in (0, 1)]
+
+
+def effective_threshold(threshold: float, samples: int) -> float:
+    """The user's threshold; 0 means automatic, max(0.001, 1 / samples) as in Cycles."""
+    return max(0.001, 1.0 / samples) if threshold == 0 else threshold
+
+
+def min_samples(threshold: float, requested: int) -> int:
+    """Samples every pixel takes before the first test (of the effective threshold); 0 = automatic."""
+    if requested == 0 and threshold > 0:
+        return max(4, math.ceil(16.0 / threshold ** 0.3))
+    return max(4, requested)
+
+
+def checkpoints(cap: int, first_test: int) -> list[int]:
+    """Per-pixel sample counts at which the driver stops to log, test and check the stop rules.
+
+    Doubling up to ``first_test`` (the log gets points early on, and small images get
+    large waves), then every ADAPTIVE_STEP up to ``cap``; without adaptive sampling
+    ``first_test`` is ``cap`` and the counts simply double.
+    """
+    first_test = min(first_test, cap)
+    points = {first_test, cap}
+    points.update(1 << k for k in range(first_test.bit_length()) if 1 << k < first_test)
+    points.update(range(first_test + ADAPTIVE_STEP, cap, ADAPTIVE_STEP))
+    return sorted(points)
+
+
+def first_test(min_count: int) -> int:
+    """Sample count of the first test, as Cycles: 0-based sample (min + 1) | (step - 1)."""
+    return ((min_count + 1) | (ADAPTIVE_STEP - 1)) + 1
+
+
+def dilate(mask: np.ndarray) -> np.ndarray:
+    """Grow a (h, w) boolean mask by one pixel in x and then y (Cycles' filter_x / filter_y)."""
+    out = mask.copy()
+    out[:, 1:] |= mask[:, :-1]
+    out[:, :-1] |= mask[:, 1:]
+    grown = out.copy()
+    out[1:] |= grown[:-1]
+    out[:-1] |= grown[1:]
+    return out
+
+
+def noise_error(film: Film) -> np.ndarray:
+    """Cycles' per-pixel error: summed RGB standard error over the tone-aware intensity."""
+    mean = film.sums["Combined"][:, :3] / np.maximum(film.count, 1)[:, None]
+    difference = np.sqrt(film.variance()).sum(axis=1)
+    intensity = mean.sum(axis=1)
+    normalize = np.where(intensity < 1.0, np.sqrt(np.maximum(intensity, 0.0)), intensity)
+    return difference / (1e-4 + normalize)
+
+
+def contrast(film: Film) -> np.ndarray:
+    """Mitchell's contrast of the samples in each pixel's 3x3 neighbourhood, per channel / threshold."""
+    h, w = film.height, film.width
+    lo = film.lo.reshape(h, w, 3)
+    hi = film.hi.reshape(h, w, 3)
+    lo_pad = np.pad(lo, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    hi_pad = np.pad(hi, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    lo_n = np.full_like(lo, np.inf)
+    hi_n = np.full_like(hi, -np.inf)
+    for dy in range(3):
+        for dx in range(3):
+            lo_n = np.minimum(lo_n, lo_pad[dy:dy + h, dx:dx + w])
+            hi_n = np.maximum(hi_n, hi_pad[dy:dy + h, dx:dx + w])
+    lo_n = np.maximum(lo_n, 0.0)
+    c = (hi_n - lo_n) / np.maximum(hi_n + lo_n, 1e-12)
+    return (c / MITCHELL_CONTRAST).max(axis=2).reshape(-1)
+
+
+def still_active(film: Film, mode: str, threshold: float) -> np.ndarray:
+    """Flat boolean mask of the pixels that need more samples, dilated by one pixel."""
+    if mode == "CONTRAST":
+        need = contrast(film) > 1.0
+    else:
+        need = ~(noise_error(film) < THRESHOLD_SCALE * threshold)
+    return dilate(need.reshape(film.height, film.width)).reshape(-1)
+
+
+def image_error(film: Film) -> tuple[float, float]:
+    """Estimated (RMSE, relMSE) of the Combined RGB image; inf until every pixel has an estimate."""
+    var = film.variance()
+    if film.n == 0:
+        return 0.0, 0.0
+    if not np.isfinite(var).all():
+        return math.inf, math.inf
+    mean = film.sums["Combined"][:, :3] / np.maximum(film.count, 1)[:, None]
+    rmse = float(np.sqrt(var.mean()))
+    relmse = float((var / (mean * mean + RELMSE_EPSILON)).mean())
+    return rmse, relmse
+
+
+def true_error(image: np.ndarray, reference: np.ndarray, reference_variance=None) -> tuple[float, float]:
+    """(RMSE, relMSE) of an RGB image against a reference, less the reference's own variance."""
+    d2 = (np.asarray(image, float) - np.asarray(reference, float)) ** 2
+    if reference_variance is not None:
+        d2 = d2 - np.asarray(reference_variance, float)
+    denom = np.asarray(reference, float) ** 2 + RELMSE_EPSILON
+    return float(np.sqrt(max(d2.mean(), 0.0))), float(max((d2 / denom).mean(), 0.0))
