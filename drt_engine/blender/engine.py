@@ -5,8 +5,10 @@ are not rendered separately yet). With border render on, Blender's render result
 pastes the result into the full frame itself when "Crop to Render Region" is off), so
 the engine always writes the ``camera.window`` rectangle at (0, 0) of its result.
 """
+import dataclasses
 import time
 import traceback
+import weakref
 
 import bpy
 import numpy as np
@@ -16,6 +18,10 @@ from .properties import enabled_passes, pass_layout, settings_from_scene
 
 DISPLAY_INTERVAL = 1.0
 """Seconds between refreshes of the image on screen while rendering."""
+
+PREVIEW_SAMPLES = 16
+PREVIEW_MAX_DEPTH = 4
+"""Material and light previews (thumbnails, the Preview panel): few samples and short chains."""
 
 
 def render_window(render, width: int, height: int) -> tuple[int, int, int, int]:
@@ -42,6 +48,20 @@ def write_passes(result, passes: dict) -> None:
             target.rect.foreach_set(np.ascontiguousarray(pixels, dtype=np.float32).ravel())
 
 
+def preview_settings(settings):
+    """Settings for a material or light preview: small and fast, Combined only."""
+    return dataclasses.replace(settings, samples=min(settings.samples, PREVIEW_SAMPLES),
+                               max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",))
+
+
+def viewport_settings(settings):
+    """Settings for Rendered shading: few samples, Combined only, no stop rules."""
+    from .viewport import MAX_SAMPLES
+
+    return dataclasses.replace(settings, samples=min(settings.samples, MAX_SAMPLES), passes=("Combined",),
+                               use_adaptive_sampling=False, time_limit=0.0, target_error=0.0)
+
+
 def _one_line(text: str) -> str:
     return " ".join(text.split())
 
@@ -56,6 +76,11 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
+        self._viewport = None  # ViewportRender, made at the first view_update
+        self._view_scene = None  # SceneData of the last view_update, camera replaced per view
+        self._view_settings = None
+        self._view_key = None  # region size and matrices the running viewport render is for
+        self._view_texture = None
 
     def render(self, depsgraph):
         try:
@@ -75,13 +100,16 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         self.update_stats("", "Exporting scene")
-        scene_data = export_scene(depsgraph, camera_object=self.camera_override, cancel=self.test_break)
+        scene_data = export_scene(depsgraph, camera_object=self.camera_override, cancel=self.test_break,
+                                  frame_set=None if self.is_preview else self.frame_set)
         self._warn(scene_data.warnings)
         if self.test_break():
             return
         self._check_window(scene_data.camera, scene.render)
 
         settings = settings_from_scene(scene, view_layer)
+        if self.is_preview:
+            settings = preview_settings(settings)
         self.update_stats("", "Preparing the render")
         renderer = Renderer(scene_data, settings)
         if self.test_break():
@@ -133,6 +161,58 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 f"DRT internal error: exported image {camera.resolution} window {camera.window} "
                 f"differs from Blender's {(self.resolution_x, self.resolution_y)} window {expected}"
             )
+
+    def view_update(self, context, depsgraph):
+        """The scene changed (or the viewport opened): export it and restart the viewport render."""
+        from .export import export_scene
+        from .viewport import ViewportRender, weak_redraw
+
+        if self._viewport is None:
+            self._viewport = ViewportRender(weak_redraw(self))
+            weakref.finalize(self, self._viewport.stop)  # Blender frees the engine: stop the worker
+        try:
+            scene_data = export_scene(depsgraph)
+        except Exception as error:
+            if not isinstance(error, DRTError):  # a bug of ours: details in the console
+                print(f"DRT: unexpected error while exporting for the viewport\n{traceback.format_exc()}")
+            self._viewport.stop(timeout=0.0)
+            self._view_scene = None
+            self.update_stats("", _one_line(str(error)))
+            return
+        self._view_scene = scene_data
+        self._view_settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer))
+        self._view_key = None  # view_draw restarts the render with the region's camera
+
+    def view_draw(self, context, depsgraph):
+        """Draw the newest viewport image; restart the render first if the view changed."""
+        import gpu
+
+        from .export.viewport import viewport_camera
+        from .viewport import ViewportTexture
+
+        region, region_data = context.region, context.region_data
+        if self._view_scene is not None:
+            key = (region.width, region.height, tuple(map(tuple, region_data.view_matrix)),
+                   tuple(map(tuple, region_data.window_matrix)))
+            if key != self._view_key:
+                camera = viewport_camera(region, region_data)
+                self._viewport.start(dataclasses.replace(self._view_scene, camera=camera), self._view_settings)
+                self._view_key = key
+        if self._viewport is None:
+            return
+        version, image = self._viewport.latest()
+        if self._viewport.status:
+            self.update_stats("", self._viewport.status)
+        if image is None:
+            return
+        if self._view_texture is None:
+            self._view_texture = ViewportTexture()
+        self._view_texture.update(version, image)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(depsgraph.scene)
+        self._view_texture.draw(region.width, region.height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
 
     def update_render_passes(self, scene=None, renderlayer=None):
         for name in enabled_passes(renderlayer):

@@ -1,0 +1,143 @@
+"""Rendered shading in the 3D viewport: a progressive render on a worker thread.
+
+Blender calls the engine's ``view_update`` and ``view_draw`` on its main thread, which
+must never wait for the tracer. The scene is exported there (reading Blender data is
+only safe on the main thread), then a worker thread builds the ``Renderer`` and traces,
+publishing the image after every round of samples; ``view_draw`` only uploads the
+newest image and draws it. A new scene or a new view stops the running worker (it
+notices at its next progress call) and starts another one. The worker never holds the
+engine: it asks for redraws through a weak reference, so Blender can free the engine
+whenever it wants, and the engine's ``__del__`` stops the worker first.
+"""
+from __future__ import annotations
+
+import threading
+import traceback
+import weakref
+from collections.abc import Callable
+
+import numpy as np
+
+from ..core.errors import DRTError
+
+MAX_SAMPLES = 16
+"""Camera samples per pixel the viewport takes at most (the scene's DRT samples if fewer)."""
+
+STOP_TIMEOUT = 5.0
+"""Seconds the engine waits, when Blender frees it, for the worker to reach its next progress call."""
+
+
+class ViewportRender:
+    """One worker at a time rendering the viewport; the newest image, shared under a lock."""
+
+    def __init__(self, redraw: Callable[[], None]):
+        self._redraw = redraw
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.image: np.ndarray | None = None
+        """(h, w, 4) float32 RGBA, rows bottom-to-top, or None before the first round."""
+        self.version = 0
+        self.status = ""
+
+    def start(self, scene_data, settings) -> None:
+        """Stop the running worker (without waiting for it) and render ``scene_data``."""
+        self._stop.set()
+        stop = threading.Event()
+        self._stop = stop
+        self._thread = threading.Thread(target=self._run, args=(scene_data, settings, stop),
+                                        name="DRT viewport", daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout: float = STOP_TIMEOUT) -> None:
+        """Stop the worker and wait for it, so nothing calls back into a freed engine."""
+        self._stop.set()
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout)
+
+    def latest(self) -> tuple[int, np.ndarray | None]:
+        with self._lock:
+            return self.version, self.image
+
+    def _publish(self, image: np.ndarray, stop: threading.Event, status: str) -> None:
+        with self._lock:
+            if stop.is_set():
+                return
+            self.image = np.ascontiguousarray(image, dtype=np.float32)
+            self.version += 1
+            self.status = status
+        self._redraw()
+
+    def _run(self, scene_data, settings, stop: threading.Event) -> None:
+        from ..core.render import Renderer
+
+        try:
+            renderer = Renderer(scene_data, settings)
+
+            def progress(update) -> bool:
+                if stop.is_set():
+                    return False
+                self._publish(update.passes()["Combined"], stop,
+                              f"Sample {update.samples_done}/{update.samples_total}")
+                return not stop.is_set()
+
+            result = renderer.render(progress=progress)
+            if not result.cancelled:
+                self._publish(result.passes["Combined"], stop,
+                              f"Done | {result.stats.get('samples', settings.samples)} samples "
+                              f"| {result.stats.get('elapsed', 0.0):.2f} s")
+        except DRTError as error:
+            self._fail(" ".join(str(error).split()), stop)
+        except Exception as error:  # a bug of ours: keep the UI alive, details in the console
+            print(f"DRT: unexpected error in the viewport render\n{traceback.format_exc()}")
+            self._fail(f"DRT internal error: {type(error).__name__}: {error}", stop)
+
+    def _fail(self, message: str, stop: threading.Event) -> None:
+        with self._lock:
+            if stop.is_set():
+                return
+            self.status = message
+        self._redraw()
+
+
+def weak_redraw(engine) -> Callable[[], None]:
+    """``engine.tag_redraw`` through a weak reference: a no-op once the engine is gone.
+
+    Blender may free the engine between the dereference and the call; the Python object
+    then raises ReferenceError instead of touching freed memory.
+    """
+    ref = weakref.ref(engine)
+
+    def redraw():
+        alive = ref()
+        if alive is not None:
+            try:
+                alive.tag_redraw()
+            except ReferenceError:
+                pass
+
+    return redraw
+
+
+class ViewportTexture:
+    """The newest viewport image on the GPU, drawn stretched over the whole region."""
+
+    def __init__(self):
+        self.version = -1
+        self.texture = None
+
+    def update(self, version: int, image: np.ndarray) -> None:
+        import gpu
+
+        if version == self.version:
+            return
+        height, width, _ = image.shape
+        pixels = gpu.types.Buffer("FLOAT", width * height * 4, image.ravel())
+        self.texture = gpu.types.GPUTexture((width, height), format="RGBA16F", data=pixels)
+        self.version = version
+
+    def draw(self, width: int, height: int) -> None:
+        from gpu_extras.presets import draw_texture_2d
+
+        if self.texture is not None:
+            draw_texture_2d(self.texture, (0, 0), width, height)
