@@ -1,0 +1,269 @@
+"""make bench: error against time for DRT's sampling strategies and for Cycles, per sample scene.
+
+For each scene (at a small resolution so the whole run takes minutes on two cores):
+- a DRT reference (SOBOL, many samples, another seed) and a Cycles reference; every
+  error below is the true relMSE against the renderer's own reference, less the
+  reference's own estimated variance;
+- DRT GRID and JITTERED: one render per sample count (their patterns depend on it);
+- DRT SOBOL: one progressive render, its error at every logged step;
+- DRT SOBOL + NOISE adaptive: one render per noise threshold (what a user would run);
+- DRT SOBOL + CONTRAST adaptive: one progressive render, its error at every step;
+- Cycles with diffuse bounces 0 (a distribution ray tracer), without and with its
+  adaptive sampling: one render per sample count, resp. noise threshold.
+DRT times are the renderer's own (scene export and BVH build excluded, the bench's
+error measurements subtracted); Cycles times are wall time less the wall time of a
+1-sample render of the same scene (its sync and BVH build).
+
+Writes bench/results/<scene>.png (log-log plot), bench/results/<scene>.json, and
+bench/results/RESULTS.md (the table; copy it to bench/RESULTS.md to commit it).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+import OpenImageIO as oiio  # noqa: E402
+
+import drt_engine  # noqa: E402
+from drt_engine.blender.export import export_scene  # noqa: E402
+from drt_engine.core.adaptive import true_error  # noqa: E402
+from drt_engine.core.render import Renderer  # noqa: E402
+from drt_engine.core.report import plot_loglog  # noqa: E402
+from drt_engine.core.settings import RenderSettings  # noqa: E402
+
+SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
+LEVELS = (1e-2, 3e-3, 1e-3)
+SWEEP = (4, 16, 64, 256, 1024)
+THRESHOLDS = (0.04, 0.02, 0.01, 0.005, 0.0025, 0.00125)
+CURVES = ("GRID", "JITTERED", "SOBOL", "SOBOL+NOISE", "SOBOL+CONTRAST", "Cycles", "Cycles adaptive")
+
+
+def drt_settings(scene, **kw) -> RenderSettings:
+    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
+                filter_size=scene.render.filter_size, threads=0, passes=("Combined", "Noise"))
+    base.update(kw)
+    return RenderSettings(**base)
+
+
+def drt_run(data, settings, reference=None):
+    """One DRT render; with a reference, the true relMSE at every logged step (measuring time excluded)."""
+    points = []
+    spent = 0.0
+
+    def progress(update):
+        nonlocal spent
+        if update.entry is not None and reference is not None:
+            t = time.perf_counter()
+            img = update.passes()["Combined"][..., :3]
+            _, rel = true_error(img, *reference)
+            points.append((update.entry["elapsed"] - spent, rel, update.entry["relmse"]))
+            spent += time.perf_counter() - t
+        return True
+
+    result = Renderer(data, settings).render(progress=progress)
+    return result, points, result.stats["elapsed"] - spent
+
+
+def configure_cycles(scene, samples, seed, threshold=None):
+    """Cycles as a distribution ray tracer: no indirect diffuse, DRT's depth and filter, no denoising."""
+    c = scene.cycles
+    depth = scene.drt.max_depth
+    c.device = "CPU"
+    c.samples = samples
+    c.seed = seed
+    c.use_animated_seed = False
+    c.use_adaptive_sampling = threshold is not None
+    if threshold is not None:
+        c.adaptive_threshold = threshold
+        c.adaptive_min_samples = 0
+    c.use_denoising = False
+    c.diffuse_bounces = 0
+    c.glossy_bounces = c.transmission_bounces = c.transparent_max_bounces = c.max_bounces = depth
+    c.volume_bounces = 0
+    c.caustics_reflective = c.caustics_refractive = True
+    c.blur_glossy = 0.0
+    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
+    c.pixel_filter_type = scene.drt.filter_type
+    c.filter_width = scene.render.filter_size
+    c.time_limit = 0.0
+
+
+def cycles_run(scene, out_dir, samples, seed=0, threshold=None):
+    configure_cycles(scene, samples, seed, threshold)
+    scene.render.engine = "CYCLES"
+    path = Path(out_dir) / "cycles.exr"
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    settings = scene.render.image_settings
+    settings.media_type = "IMAGE"
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "32"
+    start = time.perf_counter()
+    bpy.ops.render.render(write_still=True, scene=scene.name)
+    seconds = time.perf_counter() - start
+    image = oiio.ImageInput.open(str(path))
+    spec = image.spec()
+    pixels = image.read_image(format="float").reshape(spec.height, spec.width, spec.nchannels)[..., :3]
+    image.close()
+    return pixels.astype(np.float64), seconds
+
+
+def time_to(points, level):
+    """First time the error reaches ``level``, interpolated log-log from the point before; None if never."""
+    points = sorted((t, e) for t, e, *_ in points if t > 0 and e > 0)
+    for k, (t, e) in enumerate(points):
+        if e <= level:
+            if k == 0:
+                return t
+            t0, e0 = points[k - 1]
+            if e0 <= e:
+                return t
+            f = (math.log(e0) - math.log(level)) / (math.log(e0) - math.log(e))
+            return math.exp(math.log(t0) + f * (math.log(t) - math.log(t0)))
+    return None
+
+
+def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
+    bpy.ops.wm.open_mainfile(filepath=str(ROOT / "sample_scenes" / f"{name}.blend"), load_ui=False)
+    scene = bpy.context.scene
+    r = scene.render
+    aspect = r.resolution_y / r.resolution_x
+    r.resolution_x, r.resolution_y, r.resolution_percentage = width, max(4, round(width * aspect)), 100
+    r.use_border = False
+    data = export_scene(bpy.context.evaluated_depsgraph_get())
+    curves = {}
+    log = print
+
+    t = time.perf_counter()
+    ref = Renderer(data, drt_settings(scene, samples=ref_samples, seed=1 << 20)).render()
+    reference = (ref.passes["Combined"][..., :3].astype(np.float64), ref.passes["Noise"].astype(np.float64) ** 2)
+    log(f"  DRT reference {ref_samples} spp: {time.perf_counter() - t:.1f} s, est. relMSE {ref.stats['relmse']:.2e}")
+
+    for pattern in ("GRID", "JITTERED"):
+        pts = []
+        for n in SWEEP:
+            res, _, _ = drt_run(data, drt_settings(scene, samples=n, sampling_pattern=pattern))
+            _, rel = true_error(res.passes["Combined"][..., :3], *reference)
+            pts.append((res.stats["elapsed"], rel, res.stats.get("relmse")))
+        curves[pattern] = pts
+        log(f"  {pattern}: {[(round(p[0], 2), f'{p[1]:.1e}') for p in pts]}")
+
+    _, pts, _ = drt_run(data, drt_settings(scene, samples=cap), reference)
+    curves["SOBOL"] = pts
+    log(f"  SOBOL: {len(pts)} steps, last {pts[-1][0]:.1f} s {pts[-1][1]:.1e}")
+
+    pts = []
+    for th in THRESHOLDS:
+        res, steps, elapsed = drt_run(data, drt_settings(scene, samples=cap, use_adaptive_sampling=True,
+                                                         adaptive_threshold=th), reference)
+        pts.append((elapsed, steps[-1][1], steps[-1][2], th, res.stats["samples_mean"]))
+    curves["SOBOL+NOISE"] = pts
+    log(f"  SOBOL+NOISE: {[(p[3], round(p[0], 2), f'{p[1]:.1e}', round(p[4], 1)) for p in pts]}")
+
+    _, pts, _ = drt_run(data, drt_settings(scene, samples=cap, use_adaptive_sampling=True,
+                                           adaptive_mode="CONTRAST"), reference)
+    curves["SOBOL+CONTRAST"] = pts
+    log(f"  SOBOL+CONTRAST: last {pts[-1][0]:.1f} s {pts[-1][1]:.1e}")
+
+    t = time.perf_counter()
+    cref, _ = cycles_run(scene, tmp, ref_samples, seed=12345)
+    log(f"  Cycles reference {ref_samples} spp: {time.perf_counter() - t:.1f} s")
+    cycles_ref = (cref, None)
+    _, overhead = cycles_run(scene, tmp, 1)
+    pts = []
+    for n in SWEEP:
+        img, sec = cycles_run(scene, tmp, n)
+        pts.append((max(sec - overhead, 1e-3), true_error(img, *cycles_ref)[1]))
+    curves["Cycles"] = pts
+    pts = []
+    for th in THRESHOLDS:
+        img, sec = cycles_run(scene, tmp, cap, threshold=th)
+        pts.append((max(sec - overhead, 1e-3), true_error(img, *cycles_ref)[1], None, th))
+    curves["Cycles adaptive"] = pts
+    log(f"  Cycles: {[(round(p[0], 2), f'{p[1]:.1e}') for p in curves['Cycles']]}; overhead {overhead:.2f} s")
+    log(f"  Cycles adaptive: {[(p[3], round(p[0], 2), f'{p[1]:.1e}') for p in pts]}")
+
+    plot_loglog(out_dir / f"{name}.png", [(k, [(p[0], p[1]) for p in sorted(curves[k])]) for k in CURVES],
+                f"{name} {r.resolution_x}x{r.resolution_y}: true relMSE vs time")
+    (out_dir / f"{name}.json").write_text(json.dumps({"resolution": [r.resolution_x, r.resolution_y],
+                                                      "reference_samples": ref_samples, "cap": cap,
+                                                      "curves": curves}, indent=1))
+    return {k: [time_to(curves[k], lv) for lv in LEVELS] for k in CURVES}
+
+
+def fmt(t):
+    return "—" if t is None else f"{t:.2f}"
+
+
+def table(results, width, ref_samples, cap) -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    lines = [
+        "# DRT benchmark: time to reach a relMSE",
+        "",
+        f"Machine: {cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}; "
+        f"Python {platform.python_version()}, bpy {bpy.app.version_string}. Made by `make bench` "
+        f"on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.",
+        "",
+        f"Scenes at width {width} px; DRT references {ref_samples} spp (SOBOL, another seed), Cycles "
+        f"against its own {ref_samples}-spp reference; sample cap {cap}. Seconds to reach each relMSE "
+        "(log-log interpolated between logged points; — = not reached); the ratio is Cycles' time "
+        "(without adaptive sampling) over this curve's time at relMSE 1e-3 (above 1: faster than Cycles). "
+        "DRT times exclude export and BVH build, Cycles times exclude its 1-sample render time.",
+        "",
+    ]
+    for name, res in results.items():
+        lines += [f"## {name}", "", "| curve | 1e-2 | 3e-3 | 1e-3 | Cycles / this at 1e-3 |", "|---|---|---|---|---|"]
+        base = res["Cycles"][2]
+        for k in CURVES:
+            t = res[k][2]
+            ratio = f"{base / t:.2f}" if base is not None and t is not None else "—"
+            lines.append(f"| {k} | {fmt(res[k][0])} | {fmt(res[k][1])} | {fmt(res[k][2])} | {ratio} |")
+        s, a = res["SOBOL"][2], res["SOBOL+NOISE"][2]
+        if s is not None and a is not None:
+            lines += ["", f"SOBOL+NOISE reaches 1e-3 {s / a:.2f}x sooner than SOBOL."]
+        lines += ["", f"![{name}]({name}.png)", ""]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--width", type=int, default=80)
+    parser.add_argument("--reference-samples", type=int, default=2048)
+    parser.add_argument("--cap", type=int, default=1024)
+    parser.add_argument("--scenes", nargs="*", default=SCENES)
+    parser.add_argument("--out", default=str(ROOT / "bench" / "results"))
+    args = parser.parse_args(argv)
+    out_dir = Path(args.out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    drt_engine.register()
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in args.scenes:
+            print(f"{name}:", flush=True)
+            results[name] = bench_scene(name, args.width, args.reference_samples, args.cap, out_dir, tmp)
+    text = table(results, args.width, args.reference_samples, args.cap)
+    (out_dir / "RESULTS.md").write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
