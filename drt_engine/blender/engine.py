@@ -128,7 +128,10 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         stats = outcome.stats
         state = "Cancelled" if outcome.cancelled else "Done"
         self.update_stats("", f"{state} | {stats.get('samples', settings.samples)} samples "
-                          f"| {stats.get('elapsed', 0.0):.2f} s")
+                          f"| {stats.get('elapsed', 0.0):.2f} s | {stats.get('plan_summary', '')}")
+        if not self.is_preview:  # the console (and the CLI's output) shows what the scene left out
+            rays = ", ".join(f"{k} {v}" for k, v in stats.get("rays", {}).items())
+            print(f"DRT: {stats.get('plan_summary', '')}\nDRT: rays traced: {rays}", flush=True)
 
     def _warn(self, warnings):
         if not self.is_preview:  # material thumbnails would repeat the same warnings endlessly

@@ -24,6 +24,7 @@ from .bsdf import MaterialShader
 from .errors import SceneError
 from .film import Film, PixelFilter
 from .lights import Lights
+from .plan import make_plan
 from .report import ErrorLog
 from .sampling import Sampler
 from .scene import SceneData
@@ -109,7 +110,8 @@ class Renderer:
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
         self.dims = _Dims(self.lights.strategies)
-        self.timed = self.geometry.moving or camera_rays.moves(self.camera) or self.lights.moving
+        self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
+        self.timed = self.plan.time
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast)
@@ -218,7 +220,8 @@ class Renderer:
                  "triangles": self.geometry.triangle_count, "light_strategies": self.lights.strategies,
                  "stopped_by": stopped or "samples", "rmse": last.get("rmse"), "relmse": last.get("relmse"),
                  "adaptive_threshold": threshold if s.use_adaptive_sampling else None,
-                 "adaptive_first_test": first if s.use_adaptive_sampling else None}
+                 "adaptive_first_test": first if s.use_adaptive_sampling else None,
+                 "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
         return RenderResult(self.film.images(), stats, stopped == "cancelled", self.warnings, log.entries)
 
     # -- one wave of camera samples ---------------------------------------------------
@@ -232,7 +235,7 @@ class Renderer:
         off = self.filter.offset(self.sampler.get2d(seed_pixel, sample, _Dims.PIXEL))
         px = (pixel % w + x0) + 0.5 + off[:, 0]
         py = (pixel // w + y0) + 0.5 + off[:, 1]
-        lens = self.sampler.get2d(seed_pixel, sample, _Dims.LENS) if self.camera.aperture_radius > 0 else None
+        lens = self.sampler.get2d(seed_pixel, sample, _Dims.LENS) if self.plan.lens else None
         # the shutter is a dimension only when something moves
         time = self.sampler.get(seed_pixel, sample, _Dims.TIME) if self.timed else np.zeros(n)
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
