@@ -45,13 +45,19 @@ def hash_combine(*values) -> np.ndarray:
     return h
 
 
-_BYTE_REVERSED = np.array([int(f"{b:08b}"[::-1], 2) for b in range(256)], dtype=_U32)
+_M1, _M2, _M4 = _U32(0x55555555), _U32(0x33333333), _U32(0x0F0F0F0F)
 
 
 def _reverse_bits(x: np.ndarray) -> np.ndarray:
-    r = _BYTE_REVERSED
-    return ((r[x & _U32(0xFF)] << _U32(24)) | (r[(x >> _U32(8)) & _U32(0xFF)] << _U32(16))
-            | (r[(x >> _U32(16)) & _U32(0xFF)] << _U32(8)) | r[x >> _U32(24)])
+    """Bit reversal by swapping bits, pairs and nibbles, then bytes (arithmetic runs ~3x
+    faster than byte-table lookups, which are gathers)."""
+    y = (x >> _U32(1)) & _M1
+    y |= (x & _M1) << _U32(1)
+    z = (y >> _U32(2)) & _M2
+    z |= (y & _M2) << _U32(2)
+    y = (z >> _U32(4)) & _M4
+    y |= (z & _M4) << _U32(4)
+    return y.byteswap(inplace=True)
 
 
 def _laine_karras(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
@@ -107,9 +113,14 @@ _SOBOL = _byte_tables(_sobol_matrices())
 def sobol_u32(index: np.ndarray, dim: int) -> np.ndarray:
     """Unscrambled Sobol point ``index`` in dimension ``dim`` (0-3) as 32-bit fixed point."""
     index = np.asarray(index, dtype=_U32)
+    if dim == 0:
+        return _reverse_bits(index)  # the van der Corput sequence
     t = _SOBOL[dim]
-    return (t[0][index & _U32(0xFF)] ^ t[1][(index >> _U32(8)) & _U32(0xFF)]
-            ^ t[2][(index >> _U32(16)) & _U32(0xFF)] ^ t[3][index >> _U32(24)])
+    out = np.take(t[0], index & _U32(0xFF))
+    out ^= np.take(t[1], (index >> _U32(8)) & _U32(0xFF))
+    out ^= np.take(t[2], (index >> _U32(16)) & _U32(0xFF))
+    out ^= np.take(t[3], index >> _U32(24))
+    return out
 
 
 def _to_unit(x: np.ndarray) -> np.ndarray:
