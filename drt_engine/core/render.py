@@ -106,6 +106,8 @@ class Renderer:
                                                or mesh.material_indices.min() < 0):
                 raise SceneError(f"mesh {mesh.name!r} refers to a material that does not exist")
         self.shaders = [MaterialShader(m) for m in scene.materials]
+        self._lit = np.array([bool(sh.lobes) for sh in self.shaders] + [False])  # casts shadow rays
+        self._continues = np.array([sh.can_continue for sh in self.shaders] + [False])
         self.lights = Lights(scene, self.geometry, self.shaders)
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
@@ -356,6 +358,7 @@ class Renderer:
                     aux["Position"][p_ids] = pos
 
             scale = self.geometry.offset_scale(prim, pos)
+            u = self._draw(depth, seed_pixel[p_ids], sample[p_ids], mat, depth < s.max_depth)
             next_state = []
             shadow = []
             for m in np.unique(mat):
@@ -368,10 +371,10 @@ class Renderer:
                         aux["DiffCol"][p_ids[fg]] = diff
                     if "GlossCol" in aux:
                         aux["GlossCol"][p_ids[fg]] = gloss
-                shadow.append(self._direct(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o, ns_o,
+                shadow.append(self._direct(shader, g, u, p_ids, pos, ng_o, ns_o,
                                            tangent, bitangent, wo_l, inside, scale, throughput[surf], time))
                 if shader.can_continue and depth < s.max_depth:
-                    next_state.append(self._continue(shader, g, depth, p_ids, sample, seed_pixel, pos, ng_o,
+                    next_state.append(self._continue(shader, g, u, p_ids, pos, ng_o,
                                                      ns_o, tangent, bitangent, wo_l, inside, scale,
                                                      throughput[surf], straight[p_ids]))
             self._resolve_shadows(shadow, radiance, time)
@@ -396,21 +399,50 @@ class Renderer:
         values.update(aux)
         self.film.add(pixel, values, sample)
 
+    # -- sample values of one depth step ------------------------------------------------
+    def _draw(self, depth, sp, sm, mat, bounce):
+        """Every sample value the hits of one depth step use, drawn in one call per dimension
+        for all materials at once (values are per (pixel, sample, dimension), so drawing them
+        together gives the very numbers drawing per material would).
+
+        Keys: "pick" (N, 2) lobe choice and emissive-triangle pick; "light" [k] (N, 2) and
+        "choice" [k] (N,) per light strategy; "lobe" (N, 2), valid where the material continues.
+        """
+        n = len(sp)
+        u = {"pick": self.sampler.get2d(sp, sm, self.dims.pick(depth))}
+        lit = np.flatnonzero(self._lit[mat]) if self.lights.strategies else np.zeros(0, np.int64)
+        whole = len(lit) == n
+
+        def subset(get, dim, shape):
+            if whole:
+                return get(sp, sm, dim)
+            out = np.zeros(shape)
+            out[lit] = get(sp[lit], sm[lit], dim)
+            return out
+
+        u["light"] = [subset(self.sampler.get2d, self.dims.light(depth, k), (n, 2))
+                      for k in range(self.lights.strategies)] if len(lit) else []
+        u["choice"] = [subset(self.sampler.get, self.dims.choice(depth, k), n)
+                       for k in range(self.lights.strategies)] if len(lit) and self.lights.selecting else None
+        go = np.flatnonzero(self._continues[mat]) if bounce else np.zeros(0, np.int64)
+        u["lobe"] = np.zeros((n, 2))
+        if len(go):
+            u["lobe"][go] = self.sampler.get2d(sp[go], sm[go], self.dims.lobe(depth))
+        return u
+
     # -- next-event estimation ----------------------------------------------------------
-    def _direct(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale, thr,
-                time):
+    def _direct(self, shader, g, u, p_ids, pos, ng, ns, t, b, wo_l, inside, scale, thr, time):
         """Shadow rays (not yet traced) for the hits g of one material, one per light strategy."""
         lights = self.lights
         out = []
         if lights.strategies == 0 or not shader.lobes:
             return out
         pid = p_ids[g]
-        sp, sm = seed_pixel[pid], sample[pid]
-        u_pick = self.sampler.get(sp, sm, self.dims.pick(depth) + 1)
+        u_pick = u["pick"][g, 1]
         for k in range(lights.strategies):
-            u = self.sampler.get2d(sp, sm, self.dims.light(depth, k))
-            u_light = self.sampler.get(sp, sm, self.dims.choice(depth, k)) if lights.selecting else None
-            ls = lights.sample(k, pos[g], ng[g], u, u_pick, u_light, time[pid] if self.timed else None)
+            u_k = u["light"][k][g]
+            u_light = u["choice"][k][g] if lights.selecting else None
+            ls = lights.sample(k, pos[g], ng[g], u_k, u_pick, u_light, time[pid] if self.timed else None)
             ok = ls.value.max(axis=1) > 0
             if not ok.any():
                 continue
@@ -449,12 +481,10 @@ class Renderer:
             radiance[:, c] += np.bincount(pid[visible], weights=contrib[visible, c], minlength=len(radiance))
 
     # -- continuation through a non-diffuse lobe ------------------------------------
-    def _continue(self, shader, g, depth, p_ids, sample, seed_pixel, pos, ng, ns, t, b, wo_l, inside, scale,
-                  thr, straight):
+    def _continue(self, shader, g, u, p_ids, pos, ng, ns, t, b, wo_l, inside, scale, thr, straight):
         pid = p_ids[g]
-        sp, sm = seed_pixel[pid], sample[pid]
-        u2 = self.sampler.get2d(sp, sm, self.dims.lobe(depth))
-        u_sel = self.sampler.get(sp, sm, self.dims.pick(depth))
+        u2 = u["lobe"][g]
+        u_sel = u["pick"][g, 0]
         wi_l, weight, pdf, delta, valid, passthrough = shader.sample(wo_l[g], u_sel, u2, inside[g])
         new_thr = thr[g] * weight
         valid &= new_thr.max(axis=1) > 0
