@@ -18,7 +18,6 @@ index the same arrays whatever part a hit came from.
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,7 +27,7 @@ from .motion import Motion, inverse3
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
-_CHUNK = 1 << 15  # rays per Embree call per thread
+_CHUNK = 1 << 16  # rays per Embree call: bounds its output buffers
 _FAR = np.float32(3.0e38)
 DEFORM_BUCKETS = 8
 
@@ -86,9 +85,8 @@ class Geometry:
     copies ``world_vertices``, ``world_ng``, ``area`` for light sampling.
     """
 
-    def __init__(self, scene: SceneData, center: np.ndarray, pool: ThreadPoolExecutor | None = None):
+    def __init__(self, scene: SceneData, center: np.ndarray):
         self.center = np.asarray(center, dtype=np.float64)
-        self.pool = pool
         self.warnings: list[str] = []
         self.parts: list[_Part] = []
         verts, world_verts, tris, mats, normals, flips = [], [], [], [], [], []
@@ -237,13 +235,9 @@ class Geometry:
         o = np.ascontiguousarray(origins, dtype=np.float32)
         d = np.ascontiguousarray(directions, dtype=np.float32)
         far = np.minimum(tmax, _FAR).astype(np.float32)
-        n = len(o)
         output = 1 if query == "INTERSECT" else 0
-        if self.pool is None or n <= _CHUNK:
-            return [scene.run(o, d, dists=far, query=query, output=output)]
-        jobs = [self.pool.submit(scene.run, o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query, output)
-                for a in range(0, n, _CHUNK)]
-        return [j.result() for j in jobs]
+        return [scene.run(o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query=query, output=output)
+                for a in range(0, max(len(o), 1), _CHUNK)]
 
     def _rays_in(self, part: _Part, origins, directions, time, index):
         """(scene, origins, directions) of rays ``index`` in the part's Embree frame."""

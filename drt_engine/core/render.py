@@ -10,6 +10,7 @@ Every random number is drawn from ``Sampler`` with the camera sample's own id.
 from __future__ import annotations
 
 import os
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -31,6 +32,7 @@ from .scene import SceneData
 from .settings import RenderSettings
 
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
+_MIN_PIECE = 1 << 12  # camera samples per thread below which splitting a wave costs more than it saves
 _TINY = 1e-30
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 
@@ -100,7 +102,7 @@ class Renderer:
         self.threads = threads
         self.pool = ThreadPoolExecutor(threads) if threads > 1 else None
         self.camera = scene.camera
-        self.geometry = Geometry(scene, self.camera.matrix[:3, 3], self.pool)
+        self.geometry = Geometry(scene, self.camera.matrix[:3, 3])
         for i, mesh in enumerate(scene.meshes):
             if len(mesh.material_indices) and (mesh.material_indices.max() >= len(scene.materials)
                                                or mesh.material_indices.min() < 0):
@@ -119,6 +121,7 @@ class Renderer:
         self.film = Film(w, h, settings.passes, track_range=contrast)
         self.warnings = list(scene.warnings) + self.geometry.warnings
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
+        self._rays_lock = threading.Lock()
 
     # -- driver ---------------------------------------------------------------------
     def render(self, progress=None) -> RenderResult:
@@ -228,6 +231,31 @@ class Renderer:
 
     # -- one wave of camera samples ---------------------------------------------------
     def _trace(self, pixel, sample, x0, y0, w):
+        """Trace a wave, split into one contiguous piece per thread, and add it to the film.
+
+        Every path depends only on its own (pixel, sample) and Embree answers each ray alone,
+        so the pieces give the values one piece would, and the film receives them in the
+        same order in one call: the image is bit-identical for any thread count. Each piece
+        runs the whole loop (NumPy releases the GIL in its array loops, Embree in its calls).
+        """
+        n = len(pixel)
+        pieces = min(self.threads, max(1, n // _MIN_PIECE))
+        if pieces == 1:
+            values = self._shade(pixel, sample, x0, y0, w)
+        else:
+            bounds = np.linspace(0, n, pieces + 1).astype(np.int64)
+            jobs = [self.pool.submit(self._shade, pixel[a:b], sample[a:b], x0, y0, w)
+                    for a, b in zip(bounds[:-1], bounds[1:])]
+            parts = [job.result() for job in jobs]
+            values = {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
+        self.film.add(pixel, values, sample)
+
+    def _count(self, kind, n):
+        with self._rays_lock:
+            self.rays[kind] += int(n)
+
+    def _shade(self, pixel, sample, x0, y0, w):
+        """Per-sample values of every pass for camera samples (pixel, sample)."""
         s = self.settings
         passes = set(s.passes)
         n = len(pixel)
@@ -241,7 +269,7 @@ class Renderer:
         # the shutter is a dimension only when something moves
         time = self.sampler.get(seed_pixel, sample, _Dims.TIME) if self.timed else np.zeros(n)
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
-        self.rays["camera"] += n
+        self._count("camera", n)
 
         radiance = np.zeros((n, 3))
         alpha = np.ones(n)
@@ -397,7 +425,7 @@ class Renderer:
         radiance = np.where(np.isfinite(radiance), radiance, 0.0)
         values = {"Combined": np.concatenate([radiance, np.clip(alpha, 0.0, 1.0)[:, None]], axis=1)}
         values.update(aux)
-        self.film.add(pixel, values, sample)
+        return values
 
     # -- sample values of one depth step ------------------------------------------------
     def _draw(self, depth, sp, sm, mat, bounce):
@@ -472,7 +500,7 @@ class Renderer:
         dirs = np.concatenate([p[2] for p in parts])
         tmax = np.concatenate([p[3] for p in parts])
         contrib = np.concatenate([p[4] for p in parts])
-        self.rays["shadow"] += len(pid)
+        self._count("shadow", len(pid))
         blocked = self.geometry.occluded(origins, dirs, tmax, time[pid])
         # area lights are not geometry: a nearer area light also blocks (lights cast shadows
         # of each other's bodies in Cycles only when they are meshes, so it does not here)
@@ -497,9 +525,9 @@ class Renderer:
         sel, gi, wi, transmit = sel[geo_ok], gi[geo_ok], wi[geo_ok], transmit[geo_ok]
         passthrough = passthrough[sel]
         origin = spawn(pos[gi], ng[gi], wi, scale[gi])
-        self.rays["refraction"] += int((transmit & ~passthrough).sum())
-        self.rays["reflection"] += int((~transmit).sum())
-        self.rays["transparent"] += int(passthrough.sum())
+        self._count("refraction", (transmit & ~passthrough).sum())
+        self._count("reflection", (~transmit).sum())
+        self._count("transparent", passthrough.sum())
         prev_pdf = np.where(delta[sel], np.inf, pdf[sel])
         return pid[sel], origin, wi, new_thr[sel], prev_pdf, ng[gi], straight[g][sel] & passthrough
 
