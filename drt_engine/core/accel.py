@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import microfacet as mf
 from .errors import SceneError
 from .motion import Motion, inverse3
 from .scene import SceneData
@@ -334,7 +335,7 @@ class Geometry:
 
     def offset_scale(self, prim: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Distance that safely clears the surface of triangle ``prim`` at ``pos``."""
-        local = np.abs(pos - self.center).max(axis=1)
+        local = mf.max3(np.abs(pos - self.center))
         return _EPS_REL * np.maximum(self.tri_scale[prim], local) + 1e-30
 
 
@@ -345,7 +346,7 @@ def spawn(pos: np.ndarray, ng: np.ndarray, direction: np.ndarray, scale: np.ndar
 
 
 def _unit(v):
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-300)
+    return v / np.maximum(mf.norm(v)[..., None], 1e-300)
 
 
 def _normal_matrix(linear: np.ndarray) -> np.ndarray:

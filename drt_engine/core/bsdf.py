@@ -198,7 +198,7 @@ class MaterialShader:
     # -- lobe selection ---------------------------------------------------------------
     def selection(self, mu_o: np.ndarray) -> np.ndarray:
         """(N, L) probabilities of continuing through each non-diffuse lobe."""
-        p = np.stack([lobe.albedo_at(mu_o).max(axis=1) for lobe in self.sampled], axis=1)
+        p = np.stack([mf.max3(lobe.albedo_at(mu_o)) for lobe in self.sampled], axis=1)
         total = p.sum(axis=1, keepdims=True)
         return np.where(total > 0, p / np.maximum(total, _TINY), 1.0 / len(self.sampled))
 

@@ -98,7 +98,7 @@ class _SphericalRectangle:
 
 
 def _unit(v):
-    return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), _TINY)
+    return v / np.maximum(mf.norm(v)[:, None], _TINY)
 
 
 def _spread(spread: float, cos_l: np.ndarray) -> np.ndarray:
@@ -271,7 +271,7 @@ class Lights:
     def _sample_point(self, light: Light, pos, u, spot=False):
         c = light.position
         to = c - pos
-        d = np.linalg.norm(to, axis=1)
+        d = mf.norm(to)
         wi = to / np.maximum(d, _TINY)[:, None]
         n = len(pos)
         if light.radius <= 0:
@@ -305,7 +305,7 @@ class Lights:
         disk = mf.concentric_disk(u) * r
         q = light.position + disk[:, :1] * t + disk[:, 1:] * b
         to = q - pos
-        dist = np.linalg.norm(to, axis=1)
+        dist = mf.norm(to)
         wi = to / np.maximum(dist, _TINY)[:, None]
         cos_l = np.clip(-mf.dot(wi, -wi_c), 0.0, 1.0)
         radiance = light.intensity / (np.pi * r * r)
@@ -373,7 +373,7 @@ class Lights:
             if solid.any():
                 q[solid] = rect.sample(u[solid], solid)
         to = q - pos
-        dist = np.linalg.norm(to, axis=1)
+        dist = mf.norm(to)
         wi = to / np.maximum(dist, _TINY)[:, None]
         cos_l = wi @ ez  # the light emits along -Z: seen from the front when wi . ez > 0
         front = cos_l > 0
@@ -392,7 +392,7 @@ class Lights:
         b0, b1 = 1.0 - su, u[:, 1] * su
         q = b0[:, None] * p[:, 0] + b1[:, None] * p[:, 1] + (1.0 - b0 - b1)[:, None] * p[:, 2]
         to = q - pos
-        dist = np.linalg.norm(to, axis=1)
+        dist = mf.norm(to)
         wi = to / np.maximum(dist, _TINY)[:, None]
         cos_l = np.abs(mf.dot(wi, g.world_ng[pick]))
         pdf_area = self.emissive_prob[pick] / g.area[pick]
@@ -448,7 +448,7 @@ class Lights:
         c, r = light.position, light.radius
         oc = c - origins
         if light.soft_falloff:
-            axis = oc / np.maximum(np.linalg.norm(oc, axis=1), _TINY)[:, None]
+            axis = oc / np.maximum(mf.norm(oc), _TINY)[:, None]
             denom = mf.dot(dirs, axis)
             t = mf.dot(oc, axis) / np.where(denom > 0, denom, 1.0)
             q = origins + t[:, None] * dirs - c

@@ -352,7 +352,7 @@ class Renderer:
 
             # emission seen (two-sided), weighted against light sampling of emissive triangles
             emission = self.lights.tri_emission[prim] if len(self.lights.tri_emission) else np.zeros((len(surf), 3))
-            glowing = np.flatnonzero(emission.max(axis=1) > 0)
+            glowing = np.flatnonzero(mf.max3(emission) > 0)
             if len(glowing):
                 weight = np.ones(len(glowing))
                 k = surf[glowing]
@@ -420,7 +420,7 @@ class Renderer:
             tmax = np.full(len(path), np.inf)
 
         if s.clamp > 0:
-            peak = radiance.max(axis=1)
+            peak = mf.max3(radiance)
             radiance *= np.where(peak > s.clamp, s.clamp / np.maximum(peak, _TINY), 1.0)[:, None]
         radiance = np.where(np.isfinite(radiance), radiance, 0.0)
         values = {"Combined": np.concatenate([radiance, np.clip(alpha, 0.0, 1.0)[:, None]], axis=1)}
@@ -471,7 +471,7 @@ class Renderer:
             u_k = u["light"][k][g]
             u_light = u["choice"][k][g] if lights.selecting else None
             ls = lights.sample(k, pos[g], ng[g], u_k, u_pick, u_light, time[pid] if self.timed else None)
-            ok = ls.value.max(axis=1) > 0
+            ok = mf.max3(ls.value) > 0
             if not ok.any():
                 continue
             wi_l = _to_local(ls.wi, t[g], b[g], ns[g])
@@ -479,7 +479,7 @@ class Renderer:
             f_diff, f_nd, pdf_b = shader.evaluate(wo_l[g], wi_l, above, inside[g])
             w_l = _power(ls.pdf, pdf_b)
             contrib = thr[g] * ls.value * (f_diff + f_nd * w_l[:, None])
-            ok &= contrib.max(axis=1) > 0
+            ok &= mf.max3(contrib) > 0
             sel = np.flatnonzero(ok)
             if len(sel) == 0:
                 continue
@@ -515,7 +515,7 @@ class Renderer:
         u_sel = u["pick"][g, 0]
         wi_l, weight, pdf, delta, valid, passthrough = shader.sample(wo_l[g], u_sel, u2, inside[g])
         new_thr = thr[g] * weight
-        valid &= new_thr.max(axis=1) > 0
+        valid &= mf.max3(new_thr) > 0
         sel = np.flatnonzero(valid)
         gi = g[sel]
         wi = _to_world(wi_l[sel], t[gi], b[gi], ns[gi])
