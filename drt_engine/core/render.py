@@ -467,27 +467,30 @@ class Renderer:
             return out
         pid = p_ids[g]
         u_pick = u["pick"][g, 1]
+        # the material's hits, gathered once for all strategies
+        pos_g, ng_g, t_g, b_g, ns_g, wo_g, in_g, thr_g, scale_g = (
+            a[g] for a in (pos, ng, t, b, ns, wo_l, inside, thr, scale))
+        time_g = time[pid] if self.timed else None
         for k in range(lights.strategies):
             u_k = u["light"][k][g]
             u_light = u["choice"][k][g] if lights.selecting else None
-            ls = lights.sample(k, pos[g], ng[g], u_k, u_pick, u_light, time[pid] if self.timed else None)
+            ls = lights.sample(k, pos_g, ng_g, u_k, u_pick, u_light, time_g)
             ok = mf.max3(ls.value) > 0
             if not ok.any():
                 continue
-            wi_l = _to_local(ls.wi, t[g], b[g], ns[g])
-            above = mf.dot(ls.wi, ng[g]) > 0
-            f_diff, f_nd, pdf_b = shader.evaluate(wo_l[g], wi_l, above, inside[g])
+            wi_l = _to_local(ls.wi, t_g, b_g, ns_g)
+            above = mf.dot(ls.wi, ng_g) > 0
+            f_diff, f_nd, pdf_b = shader.evaluate(wo_g, wi_l, above, in_g)
             w_l = _power(ls.pdf, pdf_b)
-            contrib = thr[g] * ls.value * (f_diff + f_nd * w_l[:, None])
+            contrib = thr_g * ls.value * (f_diff + f_nd * w_l[:, None])
             ok &= mf.max3(contrib) > 0
             sel = np.flatnonzero(ok)
             if len(sel) == 0:
                 continue
-            gi = g[sel]
-            origin = spawn(pos[gi], ng[gi], ls.wi[sel], scale[gi])
+            origin = spawn(pos_g[sel], ng_g[sel], ls.wi[sel], scale_g[sel])
             dist = ls.dist[sel]
             stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
-            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale[gi])
+            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale_g[sel])
             out.append((pid[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel]))
         return out
 
