@@ -48,6 +48,22 @@ class Hits:
 
 
 @dataclass
+class RayTimes:
+    """Shutter times of a batch of rays with every rigidly moving part's transform at them.
+
+    A path keeps its camera sample's time down the whole tree, so the transforms (slerp,
+    matrix, inverse) are computed once per camera sample and gathered as paths go on.
+    """
+
+    values: np.ndarray | None
+    frames: dict  # part index -> (linear (N, 3, 3), translation (N, 3), inverse of linear)
+
+    def __getitem__(self, index) -> "RayTimes":
+        values = None if self.values is None else self.values[index]
+        return RayTimes(values, {k: tuple(a[index] for a in f) for k, f in self.frames.items()})
+
+
+@dataclass
 class _Part:
     kind: str  # "static" | "rigid" | "deform"
     base: int  # first global triangle id
@@ -240,11 +256,22 @@ class Geometry:
         return [scene.run(o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query=query, output=output)
                 for a in range(0, max(len(o), 1), _CHUNK)]
 
-    def _rays_in(self, part: _Part, origins, directions, time, index):
-        """(scene, origins, directions) of rays ``index`` in the part's Embree frame."""
+    def ray_times(self, time) -> RayTimes:
+        """Times (or None when nothing moves) with the transforms of the moving parts at them."""
+        if isinstance(time, RayTimes):
+            return time
+        frames = {}
+        for k, part in enumerate(self.parts):
+            if part.kind == "rigid":
+                linear, translation = part.motion.at(time)
+                frames[k] = (linear, translation, inverse3(linear))
+        return RayTimes(None if time is None else np.asarray(time), frames)
+
+    def _rays_in(self, k: int, origins, directions, times: RayTimes, index):
+        """(origins, directions) of rays ``index`` in part k's Embree frame."""
+        part = self.parts[k]
         if part.kind == "rigid":
-            linear, translation = part.motion.at(time[index])
-            inv = inverse3(linear)
+            _, translation, inv = (a[index] for a in times.frames[k])
             o = np.einsum("nij,nj->ni", inv, origins[index] - translation) - part.center
             d = np.einsum("nij,nj->ni", inv, directions[index])
             return o, d
@@ -254,20 +281,21 @@ class Geometry:
         """(scene, ray indices) pairs a part must answer for n rays."""
         if part.kind != "deform":
             return [(part.scenes[0], np.arange(n))]
-        bucket = np.minimum((np.asarray(time) * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
+        bucket = np.minimum((time.values * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
         return [(part.scenes[b], np.flatnonzero(bucket == b)) for b in range(DEFORM_BUCKETS)]
 
     def intersect(self, origins, directions, tmax, time=None) -> Hits:
         n = len(origins)
         best = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
         limit = np.array(tmax, dtype=np.float64, copy=True)
-        for part in self.parts:
+        times = self.ray_times(time)
+        for pk, part in enumerate(self.parts):
             if not part.scenes:
                 continue
-            for scene, idx in self._groups(part, n, time):
+            for scene, idx in self._groups(part, n, times):
                 if len(idx) == 0:
                     continue
-                o, d = self._rays_in(part, origins, directions, time, idx)
+                o, d = self._rays_in(pk, origins, directions, times, idx)
                 parts = self._run(scene, o, d, limit[idx], "INTERSECT")
                 prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
                 t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
@@ -283,14 +311,15 @@ class Geometry:
     def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
         n = len(origins)
         blocked = np.zeros(n, dtype=bool)
-        for part in self.parts:
+        times = self.ray_times(time)
+        for k, part in enumerate(self.parts):
             if not part.scenes:
                 continue
-            for scene, idx in self._groups(part, n, time):
+            for scene, idx in self._groups(part, n, times):
                 idx = idx[~blocked[idx]]
                 if len(idx) == 0:
                     continue
-                o, d = self._rays_in(part, origins, directions, time, idx)
+                o, d = self._rays_in(k, origins, directions, times, idx)
                 blocked[idx] = np.concatenate(self._run(scene, o, d, tmax[idx], "OCCLUDED")) >= 0
         return blocked
 
@@ -303,21 +332,22 @@ class Geometry:
         p = self.vertices[self.triangles[prim]]
         ng = self.ng[prim].copy()
         ns = self._interpolated_normals(prim, bary, ng)
+        times = self.ray_times(time) if self.moving else None
         for k, part in enumerate(self.parts):
             if part.kind == "static":
                 continue
             sel = np.flatnonzero(self.part[prim] == k)
             if len(sel) == 0:
                 continue
-            t_sel = np.asarray(time)[index][sel]
+            at = times[index[sel]]
             if part.kind == "rigid":
-                linear, translation = part.motion.at(t_sel)
-                normal_matrix = np.transpose(inverse3(linear), (0, 2, 1))
+                linear, translation, inv = at.frames[k]
+                normal_matrix = np.transpose(inv, (0, 2, 1))
                 p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
                 ng[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ng[sel]))
                 ns[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ns[sel]))
             else:
-                bucket = np.minimum((t_sel * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
+                bucket = np.minimum((at.values * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
                 for b in np.unique(bucket):
                     world, mirrored = part.buckets[b]
                     s = sel[bucket == b]

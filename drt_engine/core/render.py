@@ -269,6 +269,7 @@ class Renderer:
         # the shutter is a dimension only when something moves
         time = self.sampler.get(seed_pixel, sample, _Dims.TIME) if self.timed else np.zeros(n)
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
+        times = self.geometry.ray_times(time)  # moving parts' transforms, once per camera sample
         self._count("camera", n)
 
         radiance = np.zeros((n, 3))
@@ -291,7 +292,8 @@ class Renderer:
             if len(path) == 0:
                 break
             ray_time = time[path]
-            hits = self.geometry.intersect(origins, dirs, tmax, ray_time)
+            ray_times = times[path]
+            hits = self.geometry.intersect(origins, dirs, tmax, ray_times)
             light_t, light_id, light_le = self.lights.intersect(origins, dirs, np.minimum(hits.t, tmax), ray_time)
             # a light hidden from the camera is not there for camera rays: they go on past it
             hidden = straight[path] & ~self.lights.camera_visible[np.maximum(light_id, 0)]
@@ -345,7 +347,7 @@ class Renderer:
             if len(surf) == 0:
                 break
             p_ids = path[surf]
-            pos, ng, ns = self.geometry.surface(hits, surf, ray_time)
+            pos, ng, ns = self.geometry.surface(hits, surf, ray_times)
             prim = hits.prim[surf]
             mat = self.geometry.material[prim]
             wo = -dirs[surf]
@@ -405,7 +407,7 @@ class Renderer:
                     next_state.append(self._continue(shader, g, u, p_ids, pos, ng_o,
                                                      ns_o, tangent, bitangent, wo_l, inside, scale,
                                                      throughput[surf], straight[p_ids]))
-            self._resolve_shadows(shadow, radiance, time)
+            self._resolve_shadows(shadow, radiance, times)
 
             if not next_state:
                 break
@@ -494,7 +496,7 @@ class Renderer:
             out.append((pid[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel]))
         return out
 
-    def _resolve_shadows(self, shadow, radiance, time):
+    def _resolve_shadows(self, shadow, radiance, times):
         parts = [item for group in shadow for item in group]
         if not parts:
             return
@@ -504,7 +506,7 @@ class Renderer:
         tmax = np.concatenate([p[3] for p in parts])
         contrib = np.concatenate([p[4] for p in parts])
         self._count("shadow", len(pid))
-        blocked = self.geometry.occluded(origins, dirs, tmax, time[pid])
+        blocked = self.geometry.occluded(origins, dirs, tmax, times[pid])
         # area lights are not geometry: a nearer area light also blocks (lights cast shadows
         # of each other's bodies in Cycles only when they are meshes, so it does not here)
         visible = ~blocked
