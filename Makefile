@@ -3,6 +3,8 @@
 #   make test        venv + the whole test suite (TESTS=path and PYTEST_ARGS=... to narrow it)
 #   make extension   download the embreex wheels, validate, build the extension zips into dist/
 #   make scenes      rebuild the sample .blend files from their scripts
+#   make bench       DRT vs Cycles error against time (bench/run.py), then ray throughput and memory
+#   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes .venv and wheels/
 
@@ -27,7 +29,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test extension scenes clean distclean
+.PHONY: help venv render test extension scenes bench bench-throughput clean distclean
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -82,6 +84,14 @@ extension: $(WHEELS) | $(STAMP)
 
 scenes: $(STAMP)
 	@for script in sample_scenes/build_*.py; do echo "$(PY) $$script"; $(PY) "$$script" || exit 1; done
+
+# throughput reads bench/run.py's fresh curves for its time-to-error columns, so it runs second
+bench: $(STAMP)
+	$(PY) bench/run.py
+	$(PY) bench/throughput.py
+
+bench-throughput: $(STAMP)
+	$(PY) bench/throughput.py
 
 clean:
 	rm -rf $(OUT) $(DIST) .pytest_cache

@@ -1,0 +1,234 @@
+"""make bench (throughput part): DRT's ray throughput against raw Embree, and its peak memory.
+
+For each sample scene, in one run:
+(a) raw embreex: the scene's own camera rays (pixel jitter, lens, shutter as the scene
+    has them, each moving part queried in its own frame at mid-shutter) traced by
+    ``EmbreeScene.run`` alone, on 1 thread and on every core (one chunk per thread);
+(b) DRT end to end: every ray the renderer traced (camera, shadow, reflection,
+    refraction, transparent) over its render time (export and BVH build excluded), on
+    1 thread and on every core;
+(c) b / a on every core (target: at least 0.4);
+(d) time to relMSE 1e-3, DRT (best of its curves) against Cycles with adaptive sampling,
+    taken from bench/run.py's per-scene results (bench/results/<scene>.json) when they exist;
+(e) peak memory (ru_maxrss) of a 1920x1080 render in a fresh process, and of the same
+    process before the renderer is made (bpy, the scene, the export).
+Writes bench/THROUGHPUT.md and its section of bench/RESULTS.md.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import resource
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import drt_engine  # noqa: E402
+from drt_engine.blender.export import export_scene  # noqa: E402
+from drt_engine.core import camera as camera_rays  # noqa: E402
+from drt_engine.core.render import WAVE, Renderer  # noqa: E402
+from drt_engine.core.settings import RenderSettings  # noqa: E402
+
+SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
+TARGET_RATIO = 0.4
+MARK_BEGIN, MARK_END = "<!-- throughput: begin -->", "<!-- throughput: end -->"
+
+
+def load(name, width, height=None):
+    """The sample scene at ``width`` pixels (its own aspect unless ``height``), exported with its
+    motion over the shutter."""
+    bpy.ops.wm.open_mainfile(filepath=str(ROOT / "sample_scenes" / f"{name}.blend"), load_ui=False)
+    scene = bpy.context.scene
+    r = scene.render
+    aspect = r.resolution_y / r.resolution_x
+    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height or max(4, round(width * aspect)), 100
+    r.use_border = False
+    frame_set = lambda frame, sub: scene.frame_set(frame, subframe=sub)  # noqa: E731
+    return scene, export_scene(bpy.context.evaluated_depsgraph_get(), frame_set=frame_set)
+
+
+def settings(scene, **kw) -> RenderSettings:
+    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
+                filter_size=scene.render.filter_size, passes=("Combined",))
+    base.update(kw)
+    return RenderSettings(**base)
+
+
+def camera_batch(data, n, seed=0):
+    """n camera rays of the scene: uniform over the image, the lens and the shutter."""
+    rng = np.random.default_rng(seed)
+    w, h = data.camera.window_size
+    px, py = rng.random(n) * w, rng.random(n) * h
+    lens = rng.random((n, 2)) if data.camera.aperture_radius > 0 else None
+    return camera_rays.generate(data.camera, px, py, lens, rng.random(n))
+
+
+def raw_embree(geometry, cam, threads, seconds=1.0):
+    """Rays per second of EmbreeScene.run alone over every part, for closest hits as DRT asks."""
+    batches = []
+    for k, part in enumerate(geometry.parts):
+        if not part.scenes:
+            continue
+        times = geometry.ray_times(np.full(len(cam.origins), 0.5))
+        o, d = geometry._rays_in(k, cam.origins, cam.directions, times, np.arange(len(cam.origins)))
+        far = np.minimum(cam.tmax, 3e38).astype(np.float32)
+        batches.append((part.scenes[len(part.scenes) // 2], np.ascontiguousarray(o, np.float32),
+                        np.ascontiguousarray(d, np.float32), far))
+    n = len(cam.origins)
+    bounds = np.linspace(0, n, threads + 1).astype(int)
+    with ThreadPoolExecutor(threads) as pool:
+        def once():
+            for scene, o, d, far in batches:
+                jobs = [pool.submit(scene.run, o[a:b], d[a:b], far[a:b], "INTERSECT", 1)
+                        for a, b in zip(bounds[:-1], bounds[1:])]
+                for job in jobs:
+                    job.result()
+        once()
+        reps, start = 0, time.perf_counter()
+        while reps < 3 or time.perf_counter() - start < seconds:
+            once()
+            reps += 1
+        elapsed = time.perf_counter() - start
+    return n * reps / elapsed
+
+
+def drt_rate(data, scene, threads, samples):
+    """(rays per second, seconds, rays by kind, plan summary) of one DRT render."""
+    result = Renderer(data, settings(scene, samples=samples, threads=threads, seed=7)).render()
+    stats = result.stats
+    total = sum(stats["rays"].values())
+    return total / stats["elapsed"], stats["elapsed"], stats["rays"], stats["plan_summary"]
+
+
+def time_to_error(name, level=1e-3):
+    """(DRT's best seconds, its curve, Cycles adaptive seconds) from bench/run.py's results."""
+    path = ROOT / "bench" / "results" / f"{name}.json"
+    if not path.exists():
+        return None
+    from bench.run import time_to
+
+    curves = json.loads(path.read_text())["curves"]
+    drt = {k: time_to(v, level) for k, v in curves.items() if not k.startswith("Cycles")}
+    drt = {k: t for k, t in drt.items() if t is not None}
+    best = min(drt, key=drt.get) if drt else None
+    cycles = time_to(curves.get("Cycles adaptive", []), level)
+    return (drt[best] if best else None), best, cycles
+
+
+MEMORY_SCRIPT = """
+import resource, sys
+sys.path.insert(0, {root!r})
+sys.argv = ["x"]
+from bench.throughput import load, settings
+from drt_engine.core.render import Renderer
+import drt_engine
+drt_engine.register()
+scene, data = load({name!r}, 1920, 1080)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+result = Renderer(data, settings(scene, samples={samples}, threads=0,
+                                 passes=("Combined", "Noise"))).render()
+after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print("MEMORY", before, after, result.stats["elapsed"], result.passes["Combined"].shape)
+"""
+
+
+def peak_memory(name, samples):
+    """(peak MB before the renderer, peak MB of the whole render, seconds, image shape) in a fresh process."""
+    code = MEMORY_SCRIPT.format(root=str(ROOT), name=name, samples=samples)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    line = next(x for x in out.splitlines() if x.startswith("MEMORY"))
+    _, before, after, seconds, *shape = line.split(maxsplit=4)
+    return int(before) / 1024, int(after) / 1024, float(seconds), " ".join(shape)
+
+
+def fmt(x, spec=".2f"):
+    return "—" if x is None else format(x, spec)
+
+
+def table(rows, memory, width, samples, cores, memory_scene, memory_samples) -> str:
+    lines = [
+        "# DRT throughput and memory",
+        "",
+        f"Made by `make bench` (bench/throughput.py) on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+        f"{cores} cores, Python {sys.version.split()[0]}, NumPy {np.__version__}. Scenes at width {width} px, "
+        f"DRT {samples} spp. Raw: the scene's own camera rays through `EmbreeScene.run` only. DRT: every ray "
+        "it traced (all kinds) over its render time. Time to relMSE 1e-3 from bench/run.py's curves "
+        "(DRT's best curve; Cycles with adaptive sampling, diffuse bounces 0).",
+        "",
+        "| scene | raw 1 thread (Mrays/s) | raw all (Mrays/s) | DRT 1 thread (Mrays/s) | DRT all (Mrays/s) "
+        f"| DRT / raw, all (target {TARGET_RATIO}) | DRT to 1e-3 (s) | Cycles to 1e-3 (s) | DRT / Cycles time |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        d, c = r["drt_time"], r["cycles_time"]
+        ratio_t = f"{d / c:.1f}" if d and c else "—"
+        curve = f" ({r['drt_curve']})" if r["drt_curve"] else ""
+        lines.append(f"| {r['name']} | {r['raw1'] / 1e6:.2f} | {r['raw'] / 1e6:.2f} | {r['drt1'] / 1e6:.2f} | "
+                     f"{r['drt'] / 1e6:.2f} | {r['drt'] / r['raw']:.3f} | {fmt(d)}{curve} | {fmt(c)} | {ratio_t} |")
+    lines += ["", "Rays traced per kind (all threads) and the render plan:", ""]
+    for r in rows:
+        kinds = ", ".join(f"{k} {v}" for k, v in r["rays"].items())
+        lines.append(f"- {r['name']}: {kinds}. {r['plan']}")
+    before, after, seconds, shape = memory
+    lines += ["", f"Peak memory, {memory_scene} at 1920x1080, {memory_samples} spp, every core: {after:.0f} MB "
+              f"(ru_maxrss; {before:.0f} MB of it before the renderer: Python, bpy, the scene and its export; "
+              f"render {seconds:.1f} s, image {shape}). Target: under 2048 MB.", ""]
+    return "\n".join(lines) + "\n"
+
+
+def write_results_section(text):
+    """Put the table into bench/RESULTS.md between its markers (the rest of the file is bench/run.py's)."""
+    path = ROOT / "bench" / "RESULTS.md"
+    old = path.read_text() if path.exists() else ""
+    body = text.replace("# DRT throughput and memory", "## Throughput and memory (bench/throughput.py, also in "
+                        "[THROUGHPUT.md](THROUGHPUT.md))", 1)
+    section = f"{MARK_BEGIN}\n{body}{MARK_END}\n"
+    pattern = re.compile(re.escape(MARK_BEGIN) + ".*?" + re.escape(MARK_END) + "\n?", re.S)
+    new = pattern.sub(lambda _: section, old) if MARK_BEGIN in old else old + ("\n" if old else "") + section
+    path.write_text(new)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--width", type=int, default=160)
+    parser.add_argument("--samples", type=int, default=16)
+    parser.add_argument("--scenes", nargs="*", default=SCENES)
+    parser.add_argument("--memory-scene", default="cornell_box")
+    parser.add_argument("--memory-samples", type=int, default=2)
+    args = parser.parse_args(argv)
+    drt_engine.register()
+    cores = os.cpu_count() or 1
+    rows = []
+    for name in args.scenes:
+        scene, data = load(name, args.width)
+        geometry = Renderer(data, settings(scene, threads=1)).geometry
+        cam = camera_batch(data, WAVE)
+        raw1, raw = raw_embree(geometry, cam, 1), raw_embree(geometry, cam, cores)
+        drt1, _, _, _ = drt_rate(data, scene, 1, args.samples)
+        drt, seconds, rays, plan = drt_rate(data, scene, 0, args.samples)
+        found = time_to_error(name)
+        d, curve, c = found if found else (None, None, None)
+        rows.append(dict(name=name, raw1=raw1, raw=raw, drt1=drt1, drt=drt, rays=rays, plan=plan,
+                         drt_time=d, drt_curve=curve, cycles_time=c))
+        print(f"{name}: raw {raw1 / 1e6:.2f} / {raw / 1e6:.2f} Mrays/s, DRT {drt1 / 1e6:.2f} / {drt / 1e6:.2f} "
+              f"Mrays/s ({seconds:.1f} s), ratio {drt / raw:.3f}; to 1e-3: DRT {fmt(d)} Cycles {fmt(c)}", flush=True)
+    memory = peak_memory(args.memory_scene, args.memory_samples)
+    print(f"peak memory {memory[1]:.0f} MB ({memory[0]:.0f} MB before the renderer)", flush=True)
+    text = table(rows, memory, args.width, args.samples, cores, args.memory_scene, args.memory_samples)
+    (ROOT / "bench" / "THROUGHPUT.md").write_text(text)
+    write_results_section(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
