@@ -179,18 +179,15 @@ class Renderer:
                 need = (target - base).astype(np.int64)
                 keep = need > 0
                 pix, base, need = active[keep], base[keep], need[keep]
-                # sample-major order: every pixel's next sample before any pixel's one after
-                step = np.arange(int(need.sum())) - np.repeat(np.cumsum(need) - need, need)
-                order = np.argsort(step, kind="stable")
-                order_pix = np.repeat(pix, need)[order]
-                order_sample = np.repeat(base.astype(np.int64), need)[order] + step[order]
-                for a in range(0, len(order_pix), WAVE):
-                    trace(order_pix[a:a + WAVE], order_sample[a:a + WAVE])
-                    traced += len(order_pix[a:a + WAVE])
+                left = int(need.sum())
+                for wave_pix, wave_sample in _waves(pix, base.astype(np.int64), need):
+                    trace(wave_pix, wave_sample)
+                    traced += len(wave_pix)
+                    left -= len(wave_pix)
                     if s.time_limit > 0 and time.perf_counter() - start >= s.time_limit:
                         stopped = "time_limit"
                         break
-                    if a + WAVE < len(order_pix) and not notify(target - 1):
+                    if left > 0 and not notify(target - 1):
                         stopped = "cancelled"
                         break
                 if stopped:
@@ -535,6 +532,26 @@ class Renderer:
         self._count("transparent", passthrough.sum())
         prev_pdf = np.where(delta[sel], np.inf, pdf[sel])
         return pid[sel], origin, wi, new_thr[sel], prev_pdf, ng[gi], straight[g][sel] & passthrough
+
+
+def _waves(pix, base, need):
+    """Waves of at most WAVE (pixel, sample ids) in sample-major order: every pixel's next
+    sample before any pixel's one after. Made step by step as they are traced, so memory
+    is bounded by the image and the wave, not by the samples of a round."""
+    pend_pix, pend_sample, size = [], [], 0
+    for step in range(int(need.max()) if len(need) else 0):
+        live = need > step
+        pend_pix.append(pix[live])
+        pend_sample.append(base[live] + step)
+        size += len(pend_pix[-1])
+        if size >= WAVE:
+            p, smp = np.concatenate(pend_pix), np.concatenate(pend_sample)
+            full = size - size % WAVE
+            for a in range(0, full, WAVE):
+                yield p[a:a + WAVE], smp[a:a + WAVE]
+            pend_pix, pend_sample, size = [p[full:]], [smp[full:]], size - full
+    if size:
+        yield np.concatenate(pend_pix), np.concatenate(pend_sample)
 
 
 def _frame(n):
