@@ -95,18 +95,28 @@ class Film:
         self.hi = np.full((self.n, 3), -np.inf) if track_range else None
 
     def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray):
-        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4)."""
-        self.count += np.bincount(pixel, minlength=self.n)
+        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4).
+
+        Sums run over the pixel range the wave touches (a wave of a large image covers a
+        band of it), so the cost follows the wave, not the image.
+        """
+        if len(pixel) == 0:
+            return
+        lo = int(pixel.min())
+        span = slice(lo, int(pixel.max()) + 1)
+        m = span.stop - lo
+        local = pixel - lo
+        self.count[span] += np.bincount(local, minlength=m)
         for name, total in self.sums.items():
             v = values[name]
             for c in range(v.shape[1]):
-                total[:, c] += np.bincount(pixel, weights=v[:, c], minlength=self.n)
+                total[span, c] += np.bincount(local, weights=v[:, c], minlength=m)
         a = sample_is_class_a(sample) if self.replicate is None else np.full(len(pixel), self.replicate == 1)
-        pa = pixel[a]
-        self.count_a += np.bincount(pa, minlength=self.n)
+        la = local[a]
+        self.count_a[span] += np.bincount(la, minlength=m)
         rgb = values["Combined"][a, :3]
         for c in range(3):
-            self.sum_a[:, c] += np.bincount(pa, weights=rgb[:, c], minlength=self.n)
+            self.sum_a[span, c] += np.bincount(la, weights=rgb[:, c], minlength=m)
         if self.lo is not None:
             np.minimum.at(self.lo, pixel, values["Combined"][:, :3])
             np.maximum.at(self.hi, pixel, values["Combined"][:, :3])
