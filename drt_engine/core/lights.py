@@ -66,15 +66,19 @@ class _SphericalRectangle:
         self.x1, self.y1 = self.x0 + sx, self.y0 + sy
         self.ex, self.ey, self.ez, self.origins = ex, ey, ez, origins
         z0, x0, y0, x1, y1 = self.z0, self.x0, self.y0, self.x1, self.y1
-        n0 = _unit(np.stack([np.zeros_like(z0), z0, -y0], 1))
-        n1 = _unit(np.stack([-z0, np.zeros_like(z0), x1], 1))
-        n2 = _unit(np.stack([np.zeros_like(z0), -z0, y1], 1))
-        n3 = _unit(np.stack([z0, np.zeros_like(z0), -x0], 1))
-        g0 = np.arccos(np.clip(-mf.dot(n0, n1), -1, 1))
-        g1 = np.arccos(np.clip(-mf.dot(n1, n2), -1, 1))
-        g2 = np.arccos(np.clip(-mf.dot(n2, n3), -1, 1))
-        g3 = np.arccos(np.clip(-mf.dot(n3, n0), -1, 1))
-        self.b0, self.b1 = n0[:, 2], n2[:, 2]
+        # normals of the planes through the origin and each edge: n0 = (0, z0, -y0) / m0,
+        # n1 = (-z0, 0, x1) / m1, n2 = (0, -z0, y1) / m2, n3 = (z0, 0, -x0) / m3; each pair
+        # shares one non-zero product, so the dot products are written out (the values of
+        # the unit vectors' full dot products, without building (N, 3) arrays)
+        zz = z0 * z0
+        m0, m1 = np.maximum(np.sqrt(zz + y0 * y0), _TINY), np.maximum(np.sqrt(zz + x1 * x1), _TINY)
+        m2, m3 = np.maximum(np.sqrt(zz + y1 * y1), _TINY), np.maximum(np.sqrt(zz + x0 * x0), _TINY)
+        c0, c1, c2, c3 = -y0 / m0, x1 / m1, y1 / m2, -x0 / m3  # the z components
+        g0 = np.arccos(np.clip(-(c0 * c1), -1, 1))
+        g1 = np.arccos(np.clip(-(c1 * c2), -1, 1))
+        g2 = np.arccos(np.clip(-(c2 * c3), -1, 1))
+        g3 = np.arccos(np.clip(-(c3 * c0), -1, 1))
+        self.b0, self.b1 = c0, c2
         self.k = 2 * np.pi - g2 - g3
         self.solid_angle = g0 + g1 - self.k
         self.usable = (self.solid_angle > self.MIN_SOLID_ANGLE) & (np.abs(z0) > 0) & np.isfinite(self.solid_angle)
