@@ -79,6 +79,6 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         d_w = mf.normalize(np.einsum("nij,nj->ni", linear, d))
     else:
         m = camera.matrix
-        o_w = o @ m[:3, :3].T + m[:3, 3]
-        d_w = mf.normalize(d @ m[:3, :3].T)
+        o_w = mf.transform(o, m[:3, :3]) + m[:3, 3]
+        d_w = mf.normalize(mf.transform(d, m[:3, :3]))
     return CameraRays(o_w + d_w * t_start[:, None], d_w, np.maximum(t_end - t_start, 0.0), t_start, axial)

@@ -59,10 +59,10 @@ class _SphericalRectangle:
     def __init__(self, c, ex, ey, ez, sx, sy, origins):
         corner = c - 0.5 * sx * ex - 0.5 * sy * ey
         d = corner - origins
-        z0 = d @ ez
+        z0 = mf.dot_with(d, ez)
         self.flip = np.where(z0 > 0, -1.0, 1.0)  # local z points away from the rectangle
         self.z0 = z0 * self.flip
-        self.x0, self.y0 = d @ ex, d @ ey
+        self.x0, self.y0 = mf.dot_with(d, ex), mf.dot_with(d, ey)
         self.x1, self.y1 = self.x0 + sx, self.y0 + sy
         self.ex, self.ey, self.ez, self.origins = ex, ey, ez, origins
         z0, x0, y0, x1, y1 = self.z0, self.x0, self.y0, self.x1, self.y1
@@ -296,7 +296,7 @@ class Lights:
     def _spot(light: Light, direction):
         """Cycles' spot cone: smoothstep over the blend region, no extra cosine."""
         cos_half = np.cos(min(light.spot_size, np.pi) / 2.0)
-        cos_a = direction @ light.direction
+        cos_a = mf.dot_with(direction, light.direction)
         smooth = (1.0 - cos_half) * light.spot_blend
         if smooth <= 0:
             return (cos_a > cos_half).astype(float)
@@ -379,7 +379,7 @@ class Lights:
         to = q - pos
         dist = mf.norm(to)
         wi = to / np.maximum(dist, _TINY)[:, None]
-        cos_l = wi @ ez  # the light emits along -Z: seen from the front when wi . ez > 0
+        cos_l = mf.dot_with(wi, ez)  # the light emits along -Z: seen from the front when wi . ez > 0
         front = cos_l > 0
         pdf = np.where(front, dist * dist / np.maximum(cos_l * area, _TINY), 0.0)
         if not disk:
@@ -439,11 +439,11 @@ class Lights:
 
     def _hit_area(self, light, origins, dirs):
         c, ex, ey, ez, sx, sy, disk, _ = self._area_frame(light)
-        denom = dirs @ ez
+        denom = mf.dot_with(dirs, ez)
         front = denom > 0
-        t = ((c - origins) @ ez) / np.where(front, denom, 1.0)
+        t = mf.dot_with(c - origins, ez) / np.where(front, denom, 1.0)
         q = origins + t[:, None] * dirs - c
-        x, y = (q @ ex) / (0.5 * sx), (q @ ey) / (0.5 * sy)
+        x, y = mf.dot_with(q, ex) / (0.5 * sx), mf.dot_with(q, ey) / (0.5 * sy)
         inside = (x * x + y * y <= 1.0) if disk else ((np.abs(x) <= 1.0) & (np.abs(y) <= 1.0))
         t = np.where(front & inside, t, np.inf)
         return t, light.radiance * _spread(light.spread, denom)[:, None]
@@ -474,7 +474,7 @@ class Lights:
     def _pdf_shape(self, light, origins, dirs, t):
         if light.kind == "AREA":
             c, ex, ey, ez, sx, sy, disk, area = self._area_frame(light)
-            pdf = t * t / (np.maximum(dirs @ ez, _TINY) * area)
+            pdf = t * t / (np.maximum(mf.dot_with(dirs, ez), _TINY) * area)
             if not disk:
                 rect = _SphericalRectangle(c, ex, ey, ez, sx, sy, origins)
                 pdf = np.where(rect.usable, 1.0 / np.maximum(rect.solid_angle, _TINY), pdf)
@@ -497,7 +497,7 @@ class Lights:
             if light.kind != "SUN" or half <= 0:
                 continue
             light, _, d, _ = self._local(i, origins, dirs, time)
-            inside = d @ -light.direction > np.cos(half)
+            inside = mf.dot_with(d, -light.direction) > np.cos(half)
             radiance[inside] += light.irradiance / (np.pi * np.sin(half) ** 2)
             factor = self.pick_factor(i, origins[inside])
             pdf[inside] = factor / (2.0 * np.pi * (1.0 - np.cos(half)))
