@@ -203,13 +203,14 @@ class MaterialShader:
         return np.where(total > 0, p / np.maximum(total, _TINY), 1.0 / len(self.sampled))
 
     # -- evaluation -----------------------------------------------------------------
-    def evaluate(self, wo: np.ndarray, wi: np.ndarray, above: np.ndarray, inside: np.ndarray):
+    def evaluate(self, wo: np.ndarray, wi: np.ndarray, above: np.ndarray, inside: np.ndarray, sel=None):
         """BSDF times |cos| for light sampling.
 
         ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived
         from the back of the surface (glass sees the inverse IOR). Returns (diffuse part,
         non-diffuse part, density of continuing in direction wi through the non-diffuse
-        lobes, for multiple importance sampling).
+        lobes, for multiple importance sampling). ``sel``: ``selection(wo[:, 2])`` when the
+        caller has it already (it depends on wo only, so every light strategy shares it).
         """
         n = len(wo)
         mu_o = wo[:, 2]
@@ -218,7 +219,8 @@ class MaterialShader:
         pdf = np.zeros(n)
         refl = above & (wi[:, 2] > 0)
         trans = ~above & (wi[:, 2] < 0)
-        sel = self.selection(mu_o) if self.sampled else None
+        if sel is None and self.sampled:
+            sel = self.selection(mu_o)
         for lobe in self.lobes:
             if lobe.delta:
                 continue
@@ -275,7 +277,7 @@ class MaterialShader:
         smooth = np.flatnonzero(valid & ~delta)
         if len(smooth):
             above = wi[smooth, 2] > 0
-            _, f_nd, pdf_nd = self.evaluate(wo[smooth], wi[smooth], above, inside[smooth])
+            _, f_nd, pdf_nd = self.evaluate(wo[smooth], wi[smooth], above, inside[smooth], sel[smooth])
             pdf[smooth] = pdf_nd
             ok = pdf_nd > 0
             weight[smooth] = np.where(ok[:, None], f_nd / np.maximum(pdf_nd, _TINY)[:, None], 0.0)

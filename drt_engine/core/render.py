@@ -470,6 +470,7 @@ class Renderer:
         pos_g, ng_g, t_g, b_g, ns_g, wo_g, in_g, thr_g, scale_g = (
             a[g] for a in (pos, ng, t, b, ns, wo_l, inside, thr, scale))
         time_g = time[pid] if self.timed else None
+        sel_g = shader.selection(wo_g[:, 2]) if shader.sampled else None
         for k in range(lights.strategies):
             u_k = u["light"][k][g]
             u_light = u["choice"][k][g] if lights.selecting else None
@@ -479,7 +480,7 @@ class Renderer:
                 continue
             wi_l = _to_local(ls.wi, t_g, b_g, ns_g)
             above = mf.dot(ls.wi, ng_g) > 0
-            f_diff, f_nd, pdf_b = shader.evaluate(wo_g, wi_l, above, in_g)
+            f_diff, f_nd, pdf_b = shader.evaluate(wo_g, wi_l, above, in_g, sel_g)
             w_l = _power(ls.pdf, pdf_b)
             contrib = thr_g * ls.value * (f_diff + f_nd * w_l[:, None])
             ok &= mf.max3(contrib) > 0
