@@ -74,7 +74,8 @@ def camera_batch(data, n, seed=0):
 
 
 def raw_embree(geometry, cam, threads, seconds=1.0):
-    """Rays per second of EmbreeScene.run alone over every part, for closest hits as DRT asks."""
+    """(rays per wall second, rays per CPU second) of EmbreeScene.run alone over every part,
+    for closest hits as DRT asks."""
     batches = []
     for k, part in enumerate(geometry.parts):
         if not part.scenes:
@@ -94,35 +95,41 @@ def raw_embree(geometry, cam, threads, seconds=1.0):
                 for job in jobs:
                     job.result()
         once()
-        reps, start = 0, time.perf_counter()
+        reps, start, cpu = 0, time.perf_counter(), time.process_time()
         while reps < 3 or time.perf_counter() - start < seconds:
             once()
             reps += 1
-        elapsed = time.perf_counter() - start
-    return n * reps / elapsed
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
+    return n * reps / elapsed, n * reps / cpu
 
 
 def drt_rate(data, scene, threads, samples):
-    """(rays per second, seconds, rays by kind, plan summary) of one DRT render."""
-    result = Renderer(data, settings(scene, samples=samples, threads=threads, seed=7)).render()
-    stats = result.stats
+    """(rays per wall second, rays per CPU second, seconds, rays by kind, plan summary) of one
+    DRT render."""
+    renderer = Renderer(data, settings(scene, samples=samples, threads=threads, seed=7))
+    cpu = time.process_time()
+    stats = renderer.render().stats
+    cpu = time.process_time() - cpu
     total = sum(stats["rays"].values())
-    return total / stats["elapsed"], stats["elapsed"], stats["rays"], stats["plan_summary"]
+    return total / stats["elapsed"], total / cpu, stats["elapsed"], stats["rays"], stats["plan_summary"]
 
 
 def time_to_error(name, level=1e-3):
-    """(DRT's best seconds, its curve, Cycles adaptive seconds) from bench/run.py's results."""
+    """(DRT's best seconds, its curve, Cycles' best seconds, its curve) from bench/run.py's results."""
     path = ROOT / "bench" / "results" / f"{name}.json"
     if not path.exists():
         return None
     from bench.run import time_to
 
     curves = json.loads(path.read_text())["curves"]
-    drt = {k: time_to(v, level) for k, v in curves.items() if not k.startswith("Cycles")}
-    drt = {k: t for k, t in drt.items() if t is not None}
-    best = min(drt, key=drt.get) if drt else None
-    cycles = time_to(curves.get("Cycles adaptive", []), level)
-    return (drt[best] if best else None), best, cycles
+    times = {k: time_to(v, level) for k, v in curves.items()}
+
+    def best(cycles):
+        found = {k: t for k, t in times.items() if t is not None and k.startswith("Cycles") == cycles}
+        k = min(found, key=found.get) if found else None
+        return (found[k] if k else None), k
+
+    return best(False) + best(True)
 
 
 MEMORY_SCRIPT = """
@@ -160,21 +167,28 @@ def table(rows, memory, width, samples, cores, memory_scene, memory_samples) -> 
         "# DRT throughput and memory",
         "",
         f"Made by `make bench` (bench/throughput.py) on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
-        f"{cores} cores, Python {sys.version.split()[0]}, NumPy {np.__version__}. Scenes at width {width} px, "
-        f"DRT {samples} spp. Raw: the scene's own camera rays through `EmbreeScene.run` only. DRT: every ray "
-        "it traced (all kinds) over its render time. Time to relMSE 1e-3 from bench/run.py's curves "
-        "(DRT's best curve; Cycles with adaptive sampling, diffuse bounces 0).",
+        f"{cores} cores, Python {sys.version.split()[0]}, NumPy {np.__version__}; machine load average "
+        f"{os.getloadavg()[0]:.1f} when it ended. Scenes at width {width} px, DRT {samples} spp. Raw: the scene's "
+        "own camera rays through `EmbreeScene.run` only. DRT: every ray it traced (all kinds) over its render "
+        "time. Mrays/s per wall second, and per CPU second of the process on 1 thread (which other "
+        "processes on the machine disturb less).",
         "",
-        "| scene | raw 1 thread (Mrays/s) | raw all (Mrays/s) | DRT 1 thread (Mrays/s) | DRT all (Mrays/s) "
-        f"| DRT / raw, all (target {TARGET_RATIO}) | DRT to 1e-3 (s) | Cycles to 1e-3 (s) | DRT / Cycles time |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| scene | raw 1 thread | raw all | DRT 1 thread | DRT all | DRT / raw, all (target "
+        f"{TARGET_RATIO}) | per CPU s: raw, DRT, ratio (1 thread) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        d, c = r["drt_time"], r["cycles_time"]
-        ratio_t = f"{d / c:.1f}" if d and c else "—"
-        curve = f" ({r['drt_curve']})" if r["drt_curve"] else ""
         lines.append(f"| {r['name']} | {r['raw1'] / 1e6:.2f} | {r['raw'] / 1e6:.2f} | {r['drt1'] / 1e6:.2f} | "
-                     f"{r['drt'] / 1e6:.2f} | {r['drt'] / r['raw']:.3f} | {fmt(d)}{curve} | {fmt(c)} | {ratio_t} |")
+                     f"{r['drt'] / 1e6:.2f} | {r['drt'] / r['raw']:.3f} | {r['raw_cpu'] / 1e6:.2f}, "
+                     f"{r['drt_cpu'] / 1e6:.2f}, {r['drt_cpu'] / r['raw_cpu']:.3f} |")
+    lines += ["", "Time to relMSE 1e-3 (seconds) from bench/run.py's curves (its resolution and settings; "
+              "DRT's best curve against Cycles' best, diffuse bounces 0, with or without its adaptive sampling):",
+              "", "| scene | DRT | Cycles | DRT / Cycles |", "|---|---|---|---|"]
+    for r in rows:
+        d, dk, c, ck = r["to_error"]
+        ratio = f"{d / c:.1f}" if d and c else "—"
+        lines.append(f"| {r['name']} | {fmt(d)}{f' ({dk})' if dk else ''} | {fmt(c)}{f' ({ck})' if ck else ''} "
+                     f"| {ratio} |")
     lines += ["", "Rays traced per kind (all threads) and the render plan:", ""]
     for r in rows:
         kinds = ", ".join(f"{k} {v}" for k, v in r["rays"].items())
@@ -213,15 +227,15 @@ def main(argv=None):
         scene, data = load(name, args.width)
         geometry = Renderer(data, settings(scene, threads=1)).geometry
         cam = camera_batch(data, WAVE)
-        raw1, raw = raw_embree(geometry, cam, 1), raw_embree(geometry, cam, cores)
-        drt1, _, _, _ = drt_rate(data, scene, 1, args.samples)
-        drt, seconds, rays, plan = drt_rate(data, scene, 0, args.samples)
-        found = time_to_error(name)
-        d, curve, c = found if found else (None, None, None)
-        rows.append(dict(name=name, raw1=raw1, raw=raw, drt1=drt1, drt=drt, rays=rays, plan=plan,
-                         drt_time=d, drt_curve=curve, cycles_time=c))
+        (raw1, raw_cpu), (raw, _) = raw_embree(geometry, cam, 1), raw_embree(geometry, cam, cores)
+        drt1, drt_cpu, _, _, _ = drt_rate(data, scene, 1, args.samples)
+        drt, _, seconds, rays, plan = drt_rate(data, scene, 0, args.samples)
+        found = time_to_error(name) or (None, None, None, None)
+        rows.append(dict(name=name, raw1=raw1, raw=raw, raw_cpu=raw_cpu, drt1=drt1, drt=drt, drt_cpu=drt_cpu,
+                         rays=rays, plan=plan, to_error=found))
         print(f"{name}: raw {raw1 / 1e6:.2f} / {raw / 1e6:.2f} Mrays/s, DRT {drt1 / 1e6:.2f} / {drt / 1e6:.2f} "
-              f"Mrays/s ({seconds:.1f} s), ratio {drt / raw:.3f}; to 1e-3: DRT {fmt(d)} Cycles {fmt(c)}", flush=True)
+              f"Mrays/s ({seconds:.1f} s), ratio {drt / raw:.3f}; per CPU s {drt_cpu / raw_cpu:.3f}; "
+              f"to 1e-3: DRT {fmt(found[0])} Cycles {fmt(found[2])}", flush=True)
     memory = peak_memory(args.memory_scene, args.memory_samples)
     print(f"peak memory {memory[1]:.0f} MB ({memory[0]:.0f} MB before the renderer)", flush=True)
     text = table(rows, memory, args.width, args.samples, cores, args.memory_scene, args.memory_samples)
