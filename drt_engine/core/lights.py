@@ -371,11 +371,14 @@ class Lights:
             p2 = mf.concentric_disk(u) * 0.5
             q = c + (p2[:, :1] * sx) * ex + (p2[:, 1:] * sy) * ey
         else:
-            q = c + ((u[:, :1] - 0.5) * sx) * ex + ((u[:, 1:] - 0.5) * sy) * ey
             rect = _SphericalRectangle(c, ex, ey, ez, sx, sy, pos)
             solid = rect.usable
-            if solid.any():
-                q[solid] = rect.sample(u[solid], solid)
+            if solid.all():  # the usual case: no gathers, no area samples to overwrite
+                q = rect.sample(u, slice(None))
+            else:
+                q = c + ((u[:, :1] - 0.5) * sx) * ex + ((u[:, 1:] - 0.5) * sy) * ey
+                if solid.any():
+                    q[solid] = rect.sample(u[solid], solid)
         to = q - pos
         dist = mf.norm(to)
         wi = to / np.maximum(dist, _TINY)[:, None]
