@@ -386,6 +386,7 @@ class Renderer:
 
             scale = self.geometry.offset_scale(prim, pos)
             u = self._draw(depth, seed_pixel[p_ids], sample[p_ids], mat, depth < s.max_depth)
+            thr_s, straight_s = throughput[surf], straight[p_ids]
             next_state = []
             shadow = []
             for m in np.unique(mat):
@@ -399,11 +400,11 @@ class Renderer:
                     if "GlossCol" in aux:
                         aux["GlossCol"][p_ids[fg]] = gloss
                 shadow.append(self._direct(shader, g, u, p_ids, pos, ng_o, ns_o,
-                                           tangent, bitangent, wo_l, inside, scale, throughput[surf], time))
+                                           tangent, bitangent, wo_l, inside, scale, thr_s, time))
                 if shader.can_continue and depth < s.max_depth:
                     next_state.append(self._continue(shader, g, u, p_ids, pos, ng_o,
                                                      ns_o, tangent, bitangent, wo_l, inside, scale,
-                                                     throughput[surf], straight[p_ids]))
+                                                     thr_s, straight_s))
             self._resolve_shadows(shadow, radiance, times)
 
             if not next_state:
