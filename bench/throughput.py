@@ -115,13 +115,15 @@ def drt_rate(data, scene, threads, samples):
 
 
 def time_to_error(name, level=1e-3):
-    """(DRT's best seconds, its curve, Cycles' best seconds, its curve) from bench/run.py's results."""
+    """(DRT's best seconds, its curve, Cycles' best seconds, its curve, bench/run.py's settings) from
+    bench/run.py's results."""
     path = ROOT / "bench" / "results" / f"{name}.json"
     if not path.exists():
         return None
     from bench.run import time_to
 
-    curves = json.loads(path.read_text())["curves"]
+    found = json.loads(path.read_text())
+    curves = found["curves"]
     times = {k: time_to(v, level) for k, v in curves.items()}
 
     def best(cycles):
@@ -129,7 +131,8 @@ def time_to_error(name, level=1e-3):
         k = min(found, key=found.get) if found else None
         return (found[k] if k else None), k
 
-    return best(False) + best(True)
+    w, h = found["resolution"]
+    return best(False) + best(True) + (f"{w}x{h}, cap {found['cap']} spp, references {found['reference_samples']} spp",)
 
 
 MEMORY_SCRIPT = """
@@ -183,12 +186,12 @@ def table(rows, memory, width, samples, cores, memory_scene, memory_samples) -> 
                      f"{r['drt_cpu'] / 1e6:.2f}, {r['drt_cpu'] / r['raw_cpu']:.3f} |")
     lines += ["", "Time to relMSE 1e-3 (seconds) from bench/run.py's curves (its resolution and settings; "
               "DRT's best curve against Cycles' best, diffuse bounces 0, with or without its adaptive sampling):",
-              "", "| scene | DRT | Cycles | DRT / Cycles |", "|---|---|---|---|"]
+              "", "| scene | DRT | Cycles | DRT / Cycles | bench/run.py at |", "|---|---|---|---|---|"]
     for r in rows:
-        d, dk, c, ck = r["to_error"]
+        d, dk, c, ck, where = r["to_error"]
         ratio = f"{d / c:.1f}" if d and c else "—"
         lines.append(f"| {r['name']} | {fmt(d)}{f' ({dk})' if dk else ''} | {fmt(c)}{f' ({ck})' if ck else ''} "
-                     f"| {ratio} |")
+                     f"| {ratio} | {where} |")
     lines += ["", "Rays traced per kind (all threads) and the render plan:", ""]
     for r in rows:
         kinds = ", ".join(f"{k} {v}" for k, v in r["rays"].items())
@@ -230,7 +233,7 @@ def main(argv=None):
         (raw1, raw_cpu), (raw, _) = raw_embree(geometry, cam, 1), raw_embree(geometry, cam, cores)
         drt1, drt_cpu, _, _, _ = drt_rate(data, scene, 1, args.samples)
         drt, _, seconds, rays, plan = drt_rate(data, scene, 0, args.samples)
-        found = time_to_error(name) or (None, None, None, None)
+        found = time_to_error(name) or (None, None, None, None, "no bench/run.py results")
         rows.append(dict(name=name, raw1=raw1, raw=raw, raw_cpu=raw_cpu, drt1=drt1, drt=drt, drt_cpu=drt_cpu,
                          rays=rays, plan=plan, to_error=found))
         print(f"{name}: raw {raw1 / 1e6:.2f} / {raw / 1e6:.2f} Mrays/s, DRT {drt1 / 1e6:.2f} / {drt / 1e6:.2f} "

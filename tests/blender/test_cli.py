@@ -74,6 +74,9 @@ def test_render_to_png_through_the_view_transform(bl, blend, tmp_path):
     result = run_cli("render", blend, "-o", out)
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     assert result.stderr == ""
+    # the render plan and the rays by kind reach the output: an emitter needs no shadow rays
+    assert "DRT: plan: dims pixel;" in result.stdout and "left out: lens (aperture 0)" in result.stdout
+    assert f"DRT: rays traced: camera {16 * 12 * 2}, shadow 0," in result.stdout, result.stdout[-2000:]
     channels = bl.read_channels(out)
     rgb = np.stack([channels[c] for c in "RGB"], axis=-1)
     assert rgb.shape == (12, 16, 3)
