@@ -114,6 +114,7 @@ class Renderer:
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
         self.dims = _Dims(self.lights.strategies)
+        self._glows = mf.max3(self.lights.tri_emission) > 0  # per triangle: emission seen when hit
         self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
         self.timed = self.plan.time
         w, h = self.camera.window_size
@@ -350,16 +351,16 @@ class Renderer:
             wo = -dirs[surf]
 
             # emission seen (two-sided), weighted against light sampling of emissive triangles
-            emission = self.lights.tri_emission[prim] if len(self.lights.tri_emission) else np.zeros((len(surf), 3))
-            glowing = np.flatnonzero(mf.max3(emission) > 0)
+            glowing = np.flatnonzero(self._glows[prim]) if len(self._glows) else np.zeros(0, np.int64)
             if len(glowing):
+                emission = self.lights.tri_emission[prim[glowing]]
                 weight = np.ones(len(glowing))
                 k = surf[glowing]
                 smooth = ~np.isinf(prev_pdf[k])
                 if smooth.any():
                     pl = self.lights.pdf_emissive(prim[glowing[smooth]], dirs[k[smooth]], hits.t[k[smooth]])
                     weight[smooth] = _power(prev_pdf[k[smooth]], pl)
-                e = throughput[k] * emission[glowing] * weight[:, None]
+                e = throughput[k] * emission * weight[:, None]
                 radiance[p_ids[glowing]] += e
                 if "Emit" in aux:
                     first = straight[p_ids[glowing]]
