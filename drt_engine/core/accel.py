@@ -268,8 +268,10 @@ class Geometry:
         return RayTimes(None if time is None else np.asarray(time), frames)
 
     def _rays_in(self, k: int, origins, directions, times: RayTimes, index):
-        """(origins, directions) of rays ``index`` in part k's Embree frame."""
+        """(origins, directions) of rays ``index`` (ascending, no repeats) in part k's Embree frame."""
         part = self.parts[k]
+        if len(index) == len(origins):  # then index is every ray, in order: no gathers
+            index = slice(None)
         if part.kind == "rigid":
             _, translation, inv = (a[index] for a in times.frames[k])
             o = np.einsum("nij,nj->ni", inv, origins[index] - translation) - part.center
