@@ -344,6 +344,10 @@ class Renderer:
             surf = np.flatnonzero(on_surface)
             if len(surf) == 0:
                 break
+            if len(self.shaders) > 1:
+                # hits ordered by material (stably): each material's hits are one slice, so its
+                # arrays are views, and per path nothing changes (groups keep their order)
+                surf = surf[np.argsort(self.geometry.material[hits.prim[surf]], kind="stable")]
             p_ids = path[surf]
             pos, ng, ns = self.geometry.surface(hits, surf, ray_times)
             prim = hits.prim[surf]
@@ -390,11 +394,12 @@ class Renderer:
             thr_s, straight_s = throughput[surf], straight[p_ids]
             next_state = []
             shadow = []
-            for m in np.unique(mat):
-                g = np.flatnonzero(mat == m)
-                shader = self.shaders[m]
+            starts = np.concatenate([[0], np.flatnonzero(np.diff(mat)) + 1])
+            for a, b in zip(starts, np.append(starts[1:], len(mat))):
+                g = slice(int(a), int(b))  # the hits of material mat[a]
+                shader = self.shaders[mat[a]]
                 if ("DiffCol" in aux or "GlossCol" in aux) and first_hit[g].any():
-                    fg = g[first_hit[g]]
+                    fg = np.flatnonzero(first_hit[g]) + g.start
                     diff, gloss = shader.colors(wo_l[fg, 2])
                     if "DiffCol" in aux:
                         aux["DiffCol"][p_ids[fg]] = diff
@@ -461,7 +466,7 @@ class Renderer:
 
     # -- next-event estimation ----------------------------------------------------------
     def _direct(self, shader, g, u, p_ids, pos, ng, ns, t, b, wo_l, inside, scale, thr, time):
-        """Shadow rays (not yet traced) for the hits g of one material, one per light strategy."""
+        """Shadow rays (not yet traced) for the hits g (a slice) of one material, one per light strategy."""
         lights = self.lights
         out = []
         if lights.strategies == 0 or not shader.lobes:
@@ -522,7 +527,7 @@ class Renderer:
         new_thr = thr[g] * weight
         valid &= mf.max3(new_thr) > 0
         sel = np.flatnonzero(valid)
-        gi = g[sel]
+        gi = sel + g.start
         wi = _to_world(wi_l[sel], t[gi], b[gi], ns[gi])
         # a sampled direction on the wrong side of the geometric surface would leak light
         transmit = wi_l[sel, 2] < 0
