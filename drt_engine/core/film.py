@@ -23,6 +23,7 @@ import numpy as np
 from .settings import PASS_CHANNELS
 
 _TABLE = 1024
+_BUCKETS = 1 << 14  # uniform cells over u that locate a sample's segment of the filter table
 _ODD_BITS = np.uint32(0xAAAAAAAA)
 
 
@@ -51,9 +52,22 @@ class PixelFilter:
         cdf = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]))])
         self._cdf = cdf / cdf[-1]
         self._x = x
+        self._slope = np.diff(x) / np.diff(self._cdf)
+        grid = np.arange(_BUCKETS + 1) / _BUCKETS
+        self._first = np.clip(np.searchsorted(self._cdf, grid, side="right") - 1, 0, _TABLE - 1)
+        self._steps = int(np.ceil(np.log2(np.diff(self._first).max() + 1)))
 
     def offset(self, u: np.ndarray) -> np.ndarray:
-        return np.interp(u, self._cdf, self._x)
+        """``np.interp(u, cdf, x)``, computed the same way, but each u finds its table segment
+        from a uniform grid over u and a few bisection steps inside its cell (np.interp bisects
+        all 1024 segments: 9% of a diffuse scene's render time)."""
+        k = np.minimum((u * _BUCKETS).astype(np.intp), _BUCKETS - 1)
+        lo, hi = self._first[k], self._first[k + 1]
+        for _ in range(self._steps):
+            mid = (lo + hi + 1) >> 1
+            up = u >= self._cdf[mid]
+            lo, hi = np.where(up, mid, lo), np.where(up, hi, mid - 1)
+        return self._slope[lo] * (u - self._cdf[lo]) + self._x[lo]
 
 
 def sample_is_class_a(sample: np.ndarray) -> np.ndarray:
