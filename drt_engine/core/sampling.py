@@ -212,7 +212,10 @@ class Sampler:
         for k, c in enumerate(components):
             scramble = hash_u32(pixel_seed ^ _U32((dim + c) * 0x85EBCA6B & 0xFFFFFFFF) ^ _U32(0x0A11))
             source = dim + c if dim < 4 else c
-            out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, source), scramble))
+            if source == 0:  # Sobol dimension 0 is the bit reversal, which the scramble undoes first
+                out[:, k] = _to_unit(_reverse_bits(_laine_karras(index, scramble)))
+            else:
+                out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, source), scramble))
         return out
 
     def _stratified(self, pixel, sample, dim):
