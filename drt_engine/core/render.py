@@ -32,7 +32,7 @@ from .scene import SceneData
 from .settings import RenderSettings
 
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
-_MIN_PIECE = 1 << 12  # camera samples per thread below which splitting a wave costs more than it saves
+_MIN_PIECE = 1 << 12  # fewest camera samples in one thread's piece of a wave (smaller waves stay whole)
 _TINY = 1e-30
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 
