@@ -474,7 +474,7 @@ class Renderer:
             return out
         pid = p_ids[g]
         u_pick = u["pick"][g, 1]
-        # the material's hits, gathered once for all strategies
+        # the material's hits: views, as g is a slice
         pos_g, ng_g, t_g, b_g, ns_g, wo_g, in_g, thr_g, scale_g = (
             a[g] for a in (pos, ng, t, b, ns, wo_l, inside, thr, scale))
         time_g = time[pid] if self.timed else None
