@@ -1,82 +1,77 @@
-"""Fixtures for the tests against a real Blender (Debian 13's Blender 4.3.2 in the root made by
-``make blender-env``), run by ``make test-blender``.
+"""Fixtures for the tests against a real Blender (Debian 13's Blender 4.3.2, Python 3.13,
+NumPy 2.2, in the root made by ``make blender-env``), run by ``make test-blender``, which
+names the root in DRT_BLENDER_ENV; without it ``make test`` leaves this folder out.
 
-``make test`` collects nothing here: the test modules are named ``check_*.py``, which pytest
-collects only when they are named on its command line, as ``make test-blender`` does. This file
-stays import-light because ``make test`` still imports it.
-
-Everything Blender reads or writes lives in ``/drt-test`` inside the root (``work`` on the host),
-emptied at the start of each session; commands run through ``tools/blender-chroot.sh``, which
-mounts /proc and /dev for each command only.
+Everything Blender reads or writes lives in ``/drt-test`` inside the root (``work`` on the
+host), emptied at the start of each session. The figures the tests measure (image
+differences, memory per frame, GUI timings) go to out/real_blender/measurements.json and
+are printed at the end of the run.
 """
 from __future__ import annotations
 
+import json
 import os
 import shutil
-import signal
-import subprocess
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
+from blender_env import IGNIS_SCENES, MARK, REPO, SAMPLE_SCENES, BlenderEnv
+
 HERE = Path(__file__).resolve().parent
-CHROOT = REPO / "tools" / "blender-chroot.sh"
 ZIP = REPO / "dist" / "drt_engine-0.1.0-linux_x64.zip"
 IGNIS = Path(os.environ.get("DRT_IGNIS_SCENES", REPO.parent / "shared" / "scenes" / "ignis-cycles-eval"))
-SAMPLE_SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
-IGNIS_SCENES = ("lights", "box", "roughness", "sun", "mix", "flipped-prim")
-WIDTH = 32
+"""The Ignis evaluation scenes; without them (a fresh clone) the copies in tests/data."""
+WIDTH = 48
 """Width in pixels of every headless render (height keeps the scene's aspect)."""
 SAMPLES = 8
+MEASUREMENTS = REPO / "out" / "real_blender" / "measurements.json"
 
 
-@dataclass
-class BlenderEnv:
-    root: Path
-    work: Path
+def copy_ignis(target: Path) -> dict[str, Path]:
+    """The Ignis scenes at hand copied to ``target``, keeping their relative texture paths."""
+    if IGNIS.is_dir():
+        shutil.copytree(IGNIS, target)
+    else:  # a fresh clone without ../shared: the copies in tests/data
+        (target / "evaluation" / "blender").mkdir(parents=True)
+        (target / "textures").mkdir()
+        for blend in (REPO / "tests" / "data").glob("*.blend"):
+            shutil.copy(blend, target / "evaluation" / "blender")
+        shutil.copy(REPO / "tests" / "data" / "grid_weight.png", target / "textures")
+    folder = target / "evaluation" / "blender"
+    return {f"ignis_{name}": folder / f"{name}.blend" for name in IGNIS_SCENES if (folder / f"{name}.blend").is_file()}
 
-    def inside(self, path: Path) -> str:
-        """The path Blender sees for a host path under the root."""
-        return "/" + str(Path(path).relative_to(self.root))
 
-    def run(self, *args: str, timeout: float = 300.0) -> subprocess.CompletedProcess:
-        """Run a command in the root; on timeout TERM its process group (the wrapper unmounts)."""
-        process = subprocess.Popen([str(CHROOT), str(self.root), *args], stdout=subprocess.PIPE,
-                                   stderr=subprocess.STDOUT, text=True, start_new_session=True)
-        try:
-            output, _ = process.communicate(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGTERM)
-            output, _ = process.communicate(timeout=30)
-            pytest.fail(f"timed out after {timeout} s: {' '.join(args)}\n{output[-4000:]}")
-        return subprocess.CompletedProcess(args, process.returncode, output, "")
+@pytest.fixture(scope="session")
+def measured():
+    """Figures by test, written to MEASUREMENTS at the end of the session."""
+    figures: dict = {}
+    yield figures
+    MEASUREMENTS.parent.mkdir(parents=True, exist_ok=True)
+    MEASUREMENTS.write_text(json.dumps(figures, indent=1, sort_keys=True) + "\n")
 
-    def script(self, name: str) -> str:
-        """Path inside the root of one of the scripts in tests/real_blender/in_blender."""
-        return self.inside(self.work / "in_blender" / name)
 
-    def blender(self, *args: str, timeout: float = 300.0) -> str:
-        """Run Blender; fail with its output on a non-zero exit or a Python traceback."""
-        done = self.run("blender", *args, timeout=timeout)
-        if done.returncode != 0 or "Traceback" in done.stdout:
-            pytest.fail(f"blender {' '.join(args)} exited with {done.returncode}:\n{done.stdout[-4000:]}")
-        return done.stdout
+def pytest_terminal_summary(terminalreporter):
+    if MEASUREMENTS.is_file():
+        terminalreporter.section("measured in the real Blender")
+        terminalreporter.write_line(MEASUREMENTS.read_text())
 
 
 @pytest.fixture(scope="session")
 def blender_env() -> BlenderEnv:
     root = os.environ.get("DRT_BLENDER_ENV")
-    if not root or not (Path(root) / ".drt-blender-env").is_file():
+    if not root or not (Path(root) / MARK).is_file():
         pytest.fail("no Blender root: run `make test-blender` (it builds one with `make blender-env`)")
-    root = Path(root)
+    root = Path(root).resolve()
     work = root / "drt-test"
     if work.exists():
         shutil.rmtree(work)
     work.mkdir()
     shutil.copytree(HERE / "in_blender", work / "in_blender")
-    return BlenderEnv(root, work)
+    env = BlenderEnv(root, work)
+    yield env
+    assert env.processes_inside() == [], "processes left running in the Debian root"
+    assert env.mounts_inside() == [], "file systems left mounted in the Debian root"
 
 
 @pytest.fixture(scope="session")
@@ -88,15 +83,16 @@ def installed(blender_env) -> BlenderEnv:
     shutil.copy(ZIP, zip_copy)
     output = blender_env.blender("--command", "extension", "install-file", "-r", "user_default", "-e",
                                  blender_env.inside(zip_copy))
-    assert "Error" not in output, output
+    assert "nstalled \"drt_engine\"" in output, output  # "Installed", or "Reinstalled" over an earlier run
     return blender_env
 
 
 @pytest.fixture(scope="session")
 def scenes(installed) -> dict[str, Path]:
-    """Host paths of tiny copies of the sample scenes (built by their scripts inside Blender 4.3,
+    """Host paths of small copies of the sample scenes (built by their scripts inside Blender 4.3,
     which cannot open the committed 5.0 files) and of the Ignis scenes, saved by Blender 4.3 with
-    DRT selected, WIDTH pixels wide, SAMPLES samples, seed 0; so Blender 5.0 opens them too."""
+    DRT selected, WIDTH pixels wide, SAMPLES samples, seed 0 and the Noise pass; the bpy wheel
+    (Blender 5.0) opens these files too."""
     env = installed
     shutil.copytree(REPO / "sample_scenes", env.work / "sample_scenes",
                     ignore=shutil.ignore_patterns("*.blend", "*.blend1", "__pycache__"))
@@ -105,13 +101,10 @@ def scenes(installed) -> dict[str, Path]:
         env.blender("-b", "--factory-startup", "--python", env.inside(env.work / "sample_scenes" / f"build_{name}.py"),
                     "--", env.inside(built / f"{name}.blend"))
     sources = {name: built / f"{name}.blend" for name in SAMPLE_SCENES}
-    if IGNIS.is_dir():
-        shutil.copytree(IGNIS, env.work / "ignis")
-        for name in IGNIS_SCENES:
-            sources[f"ignis_{name}"] = env.work / "ignis" / "evaluation" / "blender" / f"{name}.blend"
+    sources.update(copy_ignis(env.work / "ignis"))
     (env.work / "scenes").mkdir()
     prepared = {name: env.work / "scenes" / f"{name}.blend" for name in sources}
     jobs = [arg for name in sources for arg in (env.inside(sources[name]), env.inside(prepared[name]))]
-    env.blender("-b", "--python", env.script("prepare_scenes.py"), "--",
+    env.blender("-b", "--python", env.inside(env.work / "in_blender" / "prepare_scenes.py"), "--",
                 str(WIDTH), str(SAMPLES), *jobs)
     return prepared

@@ -3,7 +3,8 @@
 blender -b --python prepare_scenes.py -- WIDTH SAMPLES SOURCE OUT [SOURCE OUT ...]
 
 Each copy renders WIDTH pixels wide (height keeping the aspect) at 100 %, with DRT
-selected, SAMPLES samples and seed 0, Sobol, and relative paths remapped.
+selected, SAMPLES samples and seed 0, Sobol, the Noise pass on every view layer, and
+relative paths remapped.
 """
 import sys
 
@@ -22,5 +23,7 @@ for source, out in zip(args[2::2], args[3::2]):
     scene.drt.samples = samples
     scene.drt.seed = 0
     scene.drt.sampling_pattern = "SOBOL"
+    for view_layer in scene.view_layers:
+        view_layer.drt.use_pass_noise = True
     bpy.ops.wm.save_as_mainfile(filepath=out, relative_remap=True)
     print(f"prepared {out}")
