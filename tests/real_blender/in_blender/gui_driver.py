@@ -5,7 +5,9 @@ blender FILE --python gui_driver.py -- OUTDIR
 Selects DRT in the Render Properties, walks the Properties tabs (recording which panels
 poll true), renders with F12's operator into the image editor, switches the 3D viewport
 to Rendered shading (through the camera, after an edit, after orbiting), back to Solid,
-and shows a material preview. Screenshots of the whole X screen (``import -window root``)
+and shows material previews (the slot icons and a large preview). DRT's engine class is
+wrapped to record, from Blender's calls, each render (preview or not) and each viewport
+draw (the viewport render's image version and status line), with times. Screenshots of the whole X screen (``import -window root``)
 go to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on
 the host checks. Blender quits at the end, also after an error (recorded in the state).
 """
@@ -22,6 +24,7 @@ from mathutils import Quaternion
 
 OUT = Path(sys.argv[sys.argv.index("--") + 1])
 RENDER_TIMEOUT = 120.0
+"""Seconds the F12 render and each viewport render may take at most."""
 F12_SIZE = 256
 TABS = (  # (Properties tab, object to make active first)
     ("RENDER", None),
@@ -32,7 +35,7 @@ TABS = (  # (Properties tab, object to make active first)
     ("MATERIAL", "MESH"),
     ("WORLD", None),
 )
-state = {"polls": {}, "screenshots": [], "events": []}
+state = {"polls": {}, "screenshots": [], "renders": [], "viewport_renders": []}
 shots = 0
 
 
@@ -81,6 +84,75 @@ def select(kind: str):
         obj.select_set(obj == target)
     view_layer.objects.active = target
     return target
+
+
+class DRT_TEST_PT_preview(bpy.types.Panel):
+    """A large material preview in the Material tab (Blender's own Preview panel starts
+    closed), rendered by the engine as any preview is."""
+    bl_label = "Preview (test)"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+
+    def draw(self, context):
+        if context.material is not None:
+            self.layout.template_preview(context.material)
+
+
+def instrument_engine() -> None:
+    """Wrap DRT's render and view_draw to log what Blender asked and what came out."""
+    engine = next(c for c in bpy.types.RenderEngine.__subclasses__() if getattr(c, "bl_idname", "") == "DRT")
+    render, view_draw = engine.render, engine.view_draw
+    module = sys.modules[engine.__module__]
+    write_passes = module.write_passes
+    written = {}
+
+    def logged_write_passes(result, passes):
+        write_passes(result, passes)
+        if "Combined" in passes:  # the last write of a render is its final image
+            written["mean_rgb"] = [round(float(v), 4) for v in passes["Combined"][..., :3].mean(axis=(0, 1))]
+
+    def logged_render(self, depsgraph):
+        started = time.monotonic()
+        written.clear()
+        render(self, depsgraph)
+        state["renders"].append({"preview": bool(self.is_preview), "seconds": round(time.monotonic() - started, 3),
+                                 "size": [self.resolution_x, self.resolution_y], **written})
+
+    def logged_view_draw(self, context, depsgraph):
+        view_draw(self, context, depsgraph)
+        viewport = self._viewport
+        if viewport is not None:
+            version, image = viewport.latest()
+            draws.append((time.monotonic(), version, viewport.status, None if image is None else list(image.shape)))
+
+    engine.render, engine.view_draw = logged_render, logged_view_draw
+    module.write_passes = logged_write_passes
+
+
+draws = []
+"""(time, image version, status, image shape) at each viewport draw."""
+
+
+def wait_for_viewport(since: float):
+    """Yield until a viewport draw after ``since`` shows a render finished after it (an image
+    newer than any drawn before); record its timings."""
+    old = max((d[1] for d in draws if d[0] <= since), default=0)
+    done = []
+    while time.monotonic() - since < RENDER_TIMEOUT:
+        done = [d for d in draws if d[0] > since and d[1] > old and d[2].startswith("Done")]
+        if done:
+            break
+        yield 0.25
+    seen = [d for d in draws if d[0] > since]
+    images = [d for d in seen if d[3] is not None and d[1] > old]
+    state["viewport_renders"].append({
+        "first_image_s": round(images[0][0] - since, 2) if images else None,
+        "done_s": round(done[0][0] - since, 2) if done else None,
+        "draws": len(seen),
+        "last_status": seen[-1][2] if seen else None,
+        "image_shape": images[-1][3] if images else None,
+    })
 
 
 def viewport_threads() -> list[str]:
@@ -144,22 +216,25 @@ def steps():
     region_3d = space.region_3d
     shot("viewport_solid")
     region_3d.view_perspective = "CAMERA"
+    since = time.monotonic()
     space.shading.type = "RENDERED"
     yield 1.0
     state["viewport_threads_rendered"] = viewport_threads()
-    yield 8.0
+    yield from wait_for_viewport(since)
     shot("viewport_rendered")
     light = select("LIGHT")
+    since = time.monotonic()
     light.data.color = (0.2, 0.4, 1.0)  # an edit the image must follow: the light turns blue
-    yield 8.0
+    yield from wait_for_viewport(since)
     shot("viewport_rendered_after_edit")
     camera = scene.camera  # orbit 25 degrees about the vertical through the point 3 m ahead
     forward = -camera.matrix_world.col[2].xyz.normalized()
     region_3d.view_perspective = "PERSP"
     region_3d.view_rotation = Quaternion((0.0, 0.0, 1.0), 0.44) @ camera.matrix_world.to_quaternion()
     region_3d.view_location = camera.matrix_world.translation + 3.0 * forward
+    since = time.monotonic()
     region_3d.view_distance = 3.0
-    yield 8.0
+    yield from wait_for_viewport(since)
     shot("viewport_rendered_orbited")
     space.shading.type = "SOLID"
     yield 3.0
@@ -169,21 +244,45 @@ def steps():
     material_object = select("MESH")
     yield 0.5
     props.spaces.active.context = "MATERIAL"
+    # Icons asked for while F12 ran may have been dropped with Blender's preview job (a render
+    # kills it): clear them, so the slot list renders all of them again, now.
+    icons_before = sum(1 for r in state["renders"] if r["preview"])
     for slot in material_object.material_slots:
-        slot.material.preview_ensure()
-    yield 10.0
-    shot("material_previews")
+        slot.material.preview_ensure().reload()
+    props.tag_redraw()
+    yield from wait_for_previews(lambda size: size[0] <= 32, icons_before + len(material_object.material_slots))
     state["material_icons"] = {}
     for slot in material_object.material_slots:
         preview = slot.material.preview
-        width, height = preview.icon_size
-        pixels = list(preview.icon_pixels_float)
-        means = [sum(pixels[c::4]) / max(1, width * height) for c in range(4)]
-        state["material_icons"][slot.material.name] = {"size": [width, height], "mean_rgba": means}
+        state["material_icons"][slot.material.name] = {
+            "size": list(preview.icon_size), "mean_rgba": mean_rgba(preview.icon_pixels_float, preview.icon_size)}
+    material_object.active_material_index = 1  # the red wall's material, in a large preview
+    bpy.utils.register_class(DRT_TEST_PT_preview)
+    yield from wait_for_previews(lambda size: size[0] > 64, 1)
+    yield 1.0
+    shot("material_previews")
+    large = [r for r in state["renders"] if r["preview"] and r["size"][0] > 64]
+    state["material_preview"] = {"material": material_object.active_material.name,
+                                 "renders": large}
     state["engine_at_end"] = scene.render.engine
 
 
+def wait_for_previews(fits, count: int):
+    """Yield until ``count`` preview renders whose size ``fits`` are logged (or the timeout)."""
+    since = time.monotonic()
+    while time.monotonic() - since < RENDER_TIMEOUT:
+        if sum(1 for r in state["renders"] if r["preview"] and fits(r["size"])) >= count:
+            return
+        yield 0.5
+
+
+def mean_rgba(pixels, size) -> list[float]:
+    values = list(pixels)
+    return [sum(values[c::4]) / max(1, size[0] * size[1]) for c in range(4)]
+
+
 def run():
+    instrument_engine()
     generator = steps()
 
     def tick():
