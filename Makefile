@@ -99,6 +99,7 @@ BLENDER_ENV ?= /var/cache/drt/blender-trixie
 blender-env:
 	tools/blender-env.sh $(BLENDER_ENV)
 
-# Runs tests/real_blender (which `make test` does not collect) against the extension zip.
+# Runs tests/real_blender against the extension zip; tests/conftest.py collects that folder only
+# when DRT_BLENDER_ENV names the root, so `make test` leaves it out.
 test-blender: blender-env extension
 	DRT_BLENDER_ENV=$(BLENDER_ENV) $(PY) -m pytest tests/real_blender -q $(PYTEST_ARGS)
