@@ -113,7 +113,7 @@ def test_f12_render_finished(gui):
     assert [r["size"] for r in gui["renders"] if not r["preview"]] == [[F12_SIZE, F12_SIZE]], gui["renders"]
 
 
-def test_no_errors_or_warnings_about_our_code(gui):
+def test_no_errors_or_python_warnings(gui):
     check_output(gui["log"], "Blender's GUI session")
 
 
