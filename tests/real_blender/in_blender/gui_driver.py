@@ -282,8 +282,14 @@ def mean_rgba(pixels, size) -> list[float]:
 
 
 def run():
-    instrument_engine()
-    generator = steps()
+    """Step through ``steps`` from a timer; on the last step or any error (also while setting
+    up), write the state and quit, so Blender never waits for the host's timeout."""
+    try:
+        instrument_engine()
+        generator = steps()
+    except Exception:
+        state["error"] = traceback.format_exc()
+        generator = iter(())
 
     def tick():
         try:
