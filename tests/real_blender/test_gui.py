@@ -50,6 +50,7 @@ def gui(installed, scenes, measured):
     state = json.loads(state_file.read_text())
     assert "error" not in state, state["error"] + log[-4000:]
     assert env.processes_inside() == [], "Xvfb or Blender still running after the GUI session"
+    assert done.returncode == 0 and "Blender quit" in log, f"exit {done.returncode}\n{done.stdout}\n{log[-4000:]}"
     measured["gui"] = {"session_s": round(seconds, 1), "f12": state["f12"], "renders": state["renders"],
                        "viewport_renders": state["viewport_renders"], "material_icons": state["material_icons"],
                        "material_preview": state["material_preview"]}
@@ -142,6 +143,11 @@ def test_viewport_renders_in_rendered_shading(gui):
 
 def test_viewport_stops_with_rendered_shading(gui):
     assert gui["viewport_threads_solid"] == []
+
+
+def test_quitting_while_the_viewport_renders(gui):
+    """The fixture saw Blender exit 0 and say "Blender quit" with this render running."""
+    assert gui["viewport_threads_at_quit"] == ["DRT viewport"]
 
 
 def test_material_previews_render(gui):

@@ -5,11 +5,12 @@ blender FILE --python gui_driver.py -- OUTDIR
 Selects DRT in the Render Properties, walks the Properties tabs (recording which panels
 poll true), renders with F12's operator into the image editor, switches the 3D viewport
 to Rendered shading (through the camera, after an edit, after orbiting), back to Solid,
-and shows material previews (the slot icons and a large preview). DRT's engine class is
-wrapped to record, from Blender's calls, each render (preview or not) and each viewport
-draw (the viewport render's image version and status line), with times. Screenshots of the whole X screen (``import -window root``)
-go to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on
-the host checks. Blender quits at the end, also after an error (recorded in the state).
+shows material previews (the slot icons and a large preview), and quits while the
+viewport renders. DRT's engine class is wrapped to record, from Blender's calls, each
+render (preview or not) and each viewport draw (the viewport render's image version and
+status line), with times. Screenshots of the whole X screen (``import -window root``) go
+to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on the
+host checks. Blender quits at the end, also after an error (recorded in the state).
 """
 import json
 import subprocess
@@ -265,6 +266,11 @@ def steps():
     state["material_preview"] = {"material": material_object.active_material.name,
                                  "renders": large}
     state["engine_at_end"] = scene.render.engine
+
+    # Quit while the viewport renders: Blender frees the engine, which stops its worker.
+    space.shading.type = "RENDERED"
+    yield 0.5
+    state["viewport_threads_at_quit"] = viewport_threads()
 
 
 def wait_for_previews(fits, count: int):
