@@ -1,8 +1,9 @@
 """Running Debian's Blender 4.3.2 in the root made by ``make blender-env``, from the host.
 
 Every command goes through ``tools/blender-chroot.sh --timeout``, which mounts /proc and
-/dev for that command only, kills the command's whole process group when it overruns and
-unmounts in every case; the host waits a little longer than that and then kills the wrapper.
+/dev in a mount namespace of that command's own (gone with it, however it ends) and kills
+the command's whole process group when it overruns; the host waits a little longer than
+that and then kills the wrapper.
 Blender runs with Python's warnings shown (``PYTHONWARNINGS=default`` read through
 ``--python-use-system-env``), so a Python warning fails the test that ran it.
 """

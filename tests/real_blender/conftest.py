@@ -9,10 +9,12 @@ are printed at the end of the run.
 """
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import re
 import shutil
+import time
 from pathlib import Path
 
 import pytest
@@ -27,6 +29,8 @@ WIDTH = 48
 """Width in pixels of every headless render (height keeps the scene's aspect)."""
 SAMPLES = 8
 MEASUREMENTS = REPO / "out" / "real_blender" / "measurements.json"
+LOCK_WAIT = 900.0
+"""Seconds a session waits for another one on the same root to finish."""
 
 
 def copy_ignis(target: Path) -> dict[str, Path]:
@@ -64,6 +68,25 @@ def blender_env() -> BlenderEnv:
     if not root or not (Path(root) / MARK).is_file():
         pytest.fail("no Blender root: run `make test-blender` (it builds one with `make blender-env`)")
     root = Path(root).resolve()
+    with open(root / ".drt-test.lock", "w") as lock:
+        wait_for_lock(lock)
+        yield from session_env(root)
+
+
+def wait_for_lock(lock) -> None:
+    """One test session at a time per root: they share its Blender's user extensions and /drt-test."""
+    started = time.monotonic()
+    while True:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if time.monotonic() - started > LOCK_WAIT:
+                pytest.fail(f"another test session has held {lock.name} for {LOCK_WAIT:.0f} s")
+            time.sleep(2.0)
+
+
+def session_env(root: Path):
     work = root / "drt-test"
     if work.exists():
         shutil.rmtree(work)
