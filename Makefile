@@ -93,7 +93,7 @@ distclean: clean
 	rm -rf $(VENV) wheels
 
 # A real Blender: Debian 13's Blender 4.3.2 in a debootstrap root kept outside the repository
-# (about 2 GB, built once in about 5 minutes, reused while it exists).
+# (about 1.5 GB, built once in under 3 minutes, reused while it exists).
 BLENDER_ENV ?= /var/cache/drt/blender-trixie
 
 blender-env:
