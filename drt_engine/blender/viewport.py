@@ -120,11 +120,19 @@ def weak_redraw(engine) -> Callable[[], None]:
 
 
 class ViewportTexture:
-    """The newest viewport image on the GPU, drawn stretched over the whole region."""
+    """The newest viewport image on the GPU, drawn stretched over the whole region.
+
+    Drawn with Blender's built-in IMAGE shader on a two-triangle strip; gpu_extras'
+    draw_texture_2d uses a triangle fan, which Blender 4.3 reports as deprecated on every
+    draw (a DeprecationWarning from its own module)."""
+
+    CORNERS = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0))
 
     def __init__(self):
         self.version = -1
         self.texture = None
+        self._batch = None
+        self._shader = None
 
     def update(self, version: int, image: np.ndarray) -> None:
         import gpu
@@ -137,7 +145,15 @@ class ViewportTexture:
         self.version = version
 
     def draw(self, width: int, height: int) -> None:
-        from gpu_extras.presets import draw_texture_2d
+        import gpu
+        from gpu_extras.batch import batch_for_shader
 
-        if self.texture is not None:
-            draw_texture_2d(self.texture, (0, 0), width, height)
+        if self.texture is None:
+            return
+        if self._batch is None:
+            self._shader = gpu.shader.from_builtin("IMAGE")
+            self._batch = batch_for_shader(self._shader, "TRI_STRIP", {"pos": self.CORNERS, "texCoord": self.CORNERS})
+        with gpu.matrix.push_pop():
+            gpu.matrix.scale((width, height))
+            self._shader.uniform_sampler("image", self.texture)
+            self._batch.draw(self._shader)
