@@ -3,7 +3,8 @@
 #   make test        venv + the whole test suite (TESTS=path and PYTEST_ARGS=... to narrow it)
 #   make extension   download the embreex wheels, validate, build the extension zips into dist/
 #   make scenes      rebuild the sample .blend files from their scripts
-#   make bench       DRT vs Cycles error against time (bench/run.py), then ray throughput and memory
+#   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
+#                    bench/plots/), then ray throughput and memory; about 20 min on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes .venv and wheels/
@@ -89,7 +90,7 @@ scenes: $(STAMP)
 
 # throughput reads bench/run.py's fresh curves for its time-to-error columns, so it runs second
 bench: $(STAMP)
-	$(PY) bench/run.py
+	$(PY) bench/run.py --publish
 	$(PY) bench/throughput.py
 
 bench-throughput: $(STAMP)

@@ -10,12 +10,15 @@ For each scene (at a small resolution so the whole run takes minutes on two core
 - DRT SOBOL + CONTRAST adaptive: one progressive render, its error at every step;
 - Cycles with diffuse bounces 0 (a distribution ray tracer), without and with its
   adaptive sampling: one render per sample count, resp. noise threshold.
-DRT times are the renderer's own (scene export and BVH build excluded, the bench's
-error measurements subtracted); Cycles times are wall time less the wall time of a
-1-sample render of the same scene (its sync and BVH build).
+Times are CPU seconds of this process, every thread counted (both renderers run in
+it): on a shared, loaded machine they vary far less than wall time. DRT's are the
+renderer's own (scene export and BVH build excluded, the bench's error measurements
+subtracted); Cycles' are those of the render less those of a 1-sample render of the
+same scene (its sync and BVH build).
 
 Writes bench/results/<scene>.png (log-log plot), bench/results/<scene>.json, and
-bench/results/RESULTS.md (the table; copy it to bench/RESULTS.md to commit it).
+bench/results/RESULTS.md (the table); with --publish also bench/RESULTS.md and the
+plots in bench/plots/, the copies that are committed.
 """
 from __future__ import annotations
 
@@ -24,6 +27,7 @@ import json
 import math
 import os
 import platform
+import shutil
 import sys
 import tempfile
 import time
@@ -44,9 +48,9 @@ from drt_engine.core.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
 
 SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
-LEVELS = (1e-2, 3e-3, 1e-3)
+LEVELS = (1e-2, 3e-3, 1e-3, 1e-4)
 SWEEP = (4, 16, 64, 256, 1024)
-THRESHOLDS = (0.04, 0.02, 0.01, 0.005, 0.0025, 0.00125)
+THRESHOLDS = (0.16, 0.08, 0.04, 0.02, 0.01, 0.005, 0.0025, 0.00125)
 CURVES = ("GRID", "JITTERED", "SOBOL", "SOBOL+NOISE", "SOBOL+CONTRAST", "Cycles", "Cycles adaptive")
 
 
@@ -58,22 +62,26 @@ def drt_settings(scene, **kw) -> RenderSettings:
 
 
 def drt_run(data, settings, reference=None):
-    """One DRT render; with a reference, the true relMSE at every logged step (measuring time excluded)."""
+    """One DRT render; with a reference, the true relMSE at every logged step.
+
+    Returns the result, (CPU seconds, true relMSE, estimated relMSE) per step and the
+    render's CPU seconds, the measuring excluded.
+    """
     points = []
     spent = 0.0
 
     def progress(update):
         nonlocal spent
         if update.entry is not None and reference is not None:
-            t = time.perf_counter()
+            t = time.process_time()
             img = update.passes()["Combined"][..., :3]
             _, rel = true_error(img, *reference)
-            points.append((update.entry["elapsed"] - spent, rel, update.entry["relmse"]))
-            spent += time.perf_counter() - t
+            points.append((update.entry["cpu"] - spent, rel, update.entry["relmse"]))
+            spent += time.process_time() - t
         return True
 
     result = Renderer(data, settings).render(progress=progress)
-    return result, points, result.stats["elapsed"] - spent
+    return result, points, result.stats["cpu"] - spent
 
 
 def configure_cycles(scene, samples, seed, threshold=None):
@@ -110,9 +118,9 @@ def cycles_run(scene, out_dir, samples, seed=0, threshold=None):
     settings.media_type = "IMAGE"
     settings.file_format = "OPEN_EXR"
     settings.color_depth = "32"
-    start = time.perf_counter()
+    start = time.process_time()
     bpy.ops.render.render(write_still=True, scene=scene.name)
-    seconds = time.perf_counter() - start
+    seconds = time.process_time() - start
     image = oiio.ImageInput.open(str(path))
     spec = image.spec()
     pixels = image.read_image(format="float").reshape(spec.height, spec.width, spec.nchannels)[..., :3]
@@ -154,9 +162,9 @@ def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
     for pattern in ("GRID", "JITTERED"):
         pts = []
         for n in SWEEP:
-            res, _, _ = drt_run(data, drt_settings(scene, samples=n, sampling_pattern=pattern))
+            res, _, cpu = drt_run(data, drt_settings(scene, samples=n, sampling_pattern=pattern))
             _, rel = true_error(res.passes["Combined"][..., :3], *reference)
-            pts.append((res.stats["elapsed"], rel, res.stats.get("relmse")))
+            pts.append((cpu, rel, res.stats.get("relmse")))
         curves[pattern] = pts
         log(f"  {pattern}: {[(round(p[0], 2), f'{p[1]:.1e}') for p in pts]}")
 
@@ -196,7 +204,7 @@ def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
     log(f"  Cycles adaptive: {[(p[3], round(p[0], 2), f'{p[1]:.1e}') for p in pts]}")
 
     plot_loglog(out_dir / f"{name}.png", [(k, [(p[0], p[1]) for p in sorted(curves[k])]) for k in CURVES],
-                f"{name} {r.resolution_x}x{r.resolution_y}: true relMSE vs time")
+                f"{name} {r.resolution_x}x{r.resolution_y}: true relMSE vs CPU s")
     (out_dir / f"{name}.json").write_text(json.dumps({"resolution": [r.resolution_x, r.resolution_y],
                                                       "reference_samples": ref_samples, "cap": cap,
                                                       "curves": curves}, indent=1))
@@ -207,7 +215,12 @@ def fmt(t):
     return "—" if t is None else f"{t:.2f}"
 
 
-def table(results, width, ref_samples, cap) -> str:
+def speedup(res, level_index) -> str:
+    s, a = res["SOBOL"][level_index], res["SOBOL+NOISE"][level_index]
+    return "—" if s is None or a is None else f"{s / a:.2f}x"
+
+
+def table(results, width, ref_samples, cap, plots=".") -> str:
     cpu = platform.processor() or platform.machine()
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -224,33 +237,40 @@ def table(results, width, ref_samples, cap) -> str:
         f"on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.",
         "",
         f"Scenes at width {width} px; DRT references {ref_samples} spp (SOBOL, another seed), Cycles "
-        f"against its own {ref_samples}-spp reference; sample cap {cap}. Seconds to reach each relMSE "
-        "(log-log interpolated between logged points; — = not reached); the ratio is Cycles' time "
-        "(without adaptive sampling) over this curve's time at relMSE 1e-3 (above 1: faster than Cycles). "
-        "DRT times exclude export and BVH build, Cycles times exclude its 1-sample render time.",
+        f"against its own {ref_samples}-spp reference; sample cap {cap}. CPU seconds of the process "
+        "(all threads) to reach each relMSE (log-log interpolated between logged points; — = not "
+        "reached); the ratio is Cycles' time (without adaptive sampling) over this curve's time at "
+        "relMSE 1e-3 (above 1: faster than Cycles). DRT times exclude export and BVH build, Cycles "
+        "times exclude its 1-sample render time. SOBOL+NOISE is one render per noise threshold "
+        f"({', '.join(f'{t:g}' for t in THRESHOLDS)}) with automatic minimum samples, as Cycles adaptive.",
         "",
+        "| scene | SOBOL+NOISE speed-up over SOBOL at 1e-3 | at 1e-4 |",
+        "|---|---|---|",
     ]
+    lines += [f"| {name} | {speedup(res, 2)} | {speedup(res, 3)} |" for name, res in results.items()]
+    lines.append("")
+    header = " | ".join(f"{lv:g}" for lv in LEVELS)
     for name, res in results.items():
-        lines += [f"## {name}", "", "| curve | 1e-2 | 3e-3 | 1e-3 | Cycles / this at 1e-3 |", "|---|---|---|---|---|"]
+        lines += [f"## {name}", "", f"| curve | {header} | Cycles / this at 1e-3 |",
+                  "|---" * (len(LEVELS) + 2) + "|"]
         base = res["Cycles"][2]
         for k in CURVES:
             t = res[k][2]
             ratio = f"{base / t:.2f}" if base is not None and t is not None else "—"
-            lines.append(f"| {k} | {fmt(res[k][0])} | {fmt(res[k][1])} | {fmt(res[k][2])} | {ratio} |")
-        s, a = res["SOBOL"][2], res["SOBOL+NOISE"][2]
-        if s is not None and a is not None:
-            lines += ["", f"SOBOL+NOISE reaches 1e-3 {s / a:.2f}x sooner than SOBOL."]
-        lines += ["", f"![{name}]({name}.png)", ""]
+            lines.append(f"| {k} | {' | '.join(fmt(v) for v in res[k])} | {ratio} |")
+        lines += ["", f"![{name}]({plots}/{name}.png)", ""]
     return "\n".join(lines) + "\n"
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--width", type=int, default=80)
+    parser.add_argument("--width", type=int, default=48)
     parser.add_argument("--reference-samples", type=int, default=2048)
     parser.add_argument("--cap", type=int, default=1024)
     parser.add_argument("--scenes", nargs="*", default=SCENES)
     parser.add_argument("--out", default=str(ROOT / "bench" / "results"))
+    parser.add_argument("--publish", action="store_true",
+                        help="also write bench/RESULTS.md and copy the plots to bench/plots/ (committed)")
     args = parser.parse_args(argv)
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -263,6 +283,13 @@ def main(argv=None):
     text = table(results, args.width, args.reference_samples, args.cap)
     (out_dir / "RESULTS.md").write_text(text)
     print(text)
+    if args.publish:
+        plots = ROOT / "bench" / "plots"
+        plots.mkdir(exist_ok=True)
+        for name in results:
+            shutil.copyfile(out_dir / f"{name}.png", plots / f"{name}.png")
+        (ROOT / "bench" / "RESULTS.md").write_text(table(results, args.width, args.reference_samples, args.cap,
+                                                          "plots"))
 
 
 if __name__ == "__main__":

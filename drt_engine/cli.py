@@ -5,11 +5,15 @@ stdout, so the real stderr carries exactly one line from us when something is wr
 (and nothing otherwise); the exit code says which.
 """
 import argparse
+import math
 import os
 import re
 import sys
 import time
 from pathlib import Path
+
+from .core import report
+from .core.settings import ADAPTIVE_MODES
 
 EXIT_ERROR = 1
 EXIT_USAGE = 2
@@ -53,6 +57,26 @@ def _at_least(minimum: int):
     return parse
 
 
+def _float_in(minimum: float, maximum: float = math.inf):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        if not (minimum <= value <= maximum) or not math.isfinite(value):
+            bounds = f"at least {minimum:g}" if maximum == math.inf else f"between {minimum:g} and {maximum:g}"
+            raise argparse.ArgumentTypeError(f"must be {bounds}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _mode(text: str) -> str:
+    if text.upper() not in ADAPTIVE_MODES:
+        raise argparse.ArgumentTypeError(f"must be one of {', '.join(ADAPTIVE_MODES)}, got {text!r}")
+    return text.upper()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m drt_engine", description="DRT, a distribution ray tracer for Blender scenes.")
     commands = parser.add_subparsers(dest="command", metavar="{render}", required=True, parser_class=_Parser)
@@ -61,6 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="render a .blend file with DRT",
         description="Render FILE.blend with DRT and write OUT: a multilayer EXR with every pass "
         "enabled on the view layers (.exr) or a PNG through the scene's view transform (.png). "
+        "Beside OUT it writes OUT's stem + .drt.json (settings, scene summary, stats and the "
+        "error-against-time log) and + .error.png (the log plotted). "
         "Overrides change the scene in memory only; the .blend file is never saved.",
     )
     render.add_argument("blend", metavar="FILE.blend", help="the scene to render (its active scene and camera)")
@@ -70,6 +96,16 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--frame", type=int, metavar="F", help="frame to render (default: the file's current frame)")
     render.add_argument("--resolution", type=_resolution, metavar="WxH", help="image size in pixels (at 100%%)")
     render.add_argument("--engine-threads", type=_at_least(0), metavar="T", help="render threads, 0 = all cores")
+    render.add_argument("--time-limit", type=_float_in(0.0), metavar="SECONDS",
+                        help="stop after this many seconds, 0 = none (scene.drt.time_limit)")
+    render.add_argument("--target-error", type=_float_in(0.0), metavar="E",
+                        help="stop when the estimated relMSE of the image is under E, 0 = none "
+                        "(scene.drt.target_error)")
+    render.add_argument("--adaptive-threshold", type=_float_in(0.0, 1.0), metavar="T",
+                        help="noise threshold, 0 = automatic; turns adaptive sampling on "
+                        "(scene.drt.adaptive_threshold)")
+    render.add_argument("--adaptive-mode", type=_mode, metavar="NOISE|CONTRAST",
+                        help="adaptive sampling mode; turns adaptive sampling on (scene.drt.adaptive_mode)")
     return parser
 
 
@@ -120,6 +156,7 @@ def _render(args) -> str:
     import bpy
 
     from . import register
+    from .blender import engine
 
     register()
     try:
@@ -142,13 +179,26 @@ def _render(args) -> str:
         scene.drt.seed = args.seed
     if args.engine_threads is not None:
         scene.drt.threads = args.engine_threads
+    if args.time_limit is not None:
+        scene.drt.time_limit = args.time_limit
+    if args.target_error is not None:
+        scene.drt.target_error = args.target_error
+    if args.adaptive_threshold is not None:
+        scene.drt.use_adaptive_sampling = True
+        scene.drt.adaptive_threshold = args.adaptive_threshold
+    if args.adaptive_mode is not None:
+        scene.drt.use_adaptive_sampling = True
+        scene.drt.adaptive_mode = args.adaptive_mode
 
+    engine.last_reports.clear()
     start = time.perf_counter()
     try:
         bpy.ops.render.render(write_still=False, scene=scene.name)
     except RuntimeError as error:
         raise CLIError(f"render failed: {_blender_message(error)}") from None
     elapsed = time.perf_counter() - start
+    if not engine.last_reports:
+        raise CLIError("the render produced no image")
 
     exr = output.suffix.lower() == ".exr"
     _set_output_format(render.image_settings, exr)
@@ -158,8 +208,32 @@ def _render(args) -> str:
         raise CLIError(f"cannot write {output}: {_blender_message(error)}") from None
     if not output.is_file():
         raise CLIError(f"cannot write {output}")
+    stats = _write_report(output, blend, args.frame, engine.last_reports)
     width, height = (side * render.resolution_percentage // 100 for side in (render.resolution_x, render.resolution_y))
-    return f"DRT: wrote {output} ({width}x{height}, {scene.drt.samples} samples, {elapsed:.1f} s)"
+    error = report.relative_error_text(math.inf if stats["relmse"] is None else stats["relmse"])
+    return (f"DRT: wrote {output} ({width}x{height}, {stats['samples']} samples, est. error {error}, "
+            f"stopped by {report.STOP_REASONS[stats['stopped_by']]}, {elapsed:.1f} s) and its report")
+
+
+def report_paths(output: Path) -> tuple[Path, Path]:
+    """``<OUT stem>.drt.json`` and ``<OUT stem>.error.png`` beside OUT."""
+    return output.with_name(output.stem + ".drt.json"), output.with_name(output.stem + ".error.png")
+
+
+def _write_report(output: Path, blend: Path, frame, reports: dict[str, dict]) -> dict:
+    """The first view layer's report at the top of the JSON, any others under ``other_view_layers``."""
+    json_path, plot_path = report_paths(output)
+    layers = list(reports.values())
+    data = {"file": str(blend), "output": str(output), "frame": frame, **layers[0]}
+    if len(layers) > 1:
+        data["other_view_layers"] = layers[1:]
+    try:
+        report.write_json(json_path, data)
+        report.plot_log(plot_path, {name: r["log"] for name, r in reports.items()},
+                        f"{blend.stem}: estimated error vs time")
+    except OSError as error:
+        raise CLIError(f"cannot write the report beside {output}: {error.strerror or error}") from None
+    return layers[0]["stats"]
 
 
 def main(argv=None) -> int:

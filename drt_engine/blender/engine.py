@@ -6,6 +6,7 @@ pastes the result into the full frame itself when "Crop to Render Region" is off
 the engine always writes the ``camera.window`` rectangle at (0, 0) of its result.
 """
 import dataclasses
+import json
 import time
 import traceback
 import weakref
@@ -13,6 +14,7 @@ import weakref
 import bpy
 import numpy as np
 
+from ..core import report
 from ..core.errors import DRTError, RenderCancelled
 from .properties import enabled_passes, pass_layout, settings_from_scene
 
@@ -39,6 +41,14 @@ def render_window(render, width: int, height: int) -> tuple[int, int, int, int]:
     return x0, y0, x1, y1
 
 
+last_reports: dict[str, dict] = {}
+"""The report (core.report.report_dict) of the newest final render of each view layer, by name.
+
+The CLI runs Blender's render operator in its own process; this is how it gets the
+engine's settings, stats and error log back to write ``<OUT stem>.drt.json``.
+"""
+
+
 def write_passes(result, passes: dict) -> None:
     """Copy the core's (h, w, C) arrays, rows bottom-to-top like Blender's, into a render result."""
     layer_passes = result.layers[0].passes
@@ -60,6 +70,47 @@ def viewport_settings(settings):
 
     return dataclasses.replace(settings, samples=min(settings.samples, MAX_SAMPLES), passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0)
+
+
+def stats_line(samples_done: int, samples_total: int, relmse: float, elapsed: float) -> str:
+    """The live stats line: 'Sample 12/64 | est. error 0.8% | 12.3 s'."""
+    return (f"Sample {samples_done}/{samples_total} | est. error {report.relative_error_text(relmse)} "
+            f"| {elapsed:.1f} s")
+
+
+def done_line(stats: dict, cancelled: bool) -> str:
+    """The last stats line: samples, estimated error, time, what stopped the render, the render plan."""
+    relmse = stats.get("relmse")
+    error = report.relative_error_text(float("inf") if relmse is None else relmse)
+    state = "Cancelled" if cancelled else "Done"
+    samples = f"{stats['samples']} samples"
+    if stats.get("adaptive_threshold") is not None:
+        samples += f" (mean {stats['samples_mean']:.1f})"
+    stopped = "" if cancelled else f" | stopped by {report.STOP_REASONS[stats['stopped_by']]}"
+    plan = f" | {stats['plan_summary']}" if stats.get("plan_summary") else ""
+    return f"{state} | {samples} | est. error {error} | {stats['elapsed']:.2f} s{stopped}{plan}"
+
+
+def stamp_report(engine, view_layer: str, outcome) -> None:
+    """The stop reason, estimated error and the whole error log as the render's metadata.
+
+    Fields go on the engine's whole result (as Cycles stamps ``cycles.<layer>.samples``;
+    a result from begin_result drops them when it is merged), named ``drt.<layer>.*``,
+    and Blender writes them into EXR headers and PNG text with its other metadata.
+    """
+    result = engine.get_result()
+    if result is None or not hasattr(result, "stamp_data_add_field"):
+        return
+    stats = outcome.stats
+    fields = {
+        "stopped_by": stats["stopped_by"],
+        "samples": str(stats["samples"]),
+        "elapsed": f"{stats['elapsed']:.3f}",
+        "est_relmse": "" if stats.get("relmse") is None else f"{stats['relmse']:.6g}",
+        "error_log": json.dumps(report.json_safe(outcome.log), separators=(",", ":")),
+    }
+    for name, value in fields.items():
+        result.stamp_data_add_field(f"drt.{view_layer}.{name}", value)
 
 
 def _one_line(text: str) -> str:
@@ -120,15 +171,20 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         try:
             outcome = renderer.render(progress=self._progress_callback(result))
             write_passes(result, outcome.passes)
+            if not self.is_preview:
+                summary = report.report_dict(settings, outcome.stats, outcome.log,
+                                             report.scene_summary(scene_data))
+                summary["view_layer"] = view_layer.name
+                last_reports[view_layer.name] = summary
         finally:
             self.end_result(result)
+        if not self.is_preview:
+            stamp_report(self, view_layer.name, outcome)
         self._warn([w for w in getattr(outcome, "warnings", ()) if w not in scene_data.warnings])
         if not outcome.cancelled:
             self.update_progress(1.0)
         stats = outcome.stats
-        state = "Cancelled" if outcome.cancelled else "Done"
-        self.update_stats("", f"{state} | {stats.get('samples', settings.samples)} samples "
-                          f"| {stats.get('elapsed', 0.0):.2f} s | {stats.get('plan_summary', '')}")
+        self.update_stats("", done_line(stats, outcome.cancelled))
         if not self.is_preview:  # the console (and the CLI's output) shows what the scene left out
             rays = ", ".join(f"{k} {v}" for k, v in stats.get("rays", {}).items())
             print(f"DRT: {stats.get('plan_summary', '')}\nDRT: rays traced: {rays}", flush=True)
@@ -145,8 +201,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         def progress(update) -> bool:
             nonlocal last_display
             self.update_progress(min(max(update.fraction, 0.0), 1.0))
-            self.update_stats("", f"Sample {update.samples_done}/{update.samples_total} "
-                              f"| Elapsed {update.elapsed:.1f} s")
+            self.update_stats("", stats_line(update.samples_done, update.samples_total, update.error,
+                                             update.elapsed))
             now = time.monotonic()
             if now - last_display >= DISPLAY_INTERVAL:
                 write_passes(result, {"Combined": update.passes()["Combined"]})

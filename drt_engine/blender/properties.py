@@ -65,6 +65,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         use_adaptive_sampling=drt.use_adaptive_sampling,
         adaptive_threshold=drt.adaptive_threshold,
         adaptive_min_samples=drt.adaptive_min_samples,
+        adaptive_mode=drt.adaptive_mode,
         time_limit=drt.time_limit,
         target_error=drt.target_error,
     )
@@ -143,12 +144,26 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     use_adaptive_sampling: BoolProperty(
         name="Adaptive Sampling",
-        description="Stop sampling pixels whose estimated error is below the noise threshold",
+        description="After the minimum samples, stop sampling pixels that need no more, "
+        "testing every 16 samples (as Cycles)",
         default=False,
+    )
+    adaptive_mode: EnumProperty(
+        name="Mode",
+        description="How a pixel is judged to need more samples",
+        items=(
+            ("NOISE", "Noise", "Until the estimated error of the pixel's mean is under the noise "
+             "threshold, with Cycles' measure and threshold"),
+            ("CONTRAST", "Contrast", "While the samples in the pixel's 3x3 neighbourhood differ in "
+             "contrast beyond Mitchell's (1987) thresholds (the noise threshold is not used)"),
+        ),
+        default="NOISE",
     )
     adaptive_threshold: FloatProperty(
         name="Noise Threshold",
-        description="Relative standard error of a pixel below which it gets no more samples",
+        description="Noise level at which a pixel stops receiving samples, as Cycles' Noise "
+        "Threshold (its standard error relative to its brightness); 0 chooses it from the "
+        "samples, max(0.001, 1/samples)",
         default=0.01,
         min=0.0,
         soft_min=0.001,
@@ -157,8 +172,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     adaptive_min_samples: IntProperty(
         name="Min Samples",
-        description="Samples every pixel takes before the threshold is tested; 0 chooses "
-        "automatically from the threshold",
+        description="Samples every pixel takes before the first test; 0 chooses it from the "
+        "threshold as Cycles does",
         default=0,
         min=0,
     )
@@ -173,8 +188,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     target_error: FloatProperty(
         name="Target Error",
-        description="Stop the render once the estimated mean relative error of the image "
-        "falls below this; 0 means no target",
+        description="Stop the render once the estimated relative mean squared error of "
+        "the image (relMSE) falls below this; 0 means no target",
         default=0.0,
         min=0.0,
         soft_max=0.1,

@@ -111,7 +111,10 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
         drt = context.scene.drt
         layout.active = drt.use_adaptive_sampling
         col = layout.column()
-        col.prop(drt, "adaptive_threshold")
+        col.prop(drt, "adaptive_mode")
+        row = col.row()
+        row.active = drt.adaptive_mode == "NOISE"
+        row.prop(drt, "adaptive_threshold")
         col.prop(drt, "adaptive_min_samples")
 
 

@@ -33,6 +33,7 @@ from .settings import RenderSettings
 
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
 _MIN_PIECE = 1 << 12  # fewest camera samples in one thread's piece of a wave (smaller waves stay whole)
+_FIRST_TIMED_WAVE = 1 << 12  # under a time limit, the wave that measures the rate
 _TINY = 1e-30
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 
@@ -58,6 +59,20 @@ class ProgressUpdate:
 
     def passes(self) -> dict:
         return self._film.images()
+
+
+def _wave_size(time_limit: float, elapsed: float, traced: int) -> int:
+    """Samples in the next wave: WAVE, or under a time limit what fits in the time left.
+
+    The rate so far (every cost included) predicts the time a wave takes, so the render
+    ends close to the limit instead of up to a whole wave after it.
+    """
+    if time_limit <= 0:
+        return WAVE
+    if traced == 0 or elapsed <= 0:
+        return _FIRST_TIMED_WAVE
+    fits = int(traced / elapsed * (time_limit - elapsed))
+    return min(WAVE, max(_FIRST_TIMED_WAVE // 4, fits))
 
 
 def _power(a, b):
@@ -137,6 +152,7 @@ class Renderer:
         pixel draws sample ids 0, 1, 2, ... in order, so its sequence stays stratified.
         """
         start = time.perf_counter()
+        log = ErrorLog()
         s = self.settings
         w, h = self.camera.window_size
         x0, y0, _, _ = self.camera.window
@@ -145,7 +161,6 @@ class Renderer:
         threshold = adaptive.effective_threshold(s.adaptive_threshold, cap)
         first = adaptive.first_test(adaptive.min_samples(threshold, s.adaptive_min_samples))
         points = adaptive.checkpoints(cap, first if s.use_adaptive_sampling else cap)
-        log = ErrorLog()
         replicas = adaptive.replicate_samplers(s.sampling_pattern, cap, s.seed)
         main_sampler = self.sampler
         active = np.arange(n_pix)
@@ -174,22 +189,29 @@ class Renderer:
             update = ProgressUpdate(min(fraction, 1.0), done, cap, elapsed, self.film, error, entry)
             return progress is None or progress(update) is not False
 
+        target = 0
         try:
-            for target in points:
+            while True:
+                target = adaptive.next_checkpoint(points, target, len(active), first)
                 base = self.film.count[active]
                 need = (target - base).astype(np.int64)
                 keep = need > 0
                 pix, base, need = active[keep], base[keep], need[keep]
                 left = int(need.sum())
                 for wave_pix, wave_sample in _waves(pix, base.astype(np.int64), need):
-                    trace(wave_pix, wave_sample)
-                    traced += len(wave_pix)
-                    left -= len(wave_pix)
-                    if s.time_limit > 0 and time.perf_counter() - start >= s.time_limit:
-                        stopped = "time_limit"
-                        break
-                    if left > 0 and not notify(target - 1):
-                        stopped = "cancelled"
+                    a = 0
+                    while a < len(wave_pix):  # one piece, or under a time limit what fits in the time left
+                        size = _wave_size(s.time_limit, time.perf_counter() - start, traced)
+                        trace(wave_pix[a:a + size], wave_sample[a:a + size])
+                        count = len(wave_pix[a:a + size])
+                        a, traced, left = a + size, traced + count, left - count
+                        if s.time_limit > 0 and time.perf_counter() - start >= s.time_limit:
+                            stopped = "time_limit"
+                            break
+                        if left > 0 and not notify(target - 1):
+                            stopped = "cancelled"
+                            break
+                    if stopped:
                         break
                 if stopped:
                     break
@@ -219,7 +241,7 @@ class Renderer:
         last = log.last or {}
         stats = {"samples": int(self.film.count.max()) if n_pix else 0, "samples_requested": cap,
                  "samples_mean": float(self.film.count.mean()) if n_pix else 0.0,
-                 "elapsed": elapsed, "rays": dict(self.rays), "threads": self.threads,
+                 "elapsed": elapsed, "cpu": log.cpu(), "rays": dict(self.rays), "threads": self.threads,
                  "triangles": self.geometry.triangle_count, "light_strategies": self.lights.strategies,
                  "stopped_by": stopped or "samples", "rmse": last.get("rmse"), "relmse": last.get("relmse"),
                  "adaptive_threshold": threshold if s.use_adaptive_sampling else None,

@@ -1,6 +1,7 @@
 """The error-against-time log of a render, and the files made from it.
 
-Every adaptive step of ``Renderer.render`` appends one entry: seconds since the start,
+Every adaptive step of ``Renderer.render`` appends one entry: seconds since the start
+(wall clock, and CPU seconds of the process, which a loaded machine disturbs less),
 camera samples traced, rays by kind, the fraction of pixels still sampling and the
 estimated RMSE and relMSE of the image (``adaptive.image_error``). The CLI writes the
 log as ``<stem>.drt.json`` and draws it as ``<stem>.error.png``.
@@ -10,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -22,11 +24,17 @@ class ErrorLog:
 
     def __init__(self):
         self.entries: list[dict] = []
+        self._cpu_start = time.process_time()
+
+    def cpu(self) -> float:
+        """CPU seconds of the whole process (every thread) since the log began."""
+        return time.process_time() - self._cpu_start
 
     def record(self, elapsed: float, film, rays: dict, active_fraction: float, stopped: str | None = None):
         rmse, relmse = image_error(film)
         entry = {
             "elapsed": float(elapsed),
+            "cpu": self.cpu(),
             "samples": int(film.count.sum()),
             "spp_max": int(film.count.max()) if film.n else 0,
             "spp_mean": float(film.count.mean()) if film.n else 0.0,
@@ -45,6 +53,16 @@ class ErrorLog:
         return self.entries[-1] if self.entries else None
 
 
+STOP_REASONS = {
+    "samples": "sample cap",
+    "threshold": "noise threshold",
+    "time_limit": "time limit",
+    "target_error": "target error",
+    "cancelled": "cancelled",
+}
+"""What ``stats['stopped_by']`` means, as the stats line and the CLI say it."""
+
+
 def relative_error_text(relmse: float) -> str:
     """The estimated relative RMS error as the stats line shows it ('0.8%'), or '?' while unknown."""
     if not math.isfinite(relmse):
@@ -53,15 +71,36 @@ def relative_error_text(relmse: float) -> str:
     return f"{pct:.2g}%" if pct < 1 else f"{pct:.1f}%"
 
 
-def _finite(value):
+def json_safe(value):
     """JSON has no infinity: unknown estimates become null."""
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
+        return {k: json_safe(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
+        return [json_safe(v) for v in value]
     return value
+
+
+def scene_summary(scene) -> dict:
+    """What was rendered, from a core.scene.SceneData: image, camera, geometry, materials, lights."""
+    camera = scene.camera
+    lights: dict[str, int] = {}
+    for light in scene.lights:
+        lights[light.kind] = lights.get(light.kind, 0) + 1
+    return {
+        "resolution": [int(v) for v in camera.resolution],
+        "window": [int(v) for v in camera.window],
+        "camera": camera.type,
+        "depth_of_field": bool(camera.aperture_radius > 0),
+        "meshes": len(scene.meshes),
+        "instances": len(scene.instances),
+        "triangles": int(sum(len(m.triangles) for m in scene.meshes)),
+        "materials": len(scene.materials),
+        "lights": lights,
+        "world": [float(v) for v in scene.world.radiance],
+        "film_transparent": bool(scene.film_transparent),
+    }
 
 
 def report_dict(settings, stats: dict, log: list[dict], scene: dict | None = None) -> dict:
@@ -69,7 +108,7 @@ def report_dict(settings, stats: dict, log: list[dict], scene: dict | None = Non
     settings_dict = dataclasses.asdict(settings) if dataclasses.is_dataclass(settings) else dict(settings)
     settings_dict.pop("extra", None)
     settings_dict["passes"] = list(settings_dict.get("passes", ()))
-    return _finite({"settings": settings_dict, "scene": scene or {}, "stats": stats, "log": log})
+    return json_safe({"settings": settings_dict, "scene": scene or {}, "stats": stats, "log": log})
 
 
 def write_json(path, report: dict) -> None:
@@ -150,7 +189,10 @@ def plot_loglog(path, curves, title: str, xlabel: str = "time (s)", ylabel: str 
         raise OSError(f"cannot write {path}: {buf.geterror()}")
 
 
-def plot_log(path, log: list[dict], title: str = "") -> None:
-    """The CLI's plot: estimated relMSE and RMSE of the image against render time."""
-    plot_loglog(path, [("est. relMSE", error_curve(log, "relmse")), ("est. RMSE", error_curve(log, "rmse"))],
-                title or "estimated error vs time", ylabel="error")
+def plot_log(path, logs: dict[str, list[dict]], title: str = "") -> None:
+    """The CLI's plot: estimated relMSE and RMSE against render time, for each view layer's log."""
+    curves = []
+    for layer, log in logs.items():
+        suffix = f" {layer}" if len(logs) > 1 else ""
+        curves += [(f"est. relMSE{suffix}", error_curve(log, "relmse")), (f"est. RMSE{suffix}", error_curve(log, "rmse"))]
+    plot_loglog(path, curves, title or "estimated error vs time", ylabel="error")

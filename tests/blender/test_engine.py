@@ -4,14 +4,18 @@ Scenes are an emissive plane (strength 2) filling the view of a camera 5 m above
 so every pixel's Combined is exactly 2, its depth exactly 5 and its normal +Z, at
 any sample count: the facts below do not depend on noise.
 """
+import json
+import re
 import time
 from types import SimpleNamespace
 
 import bpy
 import numpy as np
+import OpenImageIO as oiio
 import pytest
 
 import drt_engine.blender.engine as engine_module
+from drt_engine.core import adaptive
 from drt_engine.blender.engine import DRTRenderEngine, render_window
 from drt_engine.core.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
@@ -201,7 +205,9 @@ def test_progress_callback_reports_and_refreshes_the_image(monkeypatch):
     assert len(fake.progress) >= 3
     assert all(0 < a < b for a, b in zip(fake.progress, fake.progress[1:]))
     assert fake.progress[-1] == pytest.approx(1.0)
-    assert fake.stats[0].startswith(f"Sample 1/{samples} | ") and fake.stats[0].endswith(" s")
+    first = adaptive.next_checkpoint(adaptive.checkpoints(samples, samples), 0, 64 * 64, samples)
+    # the emitter is noiseless: the estimated error is known from the first checkpoint on
+    assert re.fullmatch(rf"Sample {first}/{samples} \| est\. error 0% \| \d+\.\d s", fake.stats[0]), fake.stats[0]
     assert len(fake.displayed) == len(fake.progress)
     for image in fake.displayed:
         np.testing.assert_allclose(image.reshape(64, 64, 4)[..., :3], STRENGTH, rtol=1e-4)
@@ -218,7 +224,9 @@ def test_cancel_returns_promptly_with_the_image_so_far():
     assert outcome.cancelled and len(fake.progress) == 1
     np.testing.assert_allclose(outcome.passes["Combined"][..., :3], STRENGTH, rtol=1e-4)
     counts = outcome.passes["Sample Count"]
-    assert np.all(counts == 1)  # the first checkpoint (1 sample in every pixel), then the stop
+    first = adaptive.next_checkpoint(adaptive.checkpoints(settings.samples, settings.samples), 0, 64 * 64,
+                                     settings.samples)
+    assert np.all(counts == first)  # the first checkpoint (the same samples in every pixel), then the stop
 
 
 def test_pass_toggles_update_the_compositor_sockets(bl):
@@ -238,3 +246,34 @@ def test_pass_toggles_update_the_compositor_sockets(bl):
     assert sockets() == {"Image", "Alpha", "Noise", "Sample Count", "Normal"}
     view_layer.drt.use_pass_noise = False
     assert sockets() == {"Image", "Alpha", "Sample Count", "Normal"}
+
+
+def test_adaptive_render_reports_its_error_log_in_the_metadata(bl, tmp_path):
+    scene = bl.emission_scene(samples=64)
+    scene.drt.use_adaptive_sampling = True
+    scene.drt.adaptive_min_samples = 8
+    engine_module.last_reports.clear()
+    path = tmp_path / "adaptive.exr"
+    bl.render_exr(scene, path)
+    image = oiio.ImageInput.open(str(path))
+    metadata = {a.name: a.value for a in image.spec().extra_attribs}
+    image.close()
+    # a noiseless emitter: every pixel converges at the first test
+    assert metadata[f"drt.{LAYER}.stopped_by"] == "threshold"
+    assert metadata[f"drt.{LAYER}.samples"] == str(adaptive.first_test(8))
+    log = json.loads(metadata[f"drt.{LAYER}.error_log"])
+    report = engine_module.last_reports[LAYER]
+    assert log == report["log"] and log[-1]["stopped"] == "threshold"
+    assert report["settings"]["use_adaptive_sampling"] and report["settings"]["adaptive_mode"] == "NOISE"
+    assert report["scene"]["resolution"] == [16, 12] and report["view_layer"] == LAYER
+
+
+def test_done_line_says_what_stopped_the_render():
+    renderer = Renderer(emitter_scene_data(16), RenderSettings(samples=64, threads=1, use_adaptive_sampling=True,
+                                                                adaptive_min_samples=8))
+    outcome = renderer.render()
+    line = engine_module.done_line(outcome.stats, outcome.cancelled)
+    assert re.fullmatch(r"Done \| 16 samples \(mean 16\.0\) \| est\. error 0% \| \d+\.\d\d s "
+                        r"\| stopped by noise threshold", line), line
+    assert engine_module.stats_line(12, 64, 6.4e-5, 12.34) == "Sample 12/64 | est. error 0.8% | 12.3 s"
+    assert engine_module.stats_line(1, 64, float("inf"), 0.0) == "Sample 1/64 | est. error ? | 0.0 s"

@@ -100,11 +100,13 @@ def test_scene_settings_defaults(drt):
     assert drt_settings.use_adaptive_sampling is False
     assert drt_settings.adaptive_threshold == pytest.approx(0.01)
     assert drt_settings.adaptive_min_samples == 0
+    assert drt_settings.adaptive_mode == "NOISE"
     assert drt_settings.time_limit == 0.0
     assert drt_settings.target_error == 0.0
     rna = properties.DRTSceneSettings.bl_rna.properties
     assert {i.identifier for i in rna["sampling_pattern"].enum_items} == {"GRID", "JITTERED", "SOBOL"}
     assert {i.identifier for i in rna["filter_type"].enum_items} == {"BOX", "GAUSSIAN", "BLACKMAN_HARRIS"}
+    assert {i.identifier for i in rna["adaptive_mode"].enum_items} == {"NOISE", "CONTRAST"}
     assert rna["samples"].hard_min == 1
     drt_settings.samples = 0
     assert drt_settings.samples == 1
@@ -131,6 +133,7 @@ def test_settings_from_scene(drt):
     d.samples, d.seed, d.sampling_pattern, d.max_depth = 9, 7, "JITTERED", 3
     d.clamp, d.threads, d.filter_type = 4.5, 2, "GAUSSIAN"
     d.use_adaptive_sampling, d.adaptive_threshold, d.adaptive_min_samples = True, 0.05, 16
+    d.adaptive_mode = "CONTRAST"
     d.time_limit, d.target_error = 12.0, 0.02
     scene.render.filter_size = 2.25
     view_layer.use_pass_z = True
@@ -141,7 +144,7 @@ def test_settings_from_scene(drt):
         samples=9, seed=7, sampling_pattern="JITTERED", max_depth=3, clamp=4.5, threads=2,
         filter_type="GAUSSIAN", filter_size=2.25, passes=("Combined", "Depth", "Env", "Noise"),
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,
-        time_limit=12.0, target_error=pytest.approx(0.02),
+        adaptive_mode="CONTRAST", time_limit=12.0, target_error=pytest.approx(0.02),
     )
     view_layer.use_pass_z = view_layer.use_pass_environment = view_layer.drt.use_pass_noise = False
     assert properties.settings_from_scene(scene, view_layer).passes == ("Combined",)

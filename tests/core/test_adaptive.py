@@ -1,0 +1,208 @@
+"""Adaptive sampling and the stop rules: who gets samples, when the render stops, and what it returns.
+
+The test scene is a floor seen from above: its left half an emitter (every sample
+sees the same radiance, so its pixels have no noise at all), its right half a diffuse
+floor lit by a large area light just above it (light sampling makes it noisy: about 3%
+relative standard error at 16 samples).
+"""
+import time
+
+import numpy as np
+import pytest
+
+from drt_engine.core import adaptive
+from drt_engine.core.film import Film
+from drt_engine.core.render import Renderer
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
+from drt_engine.core.settings import RenderSettings
+from scenes import translation
+
+RES = 24
+EMISSION = 0.5
+PASSES = ("Combined", "Sample Count", "Noise")
+
+
+def half_plane(name, x0, x1, material):
+    v = [[x0, -2, 0], [x1, -2, 0], [x1, 2, 0], [x0, 2, 0]]
+    return Mesh(name, v, [[0, 1, 2], [0, 2, 3]], [material, material])
+
+
+def halves_scene(right="LIT", res=RES):
+    """Left: emitter of radiance 0.5. Right: lit diffuse floor ("LIT") or an emitter of radiance ``right``."""
+    camera = Camera(translation(0, 0, 1)[None], (-1, 1, -1, 1), (res, res))
+    materials = [Material("emitter", [Closure("EMISSION", emission=(EMISSION,) * 3)])]
+    lights = []
+    if right == "LIT":
+        materials.append(Material("floor", [Closure("DIFFUSE", color=(0.5,) * 3)]))
+        lights.append(Light("AREA", translation(0.5, 0, 0.1), radiance=np.full(3, 4.0), size_x=3.0))
+    else:
+        materials.append(Material("emitter2", [Closure("EMISSION", emission=(right,) * 3)]))
+    meshes = [half_plane("left", -2, 0, 0), half_plane("right", 0, 2, 1)]
+    return SceneData(camera, meshes, [Instance(0, np.eye(4)), Instance(1, np.eye(4))], materials, lights)
+
+
+def render(scene=None, progress=None, **kw):
+    settings = RenderSettings(**{"samples": 128, "threads": 1, "passes": PASSES, **kw})
+    return Renderer(scene or halves_scene(), settings).render(progress=progress)
+
+
+def columns(counts):
+    """Mean sample count of the flat interior of the left half and of the right half."""
+    counts = counts[..., 0]
+    return counts[:, : RES // 2 - 3].mean(), counts[:, RES // 2 + 2:].mean()
+
+
+def assert_consistent(result):
+    """The passes are those of the samples the render traced, and the log ends where the image is."""
+    counts = result.passes["Sample Count"][..., 0]
+    assert counts.sum() == result.stats["rays"]["camera"]  # only the samples counted were traced
+    assert counts.max() == result.stats["samples"]
+    assert result.log[-1]["samples"] == counts.sum()
+    assert result.log[-1].get("stopped") == result.stats["stopped_by"]
+    for name, image in result.passes.items():
+        assert np.isfinite(image).all(), name
+
+
+# -- Cycles' semantics -----------------------------------------------------------------
+
+def test_automatic_threshold_and_min_samples_are_cycles():
+    # scene/integrator.cpp: threshold 0 -> max(0.001, 1 / samples); min 0 -> max(4, ceil(16 / threshold^0.3))
+    assert adaptive.effective_threshold(0.0, 256) == pytest.approx(1 / 256)
+    assert adaptive.effective_threshold(0.0, 4096) == pytest.approx(0.001)
+    assert adaptive.effective_threshold(0.02, 256) == 0.02
+    assert adaptive.min_samples(0.01, 0) == 64  # ceil(16 / 0.01^0.3) = ceil(63.7)
+    assert adaptive.min_samples(1 / 256, 0) == 85  # ceil(16 * 256^0.3) = ceil(84.4)
+    assert adaptive.min_samples(0.01, 24) == 24
+    # the first test is at 0-based sample (min + 1) | 15, i.e. after that many + 1 samples
+    assert adaptive.first_test(64) == 80 and adaptive.first_test(8) == 16 and adaptive.first_test(85) == 96
+
+
+def test_threshold_zero_is_automatic_in_a_render():
+    result = render(samples=128, use_adaptive_sampling=True, adaptive_threshold=0.0)
+    assert result.stats["adaptive_threshold"] == pytest.approx(1 / 128)
+    assert result.stats["adaptive_first_test"] == adaptive.first_test(adaptive.min_samples(1 / 128, 0)) == 80
+    assert result.passes["Sample Count"].min() >= 80
+
+
+# -- noise-adaptive ---------------------------------------------------------------------
+
+def test_noise_adaptive_stops_converged_pixels_and_traces_only_active_ones():
+    result = render(samples=256, use_adaptive_sampling=True, adaptive_threshold=0.002, adaptive_min_samples=8)
+    counts = result.passes["Sample Count"]
+    flat, noisy = columns(counts)
+    first = adaptive.first_test(8)
+    assert counts.min() == first  # every pixel took the minimum; the noiseless ones stopped at the first test
+    assert flat == first
+    assert noisy > 3 * flat
+    assert len(np.unique(counts)) > 3  # a real per-pixel count, not one number
+    assert_consistent(result)
+    active = [e["active"] for e in result.log]
+    assert 0 < min(active) < 0.75
+
+
+def test_min_samples_are_honoured():
+    for requested in (8, 40):
+        result = render(samples=128, use_adaptive_sampling=True, adaptive_threshold=0.5, adaptive_min_samples=requested)
+        assert result.passes["Sample Count"].min() == adaptive.first_test(requested) > requested
+
+
+def test_a_noiseless_image_stops_by_the_threshold():
+    result = render(halves_scene(EMISSION), samples=256, use_adaptive_sampling=True, adaptive_min_samples=8)
+    assert result.stats["stopped_by"] == "threshold"
+    assert result.passes["Sample Count"].max() == adaptive.first_test(8)
+    assert_consistent(result)
+
+
+def test_contrast_mode_refines_the_edge_only():
+    # two noiseless emitters: the only contrast of the image is the edge between them
+    result = render(halves_scene(0.05), samples=96, use_adaptive_sampling=True, adaptive_mode="CONTRAST",
+                    adaptive_min_samples=8)
+    counts = result.passes["Sample Count"][..., 0]
+    first = adaptive.first_test(8)
+    edge = counts[:, RES // 2 - 1: RES // 2 + 1]
+    assert (edge == 96).all()  # samples keep differing across an edge: refined to the cap
+    assert (counts[:, : RES // 2 - 3] == first).all() and (counts[:, RES // 2 + 3:] == first).all()
+    assert_consistent(result)
+
+
+# -- the error estimate -------------------------------------------------------------------
+
+def test_noise_pass_is_the_standard_error_of_the_pixel_mean():
+    """Pooled over pixels and seeds, the Noise pass squared is the squared error against a reference."""
+    scene = halves_scene()
+    reference = render(scene, samples=2048, seed=99, passes=("Combined", "Noise"))
+    ref = reference.passes["Combined"][..., :3]
+    ref_var = reference.passes["Noise"] ** 2
+    right = np.s_[:, RES // 2 + 2:]
+    squared_error, estimate = [], []
+    for seed in range(6):
+        result = render(scene, samples=32, seed=seed)
+        squared_error.append(((result.passes["Combined"][..., :3] - ref) ** 2 - ref_var)[right].mean())
+        estimate.append((result.passes["Noise"] ** 2)[right].mean())
+        assert (result.passes["Sample Count"] == 32).all()
+        assert (result.passes["Noise"][:, : RES // 2 - 3] == 0).all()  # the emitter's samples are all equal: no error, and none estimated
+    ratio = np.sqrt(np.mean(estimate) / np.mean(squared_error))
+    assert 1 / 1.3 < ratio < 1.3, ratio
+
+
+def test_film_error_of_independent_halves_is_unbiased():
+    """Samples of a known variance: the film's estimate of the mean's variance averages to var / n."""
+    rng = np.random.default_rng(3)
+    film = Film(2000, 1, ("Combined",))
+    n = 16
+    pixel = np.repeat(np.arange(2000), n)
+    values = rng.normal(1.0, 0.2, (len(pixel), 4))
+    film.replicate = 0
+    film.add(pixel[::2], {"Combined": values[::2]}, np.zeros(len(pixel) // 2, np.uint32))
+    film.replicate = 1
+    film.add(pixel[1::2], {"Combined": values[1::2]}, np.zeros(len(pixel) // 2, np.uint32))
+    assert film.variance().mean() == pytest.approx(0.04 / n, rel=0.08)
+
+
+# -- stop rules ---------------------------------------------------------------------------
+
+def test_target_error_stops_at_the_first_step_under_it():
+    result = render(samples=4096, use_adaptive_sampling=True, adaptive_threshold=0.001, adaptive_min_samples=8,
+                    target_error=2e-4)
+    assert result.stats["stopped_by"] == "target_error"
+    log = result.log
+    assert log[-1]["relmse"] < 2e-4 <= log[-2]["relmse"]
+    assert result.stats["samples"] < 4096
+    assert result.stats["relmse"] == log[-1]["relmse"]
+    assert_consistent(result)
+
+
+def test_time_limit_stops_the_render_in_time():
+    # minutes of work at full samples; two seconds allowed
+    renderer = Renderer(halves_scene(res=64), RenderSettings(samples=4096, threads=1, passes=PASSES, time_limit=2.0))
+    start = time.perf_counter()
+    result = renderer.render()
+    wall = time.perf_counter() - start
+    assert result.stats["stopped_by"] == "time_limit"
+    assert 2.0 <= wall < 2.5, wall
+    assert result.stats["samples"] < 4096
+    assert_consistent(result)
+
+
+def test_cancel_mid_round_returns_a_consistent_image():
+    calls = []
+
+    def progress(update):
+        calls.append(update)
+        return len(calls) < 3
+
+    result = render(halves_scene(res=64), samples=4096, progress=progress)
+    assert result.cancelled and result.stats["stopped_by"] == "cancelled"
+    assert_consistent(result)
+
+
+def test_the_log_is_monotone_and_ends_at_the_cap():
+    result = render(samples=128, use_adaptive_sampling=True, adaptive_threshold=0.002, adaptive_min_samples=8)
+    log = result.log
+    assert len(log) >= 3
+    for key in ("elapsed", "cpu", "samples"):
+        values = [e[key] for e in log]
+        assert all(a <= b for a, b in zip(values, values[1:])), key
+    assert all(0 < e["active"] <= 1 for e in log)
+    assert result.stats["stopped_by"] in ("samples", "threshold")
+    assert_consistent(result)
