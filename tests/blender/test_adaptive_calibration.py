@@ -1,0 +1,84 @@
+"""The estimated error of a render tracks its true error, on every sample scene.
+
+At every logged step, the estimated RMSE of the image (``adaptive.image_error``, from
+the film's two independent replicates) is within a factor of 1.5 of the true RMSE
+against a reference of 1024 samples with another seed, less the reference's own
+estimated variance. Both are pooled over four seeds: at 32 pixels wide the error of
+glossy_spheres sits in the handful of pixels that hold the gold sphere's highlight, so
+one render's true error is itself a sum of a few squares (one seed alone ranged from
+0.5 to 1.9 times its estimate). Adaptive renders are compared at every step all four
+seeds logged (their rounds follow their own active pixels), which always includes the
+first test.
+"""
+import bpy
+import numpy as np
+import pytest
+
+from drt_engine.blender.export import export_scene
+from drt_engine.core.adaptive import first_test, true_error
+from drt_engine.core.render import Renderer
+from drt_engine.core.settings import RenderSettings
+from test_sample_scenes import SCENES, SCENES_DIR
+
+WIDTH = 32
+REFERENCE_SAMPLES = 1024
+CAP = 64
+SEEDS = range(4)
+FACTOR = 1.5
+MIN_SAMPLES = 8
+
+
+@pytest.fixture(scope="module", params=SCENES)
+def scene(request, drt):
+    bpy.ops.wm.open_mainfile(filepath=str(SCENES_DIR / f"{request.param}.blend"), load_ui=False)
+    blender_scene = bpy.context.scene
+    render = blender_scene.render
+    aspect = render.resolution_y / render.resolution_x
+    render.resolution_x, render.resolution_y = WIDTH, max(4, round(WIDTH * aspect))
+    render.resolution_percentage = 100
+    render.use_border = False
+    data = export_scene(bpy.context.evaluated_depsgraph_get())
+    base = dict(max_depth=blender_scene.drt.max_depth, filter_type=blender_scene.drt.filter_type,
+                filter_size=render.filter_size, passes=("Combined", "Noise"))
+    reference = Renderer(data, RenderSettings(samples=REFERENCE_SAMPLES, seed=1 << 20, **base)).render().passes
+    truth = (reference["Combined"][..., :3].astype(float), reference["Noise"].astype(float) ** 2)
+    return request.param, data, base, truth
+
+
+def pooled_steps(scene, **settings) -> dict[int, tuple[float, float]]:
+    """{samples per pixel at a step: (estimated RMSE, true RMSE)}, mean squares over the seeds."""
+    _, data, base, truth = scene
+    per_seed = []
+    for seed in SEEDS:
+        steps = {}
+
+        def progress(update):
+            if update.entry is not None:
+                rmse, _ = true_error(update.passes()["Combined"][..., :3], *truth)
+                steps[update.entry["spp_max"]] = (update.entry["rmse"] ** 2, rmse ** 2)
+            return True
+
+        Renderer(data, RenderSettings(samples=CAP, seed=seed, **base, **settings)).render(progress=progress)
+        per_seed.append(steps)
+    common = sorted(set.intersection(*(set(s) for s in per_seed)))
+    return {spp: tuple(np.sqrt(np.mean([s[spp][k] for s in per_seed])) for k in (0, 1)) for spp in common}
+
+
+def assert_tracks(name, steps):
+    for spp, (estimated, true) in steps.items():
+        assert np.isfinite(estimated), (name, spp)
+        assert 1 / FACTOR < estimated / true < FACTOR, (name, spp, estimated, true)
+
+
+def test_estimated_error_tracks_the_true_error(scene):
+    steps = pooled_steps(scene)
+    assert len(steps) >= 2 and max(steps) == CAP
+    assert_tracks(scene[0], steps)
+
+
+@pytest.mark.parametrize("mode", ["NOISE", "CONTRAST"])
+def test_estimated_error_tracks_the_true_error_while_adapting(scene, mode):
+    steps = pooled_steps(scene, use_adaptive_sampling=True, adaptive_mode=mode, adaptive_threshold=0.01,
+                         adaptive_min_samples=MIN_SAMPLES)
+    assert first_test(MIN_SAMPLES) in steps
+    assert_tracks(f"{scene[0]} {mode}", {spp: v for spp, v in steps.items() if spp >= first_test(MIN_SAMPLES)})
