@@ -1,9 +1,9 @@
 """make bench: error against time for DRT's sampling strategies and for Cycles, per sample scene.
 
 For each scene (at a small resolution so the whole run takes minutes on two cores):
-- a DRT reference (SOBOL, many samples, another seed) and a Cycles reference; every
-  error below is the true relMSE against the renderer's own reference, less the
-  reference's own estimated variance;
+- a DRT reference (SOBOL, many samples, another seed) and a Cycles reference (the
+  mean of two seeds); every error below is the true relMSE against the renderer's own
+  reference, less the reference's own estimated variance;
 - DRT GRID and JITTERED: one render per sample count (their patterns depend on it);
 - DRT SOBOL: one progressive render, its error at every logged step;
 - DRT SOBOL + NOISE adaptive: one render per noise threshold (what a user would run);
@@ -186,9 +186,11 @@ def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
     log(f"  SOBOL+CONTRAST: last {pts[-1][0]:.1f} s {pts[-1][1]:.1e}")
 
     t = time.perf_counter()
-    cref, _ = cycles_run(scene, tmp, ref_samples, seed=12345)
-    log(f"  Cycles reference {ref_samples} spp: {time.perf_counter() - t:.1f} s")
-    cycles_ref = (cref, None)
+    cref_a, _ = cycles_run(scene, tmp, ref_samples, seed=12345)
+    cref_b, _ = cycles_run(scene, tmp, ref_samples, seed=54321)
+    # the mean of two seeds, and its variance from their difference: Var(mean) = E[(a - b)^2] / 4
+    cycles_ref = ((cref_a + cref_b) / 2, (cref_a - cref_b) ** 2 / 4)
+    log(f"  Cycles references 2 x {ref_samples} spp: {time.perf_counter() - t:.1f} s")
     _, overhead = cycles_run(scene, tmp, 1)
     pts = []
     for n in SWEEP:
@@ -237,7 +239,7 @@ def table(results, width, ref_samples, cap, plots=".") -> str:
         f"on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.",
         "",
         f"Scenes at width {width} px; DRT references {ref_samples} spp (SOBOL, another seed), Cycles "
-        f"against its own {ref_samples}-spp reference; sample cap {cap}. CPU seconds of the process "
+        f"against its own reference (two seeds of {ref_samples} spp), each less its reference's variance; sample cap {cap}. CPU seconds of the process "
         "(all threads) to reach each relMSE (log-log interpolated between logged points; — = not "
         "reached); the ratio is Cycles' time (without adaptive sampling) over this curve's time at "
         "relMSE 1e-3 (above 1: faster than Cycles). DRT times exclude export and BVH build, Cycles "
