@@ -77,6 +77,15 @@ def test_automatic_threshold_and_min_samples_are_cycles():
     assert adaptive.first_test(64) == 80 and adaptive.first_test(8) == 16 and adaptive.first_test(85) == 96
 
 
+def test_rounds_hold_enough_samples_but_keep_the_first_test_and_the_cap():
+    points = adaptive.checkpoints(256, 96)  # 1, 2, 4, ..., 64, 96, 112, ..., 240, 256
+    assert adaptive.next_checkpoint(points, 0, 1 << 20, 96) == 1  # a large image: every checkpoint
+    assert adaptive.next_checkpoint(points, 0, 1000, 96) == 32  # 1000 pixels x 32 >= MIN_ROUND
+    assert adaptive.next_checkpoint(points, 0, 100, 96) == 96  # never past the first test
+    assert adaptive.next_checkpoint(points, 96, 300, 96) == 160  # 300 x 64 >= MIN_ROUND
+    assert adaptive.next_checkpoint(points, 240, 1, 96) == 256  # never past the cap
+
+
 def test_threshold_zero_is_automatic_in_a_render():
     result = render(samples=128, use_adaptive_sampling=True, adaptive_threshold=0.0)
     assert result.stats["adaptive_threshold"] == pytest.approx(1 / 128)
