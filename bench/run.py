@@ -27,6 +27,7 @@ import json
 import math
 import os
 import platform
+import re
 import shutil
 import sys
 import tempfile
@@ -282,6 +283,16 @@ def table(results, width, ref_samples, cap, plots=".") -> str:
     return "\n".join(lines) + "\n"
 
 
+def publish_table(text):
+    """Write bench/RESULTS.md, keeping bench/throughput.py's section of it."""
+    from bench.throughput import MARK_BEGIN, MARK_END
+
+    path = ROOT / "bench" / "RESULTS.md"
+    old = path.read_text() if path.exists() else ""
+    kept = re.search(re.escape(MARK_BEGIN) + ".*?" + re.escape(MARK_END) + "\n?", old, re.S)
+    path.write_text(text + ("\n" + kept.group(0) if kept else ""))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=48)
@@ -308,8 +319,7 @@ def main(argv=None):
         plots.mkdir(exist_ok=True)
         for name in results:
             shutil.copyfile(out_dir / f"{name}.png", plots / f"{name}.png")
-        (ROOT / "bench" / "RESULTS.md").write_text(table(results, args.width, args.reference_samples, args.cap,
-                                                          "plots"))
+        publish_table(table(results, args.width, args.reference_samples, args.cap, "plots"))
 
 
 if __name__ == "__main__":
