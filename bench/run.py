@@ -42,13 +42,12 @@ import numpy as np  # noqa: E402
 import OpenImageIO as oiio  # noqa: E402
 
 import drt_engine  # noqa: E402
-from drt_engine.blender.export import export_scene  # noqa: E402
 from drt_engine.core.adaptive import true_error  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
 from drt_engine.core.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from scenes import SCENES, load  # noqa: E402
 
-SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
 LEVELS = (1e-2, 3e-3, 1e-3, 1e-4)
 SWEEP = (4, 16, 64, 256, 1024)
 THRESHOLDS = (0.16, 0.08, 0.04, 0.02, 0.01, 0.005, 0.0025, 0.00125)
@@ -155,13 +154,8 @@ def time_to(points, level):
 
 
 def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
-    bpy.ops.wm.open_mainfile(filepath=str(ROOT / "sample_scenes" / f"{name}.blend"), load_ui=False)
-    scene = bpy.context.scene
+    scene, data = load(name, width)
     r = scene.render
-    aspect = r.resolution_y / r.resolution_x
-    r.resolution_x, r.resolution_y, r.resolution_percentage = width, max(4, round(width * aspect)), 100
-    r.use_border = False
-    data = export_scene(bpy.context.evaluated_depsgraph_get())
     curves = {}
     log = print
 

@@ -34,27 +34,13 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import drt_engine  # noqa: E402
-from drt_engine.blender.export import export_scene  # noqa: E402
 from drt_engine.core import camera as camera_rays  # noqa: E402
 from drt_engine.core.render import WAVE, Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from scenes import SCENES, load  # noqa: E402
 
-SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
 TARGET_RATIO = 0.4
 MARK_BEGIN, MARK_END = "<!-- throughput: begin -->", "<!-- throughput: end -->"
-
-
-def load(name, width, height=None):
-    """The sample scene at ``width`` pixels (its own aspect unless ``height``), exported with its
-    motion over the shutter."""
-    bpy.ops.wm.open_mainfile(filepath=str(ROOT / "sample_scenes" / f"{name}.blend"), load_ui=False)
-    scene = bpy.context.scene
-    r = scene.render
-    aspect = r.resolution_y / r.resolution_x
-    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height or max(4, round(width * aspect)), 100
-    r.use_border = False
-    frame_set = lambda frame, sub: scene.frame_set(frame, subframe=sub)  # noqa: E731
-    return scene, export_scene(bpy.context.evaluated_depsgraph_get(), frame_set=frame_set)
 
 
 def settings(scene, **kw) -> RenderSettings:
@@ -137,9 +123,10 @@ def time_to_error(name, level=1e-3):
 
 MEMORY_SCRIPT = """
 import resource, sys
-sys.path.insert(0, {root!r})
+sys.path[:0] = [{root!r}, {root!r} + '/bench']
 sys.argv = ["x"]
-from bench.throughput import load, settings
+from scenes import load
+from throughput import settings
 from drt_engine.core.render import Renderer
 import drt_engine
 drt_engine.register()
