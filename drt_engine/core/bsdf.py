@@ -74,7 +74,7 @@ def _reflect_lobe(weight, alpha, fresnel, layer=None, multiscatter=True) -> Lobe
     mu, e = mf.directional_albedo(alpha, fresnel)
     lobe = Lobe("reflect", np.asarray(weight, float), layer=layer, alpha=alpha, fresnel=fresnel)
     _, e1 = mf.white_albedo(float(alpha))
-    if multiscatter and alpha >= mf.DELTA_ALPHA:
+    if multiscatter:
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
         e_avg = _cosine_average(mu, e1)
@@ -343,6 +343,19 @@ def _glass_eval(lobe: Lobe, wo, wi, refl, trans, eta):
     return f, pdf
 
 
+def _masking(lobe: Lobe, wo, wi):
+    """Sampling weight G2/G1 of visible-normal sampling toward wi.
+
+    A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
+    (the mean of G2/G1 over the lobe it stands for, which differs from G2/G1 at the
+    mirror direction near grazing); refraction leaves grazing, where both agree.
+    """
+    g = mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
+    if lobe.delta and lobe.kind != "transparent":
+        g = np.where(wi[:, 2] > 0, mf.lookup(*mf.white_albedo(float(lobe.alpha)), wo[:, 2]), g)
+    return g
+
+
 def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
     """Sample one lobe: (wi, weight f|cos|/pdf of this lobe alone, valid)."""
     n = len(wo)
@@ -356,8 +369,7 @@ def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
         wi = mf.reflect(wo, h)
         ok = wi[:, 2] > 0
         fr = lobe.fresnel(np.clip(mf.dot(wo, h), 0, 1))
-        g = 1.0 if lobe.delta else mf.ggx_g2(wo[:, 2], wi[:, 2], lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
-        return wi, fr * np.broadcast_to(g, (n,))[:, None], ok
+        return wi, fr * _masking(lobe, wo, wi)[:, None], ok
     fr = mf.fresnel_dielectric(mf.dot(wo, h), eta)
     p_reflect = np.zeros(n) if lobe.refract_only else fr
     go_reflect = u_choice < p_reflect
@@ -365,7 +377,7 @@ def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
     wt, ok_t = mf.refract(wo, h, eta)
     wi = np.where(go_reflect[:, None], wr, wt)
     ok = np.where(go_reflect, wr[:, 2] > 0, ok_t & (wt[:, 2] < 0))
-    g = np.ones(n) if lobe.delta else mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
+    g = _masking(lobe, wo, wi)
     # The Fresnel factor cancels against the choice probability; radiance scales by 1/eta².
     weight = np.where(go_reflect[:, None], lobe.tint_r * g[:, None], lobe.tint_t * (g / eta**2)[:, None])
     return wi, weight, ok
