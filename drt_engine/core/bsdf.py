@@ -41,7 +41,22 @@ class Lobe:
 
     @property
     def delta(self) -> bool:
-        return self.kind == "transparent" or (self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA)
+        """Sampled as a delta distribution: smooth, or an interface that barely bends light.
+
+        Refraction spreads directions by about alpha·|eta - 1|: at IOR 1 a rough glass is
+        no interface at all (the Walter model's half vector degenerates there), so it
+        becomes a straight pass-through whatever its roughness.
+        """
+        if self.kind == "transparent":
+            return True
+        if self.kind == "glass" and self.alpha_t < mf.DELTA_ALPHA:
+            return True
+        return self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA
+
+    @property
+    def alpha_t(self) -> float:
+        """Spread of the refracted directions of a glass lobe (alpha scaled by the bend)."""
+        return self.alpha * min(1.0, abs(self.eta - 1.0))
 
     def scale(self, mu_o: np.ndarray) -> np.ndarray:
         """Per-hit RGB weight: constant weight times the attenuation of layers above."""
@@ -348,12 +363,14 @@ def _masking(lobe: Lobe, wo, wi):
 
     A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
     (the mean of G2/G1 over the lobe it stands for, which differs from G2/G1 at the
-    mirror direction near grazing); refraction leaves grazing, where both agree.
+    mirror direction near grazing); its refraction is masked at the refracted spread
+    ``alpha_t`` (none at IOR 1).
     """
-    g = mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
-    if lobe.delta and lobe.kind != "transparent":
-        g = np.where(wi[:, 2] > 0, mf.lookup(*mf.white_albedo(float(lobe.alpha)), wo[:, 2]), g)
-    return g
+    if not lobe.delta:
+        return mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
+    a_t = lobe.alpha_t if lobe.kind == "glass" else lobe.alpha
+    g_t = mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), a_t) / mf.ggx_g1(wo[:, 2], a_t)
+    return np.where(wi[:, 2] > 0, mf.lookup(*mf.white_albedo(float(lobe.alpha)), wo[:, 2]), g_t)
 
 
 def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
