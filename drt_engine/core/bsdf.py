@@ -155,7 +155,7 @@ def _principled_lobes(c: Closure) -> list[Lobe]:
         lobes.append(_reflect_lobe(w * metallic, alpha, lambda x: mf.fresnel_f82(x, base, f82), base_layer,
                                    c.multiscatter))
     dielectric = 1.0 - metallic
-    ior = max(float(c.ior), 1.0 + 1e-6)
+    ior = max(float(c.ior), 1e-5)  # IOR below 1 is a valid medium (a bubble), as in Cycles
     if dielectric * transmission > 0:
         lobes.append(Lobe("glass", w * dielectric * transmission, layer=base_layer, alpha=alpha, eta=ior,
                           tint_r=np.clip(c.specular_tint, 0, None), tint_t=np.sqrt(base)))
@@ -189,7 +189,7 @@ def lobes_of(material: Material) -> list[Lobe]:
                                        multiscatter=c.multiscatter))
         elif c.kind in ("GLASS", "REFRACTION"):
             tint = np.clip(c.color, 0, 1)
-            lobes.append(Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1.0 + 1e-6),
+            lobes.append(Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1e-5),
                               tint_r=tint, tint_t=tint, refract_only=c.kind == "REFRACTION"))
         elif c.kind == "TRANSPARENT":
             lobes.append(Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1)))
