@@ -119,10 +119,13 @@ class Geometry:
                 mesh.motion_vertices, mesh.motion_vertices[:1])
             (moving if motion.moving or deforming else static).append((inst, mesh, motion, deforming))
 
+        vertex_count = [0]  # vertices appended so far (a running count: summing is quadratic in objects)
+
         def add(mesh, linear, translation, in_world):
             """Append one mesh's triangles; returns the (kept) triangle count."""
             v_obj = mesh.vertices
-            v_world = v_obj @ linear.T + translation
+            with np.errstate(invalid="ignore", over="ignore"):  # NaN / Inf vertices are dropped below
+                v_world = v_obj @ linear.T + translation
             v = v_world if in_world else v_obj
             bad = ~np.isfinite(v_world).all(axis=1)
             tri = mesh.triangles
@@ -130,7 +133,8 @@ class Geometry:
             p = v_world[tri]
             keep &= _cross_normals(np.where(np.isfinite(p), p, 0.0))[1] > 0
             self._dropped += int((~keep & bad[tri].any(axis=1)).sum())
-            offset = sum(len(x) for x in verts)
+            offset = vertex_count[0]
+            vertex_count[0] += len(v)
             verts.append(np.where(bad[:, None], 0.0, v))
             world_verts.append(np.where(bad[:, None], 0.0, v_world))
             tris.append(tri[keep] + offset)
