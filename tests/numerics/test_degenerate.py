@@ -53,6 +53,7 @@ def test_duplicate_vertices_and_faces_render_like_the_originals():
     assert np.abs(a["Combined"] - b["Combined"]).max() < 1e-6
 
 
+@pytest.mark.filterwarnings("error")  # DRT's one warning, and no RuntimeWarning from NumPy on stderr
 def test_nan_and_inf_vertices_are_dropped_with_one_warning():
     base = plane(2.0)
     v = np.concatenate([base.vertices, [[np.nan, 0, 0], [np.inf, 1, 1], [0, -np.inf, 0]]])
