@@ -193,12 +193,12 @@ class Renderer:
         try:
             while True:
                 target = adaptive.next_checkpoint(points, target, len(active), first)
-                base = self.film.count[active]
-                need = (target - base).astype(np.int64)
+                base = _counts(self.film.count, active)
+                need = target - base
                 keep = need > 0
-                pix, base, need = active[keep], base[keep], need[keep]
-                left = int(need.sum())
-                for wave_pix, wave_sample in _waves(pix, base.astype(np.int64), need):
+                pix, base, need = (active, base, need) if keep.all() else (active[keep], base[keep], need[keep])
+                left = int(need.sum(dtype=np.int64))
+                for wave_pix, wave_sample in _waves(pix, base, need):
                     a = 0
                     while a < len(wave_pix):  # one piece, or under a time limit what fits in the time left
                         size = _wave_size(s.time_limit, time.perf_counter() - start, traced)
@@ -565,22 +565,35 @@ class Renderer:
         return pid[sel], origin, wi, new_thr[sel], prev_pdf, ng[gi], straight[g][sel] & passthrough
 
 
+_BLOCK = 1 << 20  # pixels of a round gathered at a time (bounds the driver's memory on large images)
+
+
+def _counts(count, pixels):
+    """Samples so far of ``pixels`` as int32, gathered a block at a time (no float64 copy)."""
+    out = np.empty(len(pixels), np.int32)
+    for a in range(0, len(pixels), _BLOCK):
+        out[a:a + _BLOCK] = count[pixels[a:a + _BLOCK]]
+    return out
+
+
 def _waves(pix, base, need):
     """Waves of at most WAVE (pixel, sample ids) in sample-major order: every pixel's next
-    sample before any pixel's one after. Made step by step as they are traced, so memory
-    is bounded by the image and the wave, not by the samples of a round."""
+    sample before any pixel's one after. Made step by step, a block of pixels at a time, as
+    they are traced, so memory is bounded by the block and the wave, not by the samples of
+    a round or the image (an 8K round held 4.6 GB at its peak with whole-image steps)."""
     pend_pix, pend_sample, size = [], [], 0
     for step in range(int(need.max()) if len(need) else 0):
-        live = need > step
-        pend_pix.append(pix[live])
-        pend_sample.append(base[live] + step)
-        size += len(pend_pix[-1])
-        if size >= WAVE:
-            p, smp = np.concatenate(pend_pix), np.concatenate(pend_sample)
-            full = size - size % WAVE
-            for a in range(0, full, WAVE):
-                yield p[a:a + WAVE], smp[a:a + WAVE]
-            pend_pix, pend_sample, size = [p[full:]], [smp[full:]], size - full
+        for b in range(0, len(pix), _BLOCK):
+            live = need[b:b + _BLOCK] > step
+            pend_pix.append(pix[b:b + _BLOCK][live])
+            pend_sample.append(base[b:b + _BLOCK][live].astype(np.int64) + step)
+            size += len(pend_pix[-1])
+            if size >= WAVE:
+                p, smp = np.concatenate(pend_pix), np.concatenate(pend_sample)
+                full = size - size % WAVE
+                for a in range(0, full, WAVE):
+                    yield p[a:a + WAVE], smp[a:a + WAVE]
+                pend_pix, pend_sample, size = [p[full:]], [smp[full:]], size - full
     if size:
         yield np.concatenate(pend_pix), np.concatenate(pend_sample)
 
