@@ -1,4 +1,5 @@
-"""Primary rays: the pixel filter's offset, the image window, the thin lens.
+"""Primary rays: the pixel filter's offset, the image window, the thin lens (perspective
+and orthographic).
 
 Rays start at the near clipping plane and stop at the far one, as Blender's camera
 clips; ``depth_per_t`` converts distance along a ray into depth along the view axis.
@@ -69,9 +70,15 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
     else:
         o = np.stack([sx, sy, np.zeros(n)], axis=1)
         d = np.tile([0.0, 0.0, -1.0], (n, 1))
-        axial = np.ones(n)
-        t_start = np.full(n, camera.clip_start)
-        t_end = np.full(n, camera.clip_end)
+        if lens is not None and camera.aperture_radius > 0:
+            # as Cycles: the ray leaves a point of the aperture around its own image point
+            # and passes where the pinhole ray crosses the plane in focus
+            focus = o + d * camera.focus_distance
+            o = o + np.concatenate([aperture_point(camera, lens), np.zeros((n, 1))], axis=1)
+            d = mf.normalize(focus - o)
+        axial = -d[:, 2]
+        t_start = camera.clip_start / axial
+        t_end = camera.clip_end / axial
     if time is not None and moves(camera):
         linear, translation = Motion(camera.matrices).at(time)
         linear = linear / np.linalg.norm(linear, axis=1, keepdims=True)  # drop any scale
