@@ -1,13 +1,13 @@
-"""Numerics suite: the core's hand-made scenes and the Blender helpers on the path, DRT registered."""
+"""Numerics suite: the core's hand-made scenes, the Blender and sample-scene helpers on the path, DRT registered."""
 import sys
 from pathlib import Path
 
 import pytest
 
 TESTS = Path(__file__).resolve().parents[1]
-for folder in ("core", "blender", "numerics"):
-    if str(TESTS / folder) not in sys.path:
-        sys.path.insert(0, str(TESTS / folder))
+for folder in (TESTS / "core", TESTS / "blender", TESTS / "numerics", TESTS.parent / "sample_scenes"):
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
 
 
 @pytest.fixture(scope="session")
