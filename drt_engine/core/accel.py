@@ -363,6 +363,34 @@ class Geometry:
         pos = np.einsum("ni,nij->nj", bary, p)
         return pos, ng, ns
 
+    def smooth_offset(self, hits: Hits, index: np.ndarray, time=None) -> np.ndarray:
+        """World vector from hits[index] to the smooth surface its corner normals describe.
+
+        Hanika's shadow-terminator fix (Ray Tracing Gems II, ch. 4), as Cycles applies it:
+        the hit is moved, for each corner, onto that corner's tangent plane where it lies
+        below it, and the moves are blended by the barycentrics. Zero on flat triangles.
+        """
+        out = np.zeros((len(index), 3))
+        if self.ns is None or len(index) == 0:
+            return out
+        prim = hits.prim[index]
+        bary = np.stack([1.0 - hits.u[index] - hits.v[index], hits.u[index], hits.v[index]], axis=1)
+        corners = self.vertices[self.triangles[prim]]
+        normals = self.ns[prim]
+        p = np.einsum("ni,nij->nj", bary, corners)
+        to_p = p[:, None, :] - corners
+        below = np.minimum(np.einsum("nij,nij->ni", to_p, normals), 0.0)
+        out = np.einsum("ni,nij->nj", bary, -below[:, :, None] * normals)
+        times = self.ray_times(time) if self.moving else None
+        for k, part in enumerate(self.parts):
+            if part.kind != "rigid":
+                continue
+            sel = np.flatnonzero(self.part[prim] == k)
+            if len(sel):
+                linear = times.frames[k][0][index[sel]]
+                out[sel] = np.einsum("nij,nj->ni", linear, out[sel])
+        return out
+
     def _interpolated_normals(self, prim, bary, ng):
         if self.ns is None:
             return ng.copy()
