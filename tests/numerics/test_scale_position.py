@@ -59,3 +59,28 @@ def test_same_image_far_from_the_origin(offset, s, reference):
     assert differing_fraction(image, reference) <= 0.005
     position = passes["Position"]
     assert np.abs(position[..., 0]).max() > 0.5 * offset  # positions are world positions, in float32
+
+
+@pytest.mark.parametrize("offset", [1e5, 1e7])
+def test_same_image_far_from_the_origin_through_blender(drt, tmp_path, offset):
+    """A sphere on a floor under a point and an area light, the camera 6 m away; every location
+    shifted by ``offset`` (integers, exact in Blender's float32 matrices): the same image."""
+    import bpy
+
+    import blender_scenes as bs
+
+    def build(o):
+        scene = bs.new_scene(24, 24, 8)
+        scene.camera.location = (o, o - 6.0, 2.0)
+        scene.camera.rotation_euler = (1.35, 0.0, 0.0)
+        bs.add_plane(scene, "Floor", half=10.0, location=(o, o, 0), mat=bs.material("DIFFUSE"))
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(o, o, 1.0), segments=24, ring_count=12)
+        bpy.context.active_object.data.shade_smooth()
+        bs.add_light(scene, "POINT", (o - 2.0, o - 2.0, 3.0), energy=500.0, shadow_soft_size=0.25)
+        bs.add_light(scene, "AREA", (o + 2.0, o - 1.0, 4.0), rotation=(0.3, 0.4, 0.0), energy=300.0, size=1.0)
+        return scene
+
+    near = bs.render(build(0.0), tmp_path, "origin")["Combined"][..., :3]
+    far = bs.render(build(offset), tmp_path, "far")["Combined"][..., :3]
+    assert abs(far.mean() / near.mean() - 1) < 1e-3
+    assert differing_fraction(far, near) <= 0.005
