@@ -106,13 +106,7 @@ def render(scene, out_dir, name="render") -> dict:
         setattr(layer, toggle, True)
     for toggle in DRT_PASS_TOGGLES.values():
         setattr(layer.drt, toggle, True)
-    settings = scene.render.image_settings
-    settings.media_type = "MULTI_LAYER_IMAGE"
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    path = Path(out_dir) / f"{name}.exr"
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
+    path = rh.set_exr_output(scene, Path(out_dir) / f"{name}.exr")
     assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
     channels = rh.read_channels(path)
     for key, pixels in channels.items():

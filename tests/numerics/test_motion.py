@@ -42,6 +42,16 @@ def bar(scene, half_length=0.8, half_width=0.02, name="Bar"):
                        mat=bs.material("EMISSION", strength=1.0))
 
 
+PIXEL_AREA = (2 * HALF_VIEW / 32) ** 2
+
+
+def moving_and_still(scene, out_dir):
+    """Red channel of the scene with motion blur as set, then with motion blur off."""
+    moving = bs.render(scene, out_dir, "moving")["Combined"][..., 0]
+    scene.render.use_motion_blur = False
+    return moving, bs.render(scene, out_dir, "still")["Combined"][..., 0]
+
+
 def pixel_radius(res):
     c = (np.arange(res) + 0.5) / res * 2 * HALF_VIEW - HALF_VIEW
     x, y = np.meshgrid(c, -c)
@@ -99,12 +109,9 @@ def test_teleporting_object_keeps_its_energy(drt, tmp_path):
     scene.frame_set(1)
     scene.render.motion_blur_position = "CENTER"
     scene.render.motion_blur_shutter = 2.0
-    moving = bs.render(scene, tmp_path, "teleport")["Combined"][..., 0]
-    scene.render.use_motion_blur = False
-    still = bs.render(scene, tmp_path, "still")["Combined"][..., 0]
-    pixel_area = (2 * HALF_VIEW / 32) ** 2
-    assert still.sum() * pixel_area == pytest.approx(0.16, rel=0.01)
-    assert moving.sum() * pixel_area == pytest.approx(0.16, rel=0.03)
+    moving, still = moving_and_still(scene, tmp_path)
+    assert still.sum() * PIXEL_AREA == pytest.approx(0.16, rel=0.01)
+    assert moving.sum() * PIXEL_AREA == pytest.approx(0.16, rel=0.03)
     c = (np.arange(32) + 0.5) / 32 * 2 - 1
     outside_rows = np.abs(c) > 0.25
     assert moving[outside_rows].max() == 0.0
@@ -124,12 +131,9 @@ def test_parented_animated_hierarchy(drt, tmp_path):
     linear_keys(child, "location", {1: (0.6, 0, 0), 2: (0.8, 0, 0)})
     scene.frame_set(1)
     scene.render.motion_blur_shutter = 1.0
-    moving = bs.render(scene, tmp_path, "hierarchy")["Combined"][..., 0]
-    scene.render.use_motion_blur = False
-    still = bs.render(scene, tmp_path, "still")["Combined"][..., 0]
-    pixel_area = (2 * HALF_VIEW / 32) ** 2
-    assert still.sum() * pixel_area == pytest.approx(0.04, rel=0.03)
-    assert moving.sum() * pixel_area == pytest.approx(0.04, rel=0.05)
+    moving, still = moving_and_still(scene, tmp_path)
+    assert still.sum() * PIXEL_AREA == pytest.approx(0.04, rel=0.03)
+    assert moving.sum() * PIXEL_AREA == pytest.approx(0.04, rel=0.05)
     r, phi = pixel_radius(32)
     on_arc = (r > 0.4) & (r < 1.0) & (phi > -0.3) & (phi < math.pi / 2 + 0.3)  # a pixel of margin
     assert moving[~on_arc].max() == 0.0
