@@ -91,3 +91,26 @@ def test_cli_reports_an_invalid_light_on_one_line(drt, tmp_path):
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "BrokenLamp" in lines[0], result.stderr
     assert "Traceback" not in result.stdout + result.stderr
+
+
+def test_ten_thousand_instances_and_a_million_triangles_through_blender(drt, tmp_path):
+    """10^4 emissive boxes instanced on a grid's vertices (radiance 1) over a 10^6-triangle sphere
+    (radiance 0.5) that fills the view: all exported, and every pixel sees a mix of the two only."""
+    from export_helpers import render_export
+    from scenes import uv_sphere
+
+    scene = bs.new_scene(16, 16, 4)
+    scene.camera.location = (0, 0, 30)
+    grid = np.stack(np.meshgrid(np.arange(100), np.arange(100)), -1).reshape(-1, 2) * 0.2 - 10
+    parent = bs.add_mesh(scene, "Grid", [(x, y, 0) for x, y in grid], [])
+    parent.instance_type = "VERTS"
+    bs.cube(scene, "Box", half=0.05, mat=bs.material("EMISSION", strength=1.0)).parent = parent
+    ball = uv_sphere(40.0, (0, 0, -45), segments=1000, rings=501, smooth=False)
+    bs.mesh_from_arrays(scene, "Ball", ball.vertices, ball.triangles, bs.material("EMISSION", strength=0.5, name="H"))
+    assert len(ball.triangles) >= 1_000_000
+    data = render_export(scene)
+    assert data.triangle_count() == 10_000 * 12 + len(ball.triangles)
+    scene.render.engine = "DRT"
+    image = bs.render(scene, tmp_path)["Combined"][..., 0]
+    assert image.min() >= 0.5 - 1e-6 and image.max() <= 1.0 + 1e-6
+    assert 0.5 < image.mean() < 1.0
