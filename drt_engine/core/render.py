@@ -30,6 +30,7 @@ from .report import ErrorLog
 from .sampling import Sampler
 from .scene import SceneData
 from .settings import RenderSettings
+from .validate import validate_scene
 
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
 _MIN_PIECE = 1 << 12  # fewest camera samples in one thread's piece of a wave (smaller waves stay whole)
@@ -111,6 +112,7 @@ class Renderer:
     def __init__(self, scene: SceneData, settings: RenderSettings):
         if scene.camera is None:
             raise SceneError("the scene has no camera")
+        validate_scene(scene)
         self.scene = scene
         self.settings = settings
         threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)

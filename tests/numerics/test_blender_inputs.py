@@ -114,3 +114,45 @@ def test_ten_thousand_instances_and_a_million_triangles_through_blender(drt, tmp
     image = bs.render(scene, tmp_path)["Combined"][..., 0]
     assert image.min() >= 0.5 - 1e-6 and image.max() <= 1.0 + 1e-6
     assert 0.5 < image.mean() < 1.0
+
+
+NAN = float("nan")
+
+
+def _nan_camera(scene):
+    scene.camera.location = (NAN, 0, 5)
+
+
+def _nan_light(scene):
+    bpy.data.objects["Lamp"].location = (NAN, 0, 2)
+
+
+def _nan_emission(scene):
+    bs.add_plane(scene, "Glow", half=1, location=(0, 0, 0.5), mat=bs.material("EMISSION", strength=NAN, name="NaNGlow"))
+
+
+def _nan_glass(scene):
+    bs.add_plane(scene, "Pane", half=1, location=(0, 0, 0.5), mat=bs.material("GLASS", Roughness=NAN, name="NaNGlass"))
+
+
+def _nan_world(scene):
+    bs.set_world(scene, NAN)
+
+
+@pytest.mark.parametrize("spoil, words", [
+    (_nan_camera, "camera has a location"), (_nan_light, "Light 'Lamp' has a location"),
+    (_nan_emission, "Material 'NaNGlow'"), (_nan_glass, "Material 'NaNGlass': the roughness"),
+    (_nan_world, "world's colour times strength")], ids=["camera", "light", "emission", "glass", "world"])
+def test_nan_anywhere_is_one_message_naming_it(drt, spoil, words, capfd):
+    """Before: a NaN camera was reported as "geometry too far from the camera", a NaN light,
+    emission or world rendered silently (black or partly lit), NaN glass roughness left NaN in
+    the GlossCol pass."""
+    scene = bs.new_scene(8, 8, 2)
+    scene.camera.location = (0, 0, 5)
+    bs.add_plane(scene, half=3, mat=bs.material("DIFFUSE"))
+    bs.add_light(scene, "POINT", (0, 0, 2), energy=100.0, name="Lamp")
+    spoil(scene)
+    message = bs.render_error(scene)
+    assert words in message, message
+    captured = capfd.readouterr()
+    assert "Traceback" not in captured.out + captured.err
