@@ -15,6 +15,10 @@ from .motion import Motion
 from .scene import Camera
 
 
+FOCUS_MIN = 1e-5
+"""Nearest focus distance, as Cycles clamps it: at 0 every lens ray would leave sideways."""
+
+
 @dataclass
 class CameraRays:
     origins: np.ndarray
@@ -61,7 +65,7 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         o = np.zeros((n, 3))
         if lens is not None and camera.aperture_radius > 0:
             disk = aperture_point(camera, lens)
-            focus = d * (camera.focus_distance / -d[:, 2])[:, None]
+            focus = d * (max(camera.focus_distance, FOCUS_MIN) / -d[:, 2])[:, None]
             o = np.concatenate([disk, np.zeros((n, 1))], axis=1)
             d = mf.normalize(focus - o)
         axial = -d[:, 2]
@@ -73,7 +77,7 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         if lens is not None and camera.aperture_radius > 0:
             # as Cycles: the ray leaves a point of the aperture around its own image point
             # and passes where the pinhole ray crosses the plane in focus
-            focus = o + d * camera.focus_distance
+            focus = o + d * max(camera.focus_distance, FOCUS_MIN)
             o = o + np.concatenate([aperture_point(camera, lens), np.zeros((n, 1))], axis=1)
             d = mf.normalize(focus - o)
         axial = -d[:, 2]

@@ -150,3 +150,15 @@ def test_clip_start_1e_6_and_clip_end_1e9(drt, tmp_path):
     np.testing.assert_allclose(combined[far], STRENGTH, rtol=1e-5)
     np.testing.assert_allclose(passes["Depth"][..., 0][far], 1e8, rtol=1e-5)
     del near
+
+
+def test_focus_distance_zero_gives_finite_rays():
+    """Focus 0 with an open aperture: clamped at 1e-5 as Cycles does (before, every lens ray left
+    in the lens plane and started at an infinite distance)."""
+    from drt_engine.core import camera as camera_rays
+
+    cam = Camera(translation(0, 0, 5)[None], (-0.36, 0.36, -0.36, 0.36), (4, 4), aperture_radius=0.01,
+                 focus_distance=0.0)
+    rng = np.random.default_rng(0)
+    rays = camera_rays.generate(cam, rng.random(64) * 4, rng.random(64) * 4, rng.random((64, 2)))
+    assert np.isfinite(rays.origins).all() and np.isfinite(rays.directions).all() and np.isfinite(rays.tmax).all()
