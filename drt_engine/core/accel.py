@@ -119,10 +119,13 @@ class Geometry:
                 mesh.motion_vertices, mesh.motion_vertices[:1])
             (moving if motion.moving or deforming else static).append((inst, mesh, motion, deforming))
 
+        vertex_count = [0]  # vertices appended so far (a running count: summing is quadratic in objects)
+
         def add(mesh, linear, translation, in_world):
             """Append one mesh's triangles; returns the (kept) triangle count."""
             v_obj = mesh.vertices
-            v_world = v_obj @ linear.T + translation
+            with np.errstate(invalid="ignore", over="ignore"):  # NaN / Inf vertices are dropped below
+                v_world = v_obj @ linear.T + translation
             v = v_world if in_world else v_obj
             bad = ~np.isfinite(v_world).all(axis=1)
             tri = mesh.triangles
@@ -130,7 +133,8 @@ class Geometry:
             p = v_world[tri]
             keep &= _cross_normals(np.where(np.isfinite(p), p, 0.0))[1] > 0
             self._dropped += int((~keep & bad[tri].any(axis=1)).sum())
-            offset = sum(len(x) for x in verts)
+            offset = vertex_count[0]
+            vertex_count[0] += len(v)
             verts.append(np.where(bad[:, None], 0.0, v))
             world_verts.append(np.where(bad[:, None], 0.0, v_world))
             tris.append(tri[keep] + offset)
@@ -358,6 +362,34 @@ class Geometry:
                     ng[s] = n_b / np.maximum(length, 1e-300)[:, None] * (-1.0 if mirrored else 1.0)
         pos = np.einsum("ni,nij->nj", bary, p)
         return pos, ng, ns
+
+    def smooth_offset(self, hits: Hits, index: np.ndarray, time=None) -> np.ndarray:
+        """World vector from hits[index] to the smooth surface its corner normals describe.
+
+        Hanika's shadow-terminator fix (Ray Tracing Gems II, ch. 4), as Cycles applies it:
+        the hit is moved, for each corner, onto that corner's tangent plane where it lies
+        below it, and the moves are blended by the barycentrics. Zero on flat triangles.
+        """
+        out = np.zeros((len(index), 3))
+        if self.ns is None or len(index) == 0:
+            return out
+        prim = hits.prim[index]
+        bary = np.stack([1.0 - hits.u[index] - hits.v[index], hits.u[index], hits.v[index]], axis=1)
+        corners = self.vertices[self.triangles[prim]]
+        normals = self.ns[prim]
+        p = np.einsum("ni,nij->nj", bary, corners)
+        to_p = p[:, None, :] - corners
+        below = np.minimum(np.einsum("nij,nij->ni", to_p, normals), 0.0)
+        out = np.einsum("ni,nij->nj", bary, -below[:, :, None] * normals)
+        times = self.ray_times(time) if self.moving else None
+        for k, part in enumerate(self.parts):
+            if part.kind != "rigid":
+                continue
+            sel = np.flatnonzero(self.part[prim] == k)
+            if len(sel):
+                linear = times.frames[k][0][index[sel]]
+                out[sel] = np.einsum("nij,nj->ni", linear, out[sel])
+        return out
 
     def _interpolated_normals(self, prim, bary, ng):
         if self.ns is None:

@@ -151,16 +151,22 @@ def still_active(film: Film, mode: str, threshold: float) -> np.ndarray:
 
 
 def image_error(film: Film) -> tuple[float, float]:
-    """Estimated (RMSE, relMSE) of the Combined RGB image; inf until every pixel has an estimate."""
-    var = film.variance()
+    """Estimated (RMSE, relMSE) of the Combined RGB image; inf until every pixel has an estimate.
+
+    Summed a block of pixels at a time: whole-film temporaries of an 8K image are GBs.
+    """
     if film.n == 0:
         return 0.0, 0.0
-    if not np.isfinite(var).all():
-        return math.inf, math.inf
-    mean = film.sums["Combined"][:, :3] / np.maximum(film.count, 1)[:, None]
-    rmse = float(np.sqrt(var.mean()))
-    relmse = float((var / (mean * mean + RELMSE_EPSILON)).mean())
-    return rmse, relmse
+    squared = relative = 0.0
+    for span in film.blocks():
+        var = film.variance(span)
+        if not np.isfinite(var).all():
+            return math.inf, math.inf
+        mean = film.sums["Combined"][span, :3] / np.maximum(film.count[span], 1)[:, None]
+        squared += float(var.sum())
+        relative += float((var / (mean * mean + RELMSE_EPSILON)).sum())
+    values = 3 * film.n
+    return float(np.sqrt(squared / values)), relative / values
 
 
 def true_error(image: np.ndarray, reference: np.ndarray, reference_variance=None) -> tuple[float, float]:

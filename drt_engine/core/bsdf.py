@@ -41,7 +41,22 @@ class Lobe:
 
     @property
     def delta(self) -> bool:
-        return self.kind == "transparent" or (self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA)
+        """Sampled as a delta distribution: smooth, or an interface that barely bends light.
+
+        Refraction spreads directions by about alpha·|eta - 1|: at IOR 1 a rough glass is
+        no interface at all (the Walter model's half vector degenerates there), so it
+        becomes a straight pass-through whatever its roughness.
+        """
+        if self.kind == "transparent":
+            return True
+        if self.kind == "glass" and self.alpha_t < mf.DELTA_ALPHA:
+            return True
+        return self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA
+
+    @property
+    def alpha_t(self) -> float:
+        """Spread of the refracted directions of a glass lobe (alpha scaled by the bend)."""
+        return self.alpha * min(1.0, abs(self.eta - 1.0))
 
     def scale(self, mu_o: np.ndarray) -> np.ndarray:
         """Per-hit RGB weight: constant weight times the attenuation of layers above."""
@@ -74,7 +89,7 @@ def _reflect_lobe(weight, alpha, fresnel, layer=None, multiscatter=True) -> Lobe
     mu, e = mf.directional_albedo(alpha, fresnel)
     lobe = Lobe("reflect", np.asarray(weight, float), layer=layer, alpha=alpha, fresnel=fresnel)
     _, e1 = mf.white_albedo(float(alpha))
-    if multiscatter and alpha >= mf.DELTA_ALPHA:
+    if multiscatter:
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
         e_avg = _cosine_average(mu, e1)
@@ -140,7 +155,7 @@ def _principled_lobes(c: Closure) -> list[Lobe]:
         lobes.append(_reflect_lobe(w * metallic, alpha, lambda x: mf.fresnel_f82(x, base, f82), base_layer,
                                    c.multiscatter))
     dielectric = 1.0 - metallic
-    ior = max(float(c.ior), 1.0 + 1e-6)
+    ior = max(float(c.ior), 1e-5)  # IOR below 1 is a valid medium (a bubble), as in Cycles
     if dielectric * transmission > 0:
         lobes.append(Lobe("glass", w * dielectric * transmission, layer=base_layer, alpha=alpha, eta=ior,
                           tint_r=np.clip(c.specular_tint, 0, None), tint_t=np.sqrt(base)))
@@ -174,7 +189,7 @@ def lobes_of(material: Material) -> list[Lobe]:
                                        multiscatter=c.multiscatter))
         elif c.kind in ("GLASS", "REFRACTION"):
             tint = np.clip(c.color, 0, 1)
-            lobes.append(Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1.0 + 1e-6),
+            lobes.append(Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1e-5),
                               tint_r=tint, tint_t=tint, refract_only=c.kind == "REFRACTION"))
         elif c.kind == "TRANSPARENT":
             lobes.append(Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1)))
@@ -343,6 +358,21 @@ def _glass_eval(lobe: Lobe, wo, wi, refl, trans, eta):
     return f, pdf
 
 
+def _masking(lobe: Lobe, wo, wi):
+    """Sampling weight G2/G1 of visible-normal sampling toward wi.
+
+    A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
+    (the mean of G2/G1 over the lobe it stands for, which differs from G2/G1 at the
+    mirror direction near grazing); its refraction is masked at the refracted spread
+    ``alpha_t`` (none at IOR 1).
+    """
+    if not lobe.delta:
+        return mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
+    a_t = lobe.alpha_t if lobe.kind == "glass" else lobe.alpha
+    g_t = mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), a_t) / mf.ggx_g1(wo[:, 2], a_t)
+    return np.where(wi[:, 2] > 0, mf.lookup(*mf.white_albedo(float(lobe.alpha)), wo[:, 2]), g_t)
+
+
 def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
     """Sample one lobe: (wi, weight f|cos|/pdf of this lobe alone, valid)."""
     n = len(wo)
@@ -356,8 +386,7 @@ def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
         wi = mf.reflect(wo, h)
         ok = wi[:, 2] > 0
         fr = lobe.fresnel(np.clip(mf.dot(wo, h), 0, 1))
-        g = 1.0 if lobe.delta else mf.ggx_g2(wo[:, 2], wi[:, 2], lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
-        return wi, fr * np.broadcast_to(g, (n,))[:, None], ok
+        return wi, fr * _masking(lobe, wo, wi)[:, None], ok
     fr = mf.fresnel_dielectric(mf.dot(wo, h), eta)
     p_reflect = np.zeros(n) if lobe.refract_only else fr
     go_reflect = u_choice < p_reflect
@@ -365,7 +394,7 @@ def _sample_lobe(lobe: Lobe, wo, u_choice, u2, eta):
     wt, ok_t = mf.refract(wo, h, eta)
     wi = np.where(go_reflect[:, None], wr, wt)
     ok = np.where(go_reflect, wr[:, 2] > 0, ok_t & (wt[:, 2] < 0))
-    g = np.ones(n) if lobe.delta else mf.ggx_g2(wo[:, 2], np.abs(wi[:, 2]), lobe.alpha) / mf.ggx_g1(wo[:, 2], lobe.alpha)
+    g = _masking(lobe, wo, wi)
     # The Fresnel factor cancels against the choice probability; radiance scales by 1/eta².
     weight = np.where(go_reflect[:, None], lobe.tint_r * g[:, None], lobe.tint_t * (g / eta**2)[:, None])
     return wi, weight, ok

@@ -1,4 +1,5 @@
-"""Primary rays: the pixel filter's offset, the image window, the thin lens.
+"""Primary rays: the pixel filter's offset, the image window, the thin lens (perspective
+and orthographic).
 
 Rays start at the near clipping plane and stop at the far one, as Blender's camera
 clips; ``depth_per_t`` converts distance along a ray into depth along the view axis.
@@ -12,6 +13,10 @@ import numpy as np
 from . import microfacet as mf
 from .motion import Motion
 from .scene import Camera
+
+
+FOCUS_MIN = 1e-5
+"""Nearest focus distance, as Cycles clamps it: at 0 every lens ray would leave sideways."""
 
 
 @dataclass
@@ -60,7 +65,7 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         o = np.zeros((n, 3))
         if lens is not None and camera.aperture_radius > 0:
             disk = aperture_point(camera, lens)
-            focus = d * (camera.focus_distance / -d[:, 2])[:, None]
+            focus = d * (max(camera.focus_distance, FOCUS_MIN) / -d[:, 2])[:, None]
             o = np.concatenate([disk, np.zeros((n, 1))], axis=1)
             d = mf.normalize(focus - o)
         axial = -d[:, 2]
@@ -69,9 +74,15 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
     else:
         o = np.stack([sx, sy, np.zeros(n)], axis=1)
         d = np.tile([0.0, 0.0, -1.0], (n, 1))
-        axial = np.ones(n)
-        t_start = np.full(n, camera.clip_start)
-        t_end = np.full(n, camera.clip_end)
+        if lens is not None and camera.aperture_radius > 0:
+            # as Cycles: the ray leaves a point of the aperture around its own image point
+            # and passes where the pinhole ray crosses the plane in focus
+            focus = o + d * max(camera.focus_distance, FOCUS_MIN)
+            o = o + np.concatenate([aperture_point(camera, lens), np.zeros((n, 1))], axis=1)
+            d = mf.normalize(focus - o)
+        axial = -d[:, 2]
+        t_start = camera.clip_start / axial
+        t_end = camera.clip_end / axial
     if time is not None and moves(camera):
         linear, translation = Motion(camera.matrices).at(time)
         linear = linear / np.linalg.norm(linear, axis=1, keepdims=True)  # drop any scale

@@ -24,6 +24,7 @@ from .settings import PASS_CHANNELS
 
 _TABLE = 1024
 _BUCKETS = 1 << 14  # uniform cells over u that locate a sample's segment of the filter table
+_IMAGE_BLOCK = 1 << 20  # pixels per block when the passes are read out
 _ODD_BITS = np.uint32(0xAAAAAAAA)
 
 
@@ -138,21 +139,14 @@ class Film:
     def mean(self, name: str) -> np.ndarray:
         return self.sums[name] / np.maximum(self.count, 1)[:, None]
 
-    def variance(self) -> np.ndarray:
-        """Per-pixel, per-channel estimate of the squared error of the Combined RGB mean.
+    def variance(self, span: slice = slice(None)) -> np.ndarray:
+        """Per-pixel, per-channel estimate of the squared error of the Combined RGB mean
+        (see ``_variance``), of every pixel or of the pixels ``span``."""
+        return _variance(self.count[span], self.count_a[span], self.sums["Combined"][span, :3], self.sum_a[span])
 
-        With n_a samples in class A and n_b in class B, the full mean minus the class A
-        mean has variance Var(mean) * n_b / n_a if the halves are independent
-        estimates; pixels without both classes yet get an infinite estimate.
-        """
-        n, na = self.count, self.count_a
-        nb = n - na
-        full = self.sums["Combined"][:, :3] / np.maximum(n, 1)[:, None]
-        half = self.sum_a / np.maximum(na, 1)[:, None]
-        known = (na > 0) & (nb > 0)
-        var = (full - half) ** 2 * (na / np.maximum(nb, 1))[:, None]
-        var[~known] = np.inf
-        return var
+    def blocks(self):
+        """Slices covering the film a bounded block of pixels at a time."""
+        return [slice(a, a + _IMAGE_BLOCK) for a in range(0, self.n, _IMAGE_BLOCK)]
 
     def standard_error(self) -> np.ndarray:
         """Per-pixel standard error of the Combined RGB mean (the Noise pass).
@@ -160,20 +154,46 @@ class Film:
         Sample ids 0 and 1 are both class B, so a pixel with fewer than three samples
         has no estimate yet; it reports its own value, a 100% error.
         """
-        var = self.variance()
-        unknown = ~np.isfinite(var)
-        var[unknown] = (self.sums["Combined"][:, :3] / np.maximum(self.count, 1)[:, None])[unknown] ** 2
-        return np.sqrt(var)
+        return _standard_error(self.count, self.count_a, self.sums["Combined"][:, :3], self.sum_a)
 
     def images(self) -> dict[str, np.ndarray]:
-        """Each enabled pass as (height, width, channels) float32, rows from the bottom."""
+        """Each enabled pass as (height, width, channels) float32, rows from the bottom.
+
+        Computed a block of pixels at a time into the float32 result, so no float64 copy
+        of a whole pass is ever held (an 8K Combined pass is 1 GB in float64).
+        """
         out = {}
         for name in self.passes:
-            if name == "Sample Count":
-                img = self.count[:, None]
-            elif name == "Noise":
-                img = self.standard_error()
-            else:
-                img = self.mean(name)
-            out[name] = np.ascontiguousarray(img.reshape(self.height, self.width, -1), dtype=np.float32)
+            img = np.empty((self.n, len(PASS_CHANNELS[name])), np.float32)
+            for span in self.blocks():
+                img[span] = self._pass_block(name, span)
+            out[name] = img.reshape(self.height, self.width, -1)
         return out
+
+    def _pass_block(self, name: str, span: slice) -> np.ndarray:
+        count = self.count[span]
+        if name == "Sample Count":
+            return count[:, None]
+        if name == "Noise":
+            return _standard_error(count, self.count_a[span], self.sums["Combined"][span, :3], self.sum_a[span])
+        return self.sums[name][span] / np.maximum(count, 1)[:, None]
+
+
+def _variance(n, na, total, total_a):
+    """With n_a samples in class A and n_b in class B, the full mean minus the class A
+    mean has variance Var(mean) * n_b / n_a if the halves are independent estimates;
+    pixels without both classes yet get an infinite estimate."""
+    nb = n - na
+    full = total / np.maximum(n, 1)[:, None]
+    half = total_a / np.maximum(na, 1)[:, None]
+    known = (na > 0) & (nb > 0)
+    var = (full - half) ** 2 * (na / np.maximum(nb, 1))[:, None]
+    var[~known] = np.inf
+    return var
+
+
+def _standard_error(n, na, total, total_a):
+    var = _variance(n, na, total, total_a)
+    unknown = ~np.isfinite(var)
+    var[unknown] = (total / np.maximum(n, 1)[:, None])[unknown] ** 2
+    return np.sqrt(var)

@@ -3,7 +3,11 @@
 Local frame: z is the (shading) normal. All functions take arrays of shape (N, 3) for
 directions and scalar material parameters (one material is shaded at a time).
 Alpha below ``DELTA_ALPHA`` is treated as a perfect mirror or smooth interface: the
-lobe keeps its total reflectance, so brightness is continuous across the switch.
+microfacet normal is the macro normal, but the lobe keeps the albedo of GGX at its own
+alpha (masking matters within a fraction of a degree of grazing, where alpha·tanθ is no
+longer small), so brightness is continuous across the switch at every view angle.
+Albedo tables are dense near grazing (``MU_TABLE``) for the same reason: a nearly smooth
+lobe changes within mu ~ alpha of the horizon.
 """
 from __future__ import annotations
 
@@ -12,6 +16,8 @@ import functools
 import numpy as np
 
 DELTA_ALPHA = 1e-4
+MU_TABLE = np.unique(np.concatenate([np.geomspace(1e-5, 1.0 / 64, 12), np.linspace(1.0 / 64, 1.0, 32)]))
+"""Cosines the albedo tables are computed at: geometric steps toward the horizon, linear above."""
 _TINY = 1e-30
 
 
@@ -159,13 +165,14 @@ def concentric_disk(u: np.ndarray) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
 
 
-def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 4096) -> tuple[np.ndarray, np.ndarray]:
+def directional_albedo(alpha: float, fresnel, n_samples: int = 4096) -> tuple[np.ndarray, np.ndarray]:
     """Albedo E(mu) of a GGX reflection lobe with the given Fresnel(cos_h) -> (N,) or (N,3).
 
     Computed once per material with a fixed stratified pattern (deterministic),
-    tabulated at ``n_mu`` cosines; returns (mu, E).
+    tabulated at the cosines ``MU_TABLE``; returns (mu, E).
     """
-    mu = np.linspace(0.5 / n_mu, 1.0, n_mu)
+    mu = MU_TABLE
+    n_mu = len(mu)
     from .sampling import Sampler  # deterministic Owen-scrambled Sobol points
 
     g = Sampler("SOBOL", n_samples, seed=0x5AB1E).get2d(np.zeros(n_samples, np.int64), np.arange(n_samples), 0)
@@ -173,16 +180,10 @@ def directional_albedo(alpha: float, fresnel, n_mu: int = 32, n_samples: int = 4
     wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=1)
     wo_r = np.repeat(wo, m, axis=0)
     u = np.tile(g, (n_mu, 1))
-    if alpha < DELTA_ALPHA:
-        h = np.tile([0.0, 0.0, 1.0], (len(wo_r), 1))
-    else:
-        h = sample_visible_normal(wo_r, alpha, u)
+    h = sample_visible_normal(wo_r, alpha, u)  # also below DELTA_ALPHA: sampling stays exact there
     wi = reflect(wo_r, h)
     ok = wi[:, 2] > 0
-    if alpha < DELTA_ALPHA:
-        weight = ok.astype(float)
-    else:
-        weight = np.where(ok, ggx_g2(wo_r[:, 2], wi[:, 2], alpha) / ggx_g1(wo_r[:, 2], alpha), 0.0)
+    weight = np.where(ok, ggx_g2(wo_r[:, 2], wi[:, 2], alpha) / ggx_g1(wo_r[:, 2], alpha), 0.0)
     f = np.asarray(fresnel(dot(wo_r, h)))
     if f.ndim == 2:
         e = (f * weight[:, None]).reshape(n_mu, m, -1).mean(axis=1)

@@ -105,13 +105,7 @@ def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name
         layer.use = layer == view_layer
     for pass_name, (toggle, _) in PASS_TOGGLES.items():
         setattr(view_layer, toggle, pass_name in passes)
-    settings = scene.render.image_settings
-    settings.media_type = "MULTI_LAYER_IMAGE"
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    path = Path(out_dir) / f"{name}-{engine.lower()}-{seed}.exr"
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
+    path = set_exr_output(scene, Path(out_dir) / f"{name}-{engine.lower()}-{seed}.exr")
     start = time.perf_counter()
     result = bpy.ops.render.render(write_still=True, scene=scene.name)
     seconds = time.perf_counter() - start
@@ -121,6 +115,17 @@ def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name
     for pass_name in passes:
         images[pass_name] = _pass(channels, view_layer.name, pass_name, PASS_TOGGLES[pass_name][1])
     return Render(images, seconds, samples)
+
+
+def set_exr_output(scene, path: Path) -> Path:
+    """Write renders of ``scene`` to ``path`` as a 32-bit multilayer EXR (in memory only)."""
+    settings = scene.render.image_settings
+    settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    scene.render.filepath = str(path)
+    scene.render.use_file_extension = False
+    return path
 
 
 def read_channels(path) -> dict:

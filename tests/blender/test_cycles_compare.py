@@ -25,10 +25,9 @@ anything fails the resolving-power checks instead (block noise at most 0.5%).
 
 Measured at 64 px on 2 shared cores (Nov 2026), block MARD minus its noise: 0.0-0.1% on the
 Cornell box, glossy spheres, depth-of-field row and Ignis lights; 0.47% on the motion-blur
-scene (the spot light's cone edge, see test_spot_light_blend_region) and 0.43% on Ignis sun
-(its smooth-shaded 32-sided cone near the terminator: Cycles evaluates BSDFs without testing
-the light direction against the geometric normal and lifts shadow-ray origins by the object's
-shadow terminator geometry offset; DRT tests against the geometric normal and has no offset).
+scene (the spot light's cone edge, see test_spot_light_blend_region) and 0.29% on Ignis sun
+(its smooth-shaded 32-sided cone near the terminator; 0.38% before DRT, like Cycles, judged
+light samples by the shading normal and lifted diffuse shadow rays toward the smooth surface).
 On the Ignis roughness sphere (highlight left out, see highlight()) 0.17%, on the rough glass of
 Ignis flipped-prim 0.79% (image means -0.47%, the same at 64 and 128 spp). Ignis box is a known
 difference (KNOWN_DIFFERENCES): DRT's Principled dielectric with GGX is Multiscatter GGX's, +1.4%

@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from ...core.errors import SceneError
 from ...core.scene import Light
 from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
 
@@ -65,6 +66,10 @@ def export_light(obj, matrix: np.ndarray, warnings: list[str]) -> Light | None:
     if light.type == "AREA" and getattr(getattr(light, "cycles", None), "is_portal", False):
         return None
     strength = light_strength(light, warnings)
+    if not np.isfinite(strength).all() or (strength < 0).any():
+        quantity, unit = ("strength", "W/m²") if light.type == "SUN" else ("power", "W")
+        raise SceneError(f"Light '{obj.name}' has an invalid {quantity} ({light.energy:g} {unit}, colour "
+                         f"{tuple(round(c, 3) for c in light.color)}): it must be a finite number, not negative")
     if not strength.any():
         return None
     normalize = getattr(light, "normalize", True)

@@ -16,7 +16,11 @@ import numpy as np
 from .camera import without_scale
 
 MOTION_STEPS = 5
-"""Shutter times sampled: enough for curved paths and rotations up to a half turn."""
+"""Shutter times sampled at least: enough for curved paths and rotations up to a half turn."""
+STEPS_PER_FRAME = 4
+"""More for long shutters: between two sampled times an object must turn less than half a turn
+(slerp takes the short way), and whole turns between samples would not show at all. Four per
+frame follow up to two turns per frame."""
 
 _SHUTTER_START = {"START": 0.0, "CENTER": -0.5, "END": -1.0}
 
@@ -29,7 +33,8 @@ def shutter_times(scene) -> np.ndarray | None:
     shutter = render.motion_blur_shutter
     now = scene.frame_current + scene.frame_subframe
     start = now + _SHUTTER_START.get(render.motion_blur_position, -0.5) * shutter
-    return start + np.linspace(0.0, shutter, MOTION_STEPS)
+    steps = max(MOTION_STEPS, math.ceil(STEPS_PER_FRAME * shutter) + 1)
+    return start + np.linspace(0.0, shutter, steps)
 
 
 def instance_key(instance) -> tuple:

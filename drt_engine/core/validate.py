@@ -1,0 +1,44 @@
+"""Non-finite numbers in a scene, found before rendering and named for the user.
+
+A NaN that reaches the tracer does not fail loudly: it becomes a black pixel, a wrong
+error message ("geometry too far from the camera") or a NaN in one pass. Each part of
+the scene is checked here once, and the first bad value is reported by where it is.
+Triangles with non-finite vertices are not an error: the geometry drops them with a
+warning.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import SceneError
+from .scene import SceneData
+
+_CLOSURE_FIELDS = ("weight", "color", "roughness", "metallic", "ior", "specular_ior_level", "specular_tint",
+                   "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint", "emission")
+
+
+def _finite(value) -> bool:
+    return bool(np.isfinite(np.asarray(value, dtype=np.float64)).all())
+
+
+def validate_scene(scene: SceneData) -> None:
+    """Raise SceneError naming the first non-finite camera, light, world or material value."""
+    cam = scene.camera
+    if not _finite(cam.matrices):
+        raise SceneError("The camera has a location or rotation that is not a finite number")
+    for name in ("frame", "clip_start", "clip_end", "aperture_radius", "focus_distance", "aperture_ratio"):
+        if not _finite(getattr(cam, name)):
+            raise SceneError(f"The camera's {name.replace('_', ' ')} is not a finite number")
+    for light in scene.lights:
+        matrices = light.matrix if light.matrices is None else light.matrices
+        if not _finite(matrices):
+            raise SceneError(f"Light '{light.name}' has a location or rotation that is not a finite number")
+    radiance = scene.world.radiance
+    if not _finite(radiance) or (radiance < 0).any():
+        raise SceneError(f"The world's colour times strength {radiance.tolist()} must be finite and not negative")
+    for material in scene.materials:
+        for closure in material.closures:
+            for name in _CLOSURE_FIELDS:
+                if not _finite(getattr(closure, name)):
+                    raise SceneError(f"Material '{material.name}': the {name.replace('_', ' ')} of its "
+                                     f"{closure.kind.lower()} shader is not a finite number")
