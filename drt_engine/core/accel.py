@@ -106,22 +106,22 @@ class Geometry:
         self.center = np.asarray(center, dtype=np.float64)
         self.warnings: list[str] = []
         self.parts: list[_Part] = []
-        verts, world_verts, tris, mats, normals, flips = [], [], [], [], [], []
+        verts, world_verts, tris, mats, normals, flips, sources = [], [], [], [], [], [], []
         self._dropped = 0
         static = []
         moving = []
-        for inst in scene.instances:
+        for i_inst, inst in enumerate(scene.instances):
             mesh = scene.meshes[inst.mesh]
             if len(mesh.triangles) == 0:
                 continue
             motion = Motion(inst.matrices)
             deforming = mesh.motion_vertices is not None and not np.allclose(
                 mesh.motion_vertices, mesh.motion_vertices[:1])
-            (moving if motion.moving or deforming else static).append((inst, mesh, motion, deforming))
+            (moving if motion.moving or deforming else static).append((i_inst, mesh, motion, deforming))
 
         vertex_count = [0]  # vertices appended so far (a running count: summing is quadratic in objects)
 
-        def add(mesh, linear, translation, in_world):
+        def add(mesh, linear, translation, in_world, inst_index):
             """Append one mesh's triangles; returns the (kept) triangle count."""
             v_obj = mesh.vertices
             with np.errstate(invalid="ignore", over="ignore"):  # NaN / Inf vertices are dropped below
@@ -139,6 +139,8 @@ class Geometry:
             world_verts.append(np.where(bad[:, None], 0.0, v_world))
             tris.append(tri[keep] + offset)
             mats.append(mesh.material_indices[keep])
+            kept = np.flatnonzero(keep)
+            sources.append(np.stack([np.full(len(kept), inst_index), kept], axis=1))
             det = np.linalg.det(linear)
             if mesh.corner_normals is not None:
                 ns = mesh.corner_normals[keep].astype(np.float64)
@@ -155,18 +157,18 @@ class Geometry:
         if static:
             start = count
             for inst, mesh, motion, _ in static:
-                n, _ = add(mesh, motion.linear[0], motion.translation[0], True)
+                n, _ = add(mesh, motion.linear[0], motion.translation[0], True, inst)
                 count += n
             self.parts.append(_Part("static", start, count - start, self.center, []))
         for inst, mesh, motion, deforming in moving:
             if deforming:
                 mid = motion.matrix_at(0.5)
-                n, first = add(_mid_mesh(mesh), mid[:3, :3], mid[:3, 3], True)
+                n, first = add(_mid_mesh(mesh), mid[:3, :3], mid[:3, 3], True, inst)
                 part = _Part("deform", count, n, self.center, [], first_vertex=first)
                 part.buckets = [(mesh, motion)]
             else:
                 n, first = add(mesh, motion.linear[len(motion.linear) // 2],
-                               motion.translation[len(motion.translation) // 2], False)
+                               motion.translation[len(motion.translation) // 2], False, inst)
                 lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
                 part = _Part("rigid", count, n, 0.5 * (lo + hi), [], motion=motion, first_vertex=first)
             count += n
@@ -178,6 +180,8 @@ class Geometry:
         self.world_vertices = np.concatenate(world_verts) if world_verts else np.zeros((0, 3))
         self.triangles = np.concatenate(tris) if tris else np.zeros((0, 3), np.int32)
         self.material = np.concatenate(mats) if mats else np.zeros(0, np.int32)
+        self.source = np.concatenate(sources) if sources else np.zeros((0, 2), np.int64)
+        """Per triangle: (instance index in the scene, triangle index in its mesh), for attributes."""
         flip = np.concatenate(flips) if flips else np.zeros(0, bool)
         self.part = np.zeros(len(self.triangles), np.int64)
         for k, part in enumerate(self.parts):

@@ -93,3 +93,14 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
         o_w = mf.transform(o, m[:3, :3]) + m[:3, 3]
         d_w = mf.normalize(mf.transform(d, m[:3, :3]))
     return CameraRays(o_w + d_w * t_start[:, None], d_w, np.maximum(t_end - t_start, 0.0), t_start, axial)
+
+
+def pixel_spread(camera: Camera) -> tuple[float, float]:
+    """A pixel's footprint width as a + b t at distance t along a camera ray: (a, b).
+
+    Perspective: b is the pixel's angle; orthographic: a is its size. Texture lookups
+    filter over this footprint (projected onto the surface)."""
+    w = camera.resolution[0]
+    left, right, _, _ = camera.frame
+    size = abs(right - left) / w
+    return (0.0, size) if camera.type == "PERSP" else (size, 0.0)

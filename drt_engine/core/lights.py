@@ -14,7 +14,9 @@ from dataclasses import replace
 
 from . import microfacet as mf
 from .errors import SceneError
+from .environment import Environment
 from .motion import Motion
+from .shading import SurfaceAttributes, SurfaceContext
 from .scene import Light, SceneData
 
 _TINY = 1e-30
@@ -26,6 +28,15 @@ class LightSample:
     def __init__(self, wi, dist, value, pdf, tmax_scale=None):
         self.wi, self.dist, self.value, self.pdf = wi, dist, value, pdf
         self.tmax_scale = tmax_scale  # distance to stop short of an emitter that is geometry
+        self.lobes = None  # (diffuse, glossy, transmission) this light lights, when not all
+
+    def restrict(self, f_diff, f_nd, above):
+        """The BSDF parts this light may light (diffuse, reflection, transmission)."""
+        if self.lobes is None:
+            return f_diff, f_nd
+        diffuse, glossy, transmission = self.lobes
+        keep = np.where(above, glossy, transmission)[:, None]
+        return (f_diff if diffuse else np.zeros_like(f_diff)), np.where(keep, f_nd, 0.0)
 
 
 def _smoothstep(t):
@@ -37,14 +48,7 @@ def _lum(c):
     return float(np.dot(c, [0.2126, 0.7152, 0.0722]))
 
 
-def _orthonormal(n):
-    """Two unit vectors perpendicular to each row of n (Duff et al. 2017)."""
-    s = np.where(n[:, 2] >= 0, 1.0, -1.0)
-    a = -1.0 / (s + n[:, 2])
-    b = n[:, 0] * n[:, 1] * a
-    t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * b, -s * n[:, 0]], axis=1)
-    bt = np.stack([b, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
-    return t, bt
+_orthonormal = mf.orthonormal_basis
 
 
 class _SphericalRectangle:
@@ -147,12 +151,16 @@ over a floor with occluders, 4 to 256 lights): one shadow ray to every light was
 more efficient (1 / (MSE x time)) than 1 to 16 chosen lights, so choosing only bounds the
 cost of scenes with very many lights."""
 SELECT_SLOTS = 16
+MAP_SHARE = 0.75
+"""Share of a textured world's light samples drawn from its map (the rest cosine-weighted).
+Block noise measured on the environment-map Cycles comparison (64 x 48, 128 spp): 0.55% with
+the map alone, 0.47% at 0.75, 0.53% at 0.5, 0.95% at 0.25."""
 
 
 class Lights:
     """All next-event strategies of a scene."""
 
-    def __init__(self, scene: SceneData, geometry, shaders):
+    def __init__(self, scene: SceneData, geometry, shaders, textures=()):
         for light in scene.lights:
             validate_light(light)
         self.lights = [light for light in scene.lights if not light_power_zero(light)]
@@ -162,15 +170,32 @@ class Lights:
         self.geometry = geometry
         emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))
         tri_emission = emission[geometry.material] if len(geometry.material) else np.zeros((0, 3))
-        power = tri_emission @ np.array([0.2126, 0.7152, 0.0722]) * geometry.area
+        self.shaders = shaders
+        self.tri_emission = tri_emission
+        self.textured = [m for m, s in enumerate(shaders) if getattr(s, "varying_emission", False)]
+        self.attributes = SurfaceAttributes(scene, geometry) if self.textured else None
+        estimate = tri_emission.copy()
+        for m in self.textured:
+            estimate[geometry.material == m] = self._textured_estimate(m)
+        power = estimate @ np.array([0.2126, 0.7152, 0.0722]) * geometry.area
         self.emissive = np.flatnonzero(power > 0)
         if len(self.emissive):
             cdf = np.cumsum(power[self.emissive])
             self.emissive_cdf = cdf / cdf[-1]
             self.emissive_prob = np.zeros(len(power))
             self.emissive_prob[self.emissive] = power[self.emissive] / cdf[-1]
-        self.tri_emission = tri_emission
-        self.world = scene.world.radiance if np.any(scene.world.radiance > 0) else None
+        world = scene.world
+        self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
+                                 world.visible_transmission)
+        self.environment = Environment(world, list(textures)) if world.program is not None else None
+        lit = self.environment.mean_radiance > 0 if self.environment else np.any(world.radiance > 0)
+        self.world = world.radiance if lit and world.visible_lighting else None
+        self.world_constant = world.radiance
+        self.world_seen = lit and (world.visible_camera or world.visible_lighting)
+        partial = world.visible_lighting and not (world.visible_diffuse and world.visible_glossy
+                                                  and world.visible_transmission)
+        self.world_lobes = self.world_visibility[1:] if partial else None
+        """(diffuse, glossy, transmission) the world lights, when not all of them."""
         self.selecting = len(self.lights) > SELECT_ABOVE
         self.light_slots = min(SELECT_SLOTS, len(self.lights)) if self.selecting else len(self.lights)
         self.strategies = self.light_slots + (1 if len(self.emissive) else 0) + (1 if self.world is not None else 0)
@@ -184,6 +209,38 @@ class Lights:
     @property
     def moving(self) -> bool:
         return bool(self.motions)
+
+    # -- emission that varies over a surface ----------------------------------------
+    _ESTIMATE_POINTS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1 / 3, 1 / 3, 1 / 3]], float)
+
+    def _textured_estimate(self, m):
+        """Per-triangle emission for choosing triangles: the largest of the corners' and centre's
+        (any choice with power wherever the texture emits keeps light sampling unbiased)."""
+        tris = np.flatnonzero(self.geometry.material == m)
+        best = np.zeros((len(tris), 3))
+        for bary in self._ESTIMATE_POINTS:
+            best = np.maximum(best, self._emission_at(tris, np.tile(bary, (len(tris), 1))))
+        return best
+
+    def _emission_at(self, prim, bary):
+        g = self.geometry
+        out = self.tri_emission[prim].copy()
+        for m in self.textured:
+            sel = np.flatnonzero(g.material[prim] == m)
+            if len(sel):
+                p = g.world_vertices[g.triangles[prim[sel]]]
+                pos = np.einsum("ni,nij->nj", bary[sel], p)
+                ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, g.world_ng[prim[sel]])
+                out[sel] = self.shaders[m].emission_at(ctx)
+        return out
+
+    def emission_seen(self, prim, u, v):
+        """Emitted radiance at hits (triangles ``prim``, barycentrics u, v)."""
+        if not len(self.tri_emission):
+            return np.zeros((len(prim), 3))
+        if not self.textured:
+            return self.tri_emission[prim]
+        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1))
 
     def _local(self, i, points, dirs, time):
         """(light, points, directions, rotation) in the frame where light i stands still."""
@@ -211,7 +268,9 @@ class Lights:
         k -= self.light_slots
         if len(self.emissive) and k == 0:
             return self._sample_emissive(pos, u, u_pick)
-        return self._sample_world(normal, u)
+        sample = self._sample_world(normal, u)
+        sample.lobes = self.world_lobes
+        return sample
 
     def _sample_light(self, index: int, pos, u, time=None) -> LightSample:
         light, local, _, rotation = self._local(index, pos, None, time)
@@ -404,16 +463,36 @@ class Lights:
         cos_l = np.abs(mf.dot(wi, g.world_ng[pick]))
         pdf_area = self.emissive_prob[pick] / g.area[pick]
         pdf = dist * dist / np.maximum(cos_l, _TINY) * pdf_area
-        value = np.where((cos_l > 0)[:, None],
-                         self.tri_emission[pick] / np.maximum(pdf, _TINY)[:, None], 0.0)
+        le = self._emission_at(pick, np.stack([b0, b1, 1.0 - b0 - b1], axis=1)) if self.textured \
+            else self.tri_emission[pick]
+        value = np.where((cos_l > 0)[:, None], le / np.maximum(pdf, _TINY)[:, None], 0.0)
         return LightSample(wi, dist, value, pdf, tmax_scale=g.offset_scale(pick, q))
 
     def _sample_world(self, normal, u):
-        local = mf.cosine_hemisphere(u)
+        """Cosine-weighted directions for a uniform world; for a textured one, a defensive mixture:
+        the map's luminance density with probability MAP_SHARE, else cosine-weighted (the
+        sample's density is the mixture's, which ``pdf_world`` also gives)."""
         t, b = _orthonormal(normal)
+        if self.environment is None:
+            local = mf.cosine_hemisphere(u)
+        else:
+            share = MAP_SHARE
+            on_map = u[:, 0] < share
+            u_map = np.stack([u[:, 0] / share, u[:, 1]], axis=1)
+            u_cos = np.stack([(u[:, 0] - share) / (1.0 - share), u[:, 1]], axis=1)
+            local = mf.cosine_hemisphere(np.clip(u_cos, 0.0, 1.0 - 1e-12))
         wi = local[:, :1] * t + local[:, 1:2] * b + local[:, 2:] * normal
-        pdf = local[:, 2] / np.pi
-        value = np.where((pdf > 0)[:, None], self.world / np.maximum(pdf, _TINY)[:, None], 0.0)
+        if self.environment is None:
+            pdf = local[:, 2] / np.pi
+            value = np.where((pdf > 0)[:, None], self.world / np.maximum(pdf, _TINY)[:, None], 0.0)
+            return LightSample(wi, np.full(len(u), np.inf), value, pdf)
+        wi = np.where(on_map[:, None], self.environment.sample(np.clip(u_map, 0.0, 1.0 - 1e-12))[0], wi)
+        pdf = self.pdf_world(normal, wi)
+        up = mf.dot(wi, normal) > 0
+        value = np.zeros((len(u), 3))
+        k = np.flatnonzero(up & (pdf > 0))
+        if len(k):
+            value[k] = self.environment.radiance(wi[k]) / pdf[k, None]
         return LightSample(wi, np.full(len(u), np.inf), value, pdf)
 
     # -- lights hit by rays (multiple importance sampling) --------------------------
@@ -511,6 +590,26 @@ class Lights:
         cos_l = np.maximum(np.abs(mf.dot(dirs, g.world_ng[prim])), _TINY)
         return self.emissive_prob[prim] / g.area[prim] * t * t / cos_l
 
-    @staticmethod
-    def pdf_world(prev_normal, dirs):
-        return np.maximum(mf.dot(prev_normal, dirs), 0.0) / np.pi
+    def pdf_world(self, prev_normal, dirs):
+        cosine = np.maximum(mf.dot(prev_normal, dirs), 0.0) / np.pi
+        if self.environment is not None:
+            return MAP_SHARE * self.environment.pdf(dirs) + (1.0 - MAP_SHARE) * cosine
+        return cosine
+
+    def world_radiance(self, dirs, straight, prev_normal):
+        """Radiance of the world seen along ``dirs`` by camera rays (``straight``), or by rays
+        reflected or refracted at a surface of geometric normal ``prev_normal`` (toward where
+        the ray came from), as the world's ray visibility allows."""
+        n = len(dirs)
+        if not self.world_seen:
+            return np.zeros((n, 3))
+        camera, _, glossy, transmission = self.world_visibility
+        reflected = mf.dot(dirs, prev_normal) >= 0
+        shown = np.where(straight, camera, np.where(reflected, glossy, transmission))
+        if self.environment is not None:
+            value = np.zeros((n, 3))
+            k = np.flatnonzero(shown)
+            if len(k):
+                value[k] = self.environment.radiance(dirs[k])
+            return value
+        return np.where(shown[:, None], self.world_constant, 0.0)

@@ -49,6 +49,16 @@ def max3(v):
     return np.maximum(np.maximum(v[..., 0], v[..., 1]), v[..., 2])
 
 
+def orthonormal_basis(n):
+    """Two unit vectors completing each unit row of n to a right-handed frame (Duff et al. 2017)."""
+    s = np.where(n[:, 2] >= 0, 1.0, -1.0)
+    a = -1.0 / (s + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * b, -s * n[:, 0]], axis=1)
+    bt = np.stack([b, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
+    return t, bt
+
+
 def normalize(v):
     return v / np.maximum(norm(v)[..., None], _TINY)
 

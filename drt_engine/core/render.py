@@ -21,7 +21,6 @@ from . import adaptive
 from . import camera as camera_rays
 from . import microfacet as mf
 from .accel import Geometry, spawn
-from .bsdf import MaterialShader
 from .errors import SceneError
 from .film import Film, PixelFilter
 from .lights import Lights
@@ -30,6 +29,7 @@ from .report import ErrorLog
 from .sampling import Sampler
 from .scene import SceneData
 from .settings import RenderSettings
+from .shading import MaterialShading, SurfaceAttributes, SurfaceContext, load_textures
 from .validate import validate_scene
 
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
@@ -124,20 +124,27 @@ class Renderer:
             if len(mesh.material_indices) and (mesh.material_indices.max() >= len(scene.materials)
                                                or mesh.material_indices.min() < 0):
                 raise SceneError(f"mesh {mesh.name!r} refers to a material that does not exist")
-        self.shaders = [MaterialShader(m) for m in scene.materials]
-        self._lit = np.array([bool(sh.lobes) for sh in self.shaders] + [False])  # casts shadow rays
-        self._continues = np.array([sh.can_continue for sh in self.shaders] + [False])
-        self.lights = Lights(scene, self.geometry, self.shaders)
+        self.warnings = list(scene.warnings) + self.geometry.warnings
+        textures = load_textures(scene, self.warnings)
+        self.shading = [MaterialShading(m, textures, self.warnings) for m in scene.materials]
+        self.shaders = [sh.shader for sh in self.shading]
+        # casts shadow rays, continues (a material with varying inputs may, whatever its fallback)
+        self._lit = np.array([bool(sh.lobes) or m.varying for sh, m in zip(self.shaders, self.shading)] + [False])
+        self._continues = np.array([sh.can_continue or m.varying for sh, m in zip(self.shaders, self.shading)]
+                                   + [False])
+        self.attributes = SurfaceAttributes(scene, self.geometry) if any(s.varying for s in self.shading) else None
+        self.pixel_spread = camera_rays.pixel_spread(self.camera)
+        self.lights = Lights(scene, self.geometry, self.shading, textures)
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
         self.dims = _Dims(self.lights.strategies)
-        self._glows = mf.max3(self.lights.tri_emission) > 0  # per triangle: emission seen when hit
+        # per triangle: emission seen when hit (constant, or from a texture)
+        self._glows = (mf.max3(self.lights.tri_emission) > 0) | np.isin(self.geometry.material, self.lights.textured)
         self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
         self.timed = self.plan.time
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast)
-        self.warnings = list(scene.warnings) + self.geometry.warnings
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
 
@@ -346,16 +353,16 @@ class Renderer:
             idx = np.flatnonzero(escaped)
             if len(idx):
                 st = straight[path[idx]]
-                world = self.scene.world.radiance
+                world = self.lights.world_radiance(dirs[idx], st, prev_normal[idx])
                 if "Env" in aux:
-                    aux["Env"][path[idx[st]]] += throughput[idx[st]] * world
+                    aux["Env"][path[idx[st]]] += throughput[idx[st]] * world[st]
                 if self.scene.film_transparent:
                     alpha[path[idx[st]]] -= throughput[idx[st]].mean(axis=1)
-                    idx = idx[~st]
-                if len(idx) and self.lights.world is not None:
+                    idx, world = idx[~st], world[~st]
+                if len(idx) and self.lights.world_seen:
                     weight = np.ones(len(idx))
                     smooth = ~np.isinf(prev_pdf[idx])
-                    if smooth.any():
+                    if smooth.any() and self.lights.world is not None:
                         k = idx[smooth]
                         weight[smooth] = _power(prev_pdf[k], self.lights.pdf_world(prev_normal[k], dirs[k]))
                     radiance[path[idx]] += throughput[idx] * world * weight[:, None]
@@ -381,7 +388,7 @@ class Renderer:
             # emission seen (two-sided), weighted against light sampling of emissive triangles
             glowing = np.flatnonzero(self._glows[prim]) if len(self._glows) else np.zeros(0, np.int64)
             if len(glowing):
-                emission = self.lights.tri_emission[prim[glowing]]
+                emission = self.lights.emission_seen(prim[glowing], hits.u[surf[glowing]], hits.v[surf[glowing]])
                 weight = np.ones(len(glowing))
                 k = surf[glowing]
                 smooth = ~np.isinf(prev_pdf[k])
@@ -419,12 +426,10 @@ class Renderer:
             lift = self.geometry.smooth_offset(hits, surf, ray_times)
             next_state = []
             shadow = []
-            starts = np.concatenate([[0], np.flatnonzero(np.diff(mat)) + 1])
-            for a, b in zip(starts, np.append(starts[1:], len(mat))):
-                g = slice(int(a), int(b))  # the hits of material mat[a]
-                shader = self.shaders[mat[a]]
+            for g, shader in self._bind_materials(mat, prim, hits, surf, pos, ng_o, ns_o, tangent, bitangent,
+                                                  wo_l, wo, dirs[surf]):
                 if ("DiffCol" in aux or "GlossCol" in aux) and first_hit[g].any():
-                    fg = np.flatnonzero(first_hit[g]) + g.start
+                    fg = _at(g, np.flatnonzero(first_hit[g]))
                     diff, gloss = shader.colors(wo_l[fg, 2])
                     if "DiffCol" in aux:
                         aux["DiffCol"][p_ids[fg]] = diff
@@ -490,6 +495,32 @@ class Renderer:
             u["lobe"][go] = self.sampler.get2d(sp[go], sm[go], self.dims.lobe(depth))
         return u
 
+    def _bind_materials(self, mat, prim, hits, surf, pos, ng, ns, tangent, bitangent, wo_l, wo, dirs):
+        """(hits, shader) per material: a slice of the hits (sorted by material) for a constant
+        material, index arrays of hits sharing one bound shader for a material with varying
+        inputs (see core.shading); a program's normal replaces the shading normal and frame of
+        its hits in place."""
+        starts = np.concatenate([[0], np.flatnonzero(np.diff(mat)) + 1])
+        for a, b in zip(starts, np.append(starts[1:], len(mat))):
+            g = slice(int(a), int(b))  # the hits of material mat[a]
+            shading = self.shading[mat[a]]
+            if not shading.varying:
+                yield g, shading.shader
+                continue
+            u, v = hits.u[surf[g]], hits.v[surf[g]]
+            bary = np.stack([1.0 - u - v, u, v], axis=1)
+            width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[surf[g]]
+            ctx = SurfaceContext(self.attributes, prim[g], bary, pos[g], ns[g], width, dirs[g])
+            groups, normal = shading.bind(ctx)
+            if normal is not None:
+                n = np.where((mf.dot(normal, ng[g]) * mf.dot(wo[g], ng[g]) > 0)[:, None], normal, ns[g])
+                n = np.where((mf.dot(wo[g], n) <= 1e-6)[:, None], ng[g], n)
+                ns[g] = n
+                tangent[g], bitangent[g] = _frame(n)
+                wo_l[g] = _to_local(wo[g], tangent[g], bitangent[g], n)
+            for rows, shader in groups:
+                yield rows + int(a), shader
+
     # -- next-event estimation ----------------------------------------------------------
     def _direct(self, shader, g, u, p_ids, pos, ng, ns, t, b, wo_l, inside, scale, thr, time, lift):
         """Shadow rays (not yet traced) for the hits g (a slice) of one material, one per light strategy."""
@@ -517,6 +548,7 @@ class Renderer:
             wi_l = _to_local(ls.wi, t_g, b_g, ns_g)
             above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f_diff, f_nd, pdf_b = shader.evaluate(wo_g, wi_l, above, in_g, sel_g)
+            f_diff, f_nd = ls.restrict(f_diff, f_nd, above)
             w_l = _power(ls.pdf, pdf_b)
             contrib = thr_g * ls.value * (f_diff + f_nd * w_l[:, None])
             ok &= mf.max3(contrib) > 0
@@ -556,7 +588,7 @@ class Renderer:
         new_thr = thr[g] * weight
         valid &= mf.max3(new_thr) > 0
         sel = np.flatnonzero(valid)
-        gi = sel + g.start
+        gi = _at(g, sel)
         wi = _to_world(wi_l[sel], t[gi], b[gi], ns[gi])
         # a sampled direction on the wrong side of the geometric surface would leak light
         transmit = wi_l[sel, 2] < 0
@@ -622,13 +654,12 @@ def _shadow_origin(pos, ng, wi, cos_shading, lift, scale):
     return spawn(pos + lift * amount[:, None], ng, side, scale)
 
 
-def _frame(n):
-    s = np.where(n[:, 2] >= 0, 1.0, -1.0)
-    a = -1.0 / (s + n[:, 2])
-    bb = n[:, 0] * n[:, 1] * a
-    t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * bb, -s * n[:, 0]], axis=1)
-    b = np.stack([bb, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
-    return t, b
+_frame = mf.orthonormal_basis
+
+
+def _at(g, sel):
+    """Hit indices of the positions ``sel`` within the group ``g`` (a slice or an index array)."""
+    return sel + g.start if isinstance(g, slice) else g[sel]
 
 
 def _to_local(v, t, b, n):

@@ -44,6 +44,10 @@ class Closure:
     """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
     multiscatter: bool = True
     """GGX lobes get Cycles' multiple-scattering energy compensation ("Multiscatter GGX")."""
+    inputs: dict = field(default_factory=dict)
+    """Inputs that vary over the surface: field name ("weight", "color", "roughness",
+    "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``
+    of the material's ``program``; they replace the constant field per hit."""
 
     def __post_init__(self):
         if self.kind not in CLOSURE_KINDS:
@@ -72,15 +76,51 @@ class Material:
 
     name: str
     closures: list[Closure]
+    program: Program | None = None
+    """The shader nodes feeding the closures' varying ``inputs``."""
 
     @property
     def emission(self) -> np.ndarray:
-        """Total emitted radiance of the material (constant over the surface)."""
+        """Total emitted radiance of the material where it is constant (varying emission
+        and weights count with their constant fallback)."""
         total = np.zeros(3)
         for c in self.closures:
             if c.kind in ("EMISSION", "PRINCIPLED"):
                 total += c.weight * c.emission
         return total
+
+
+@dataclass
+class ProgramNode:
+    """One operation of a shader program: ``op`` (see core.shadernodes.OPS), its inputs as
+    ``(node, output)`` references to earlier nodes, and constant parameters."""
+
+    op: str
+    inputs: tuple = ()
+    params: dict = field(default_factory=dict)
+
+
+@dataclass
+class Program:
+    """Shader nodes compiled to a list in evaluation order (inputs refer to earlier nodes)."""
+
+    nodes: list[ProgramNode] = field(default_factory=list)
+
+    def add(self, op: str, inputs=(), **params) -> int:
+        self.nodes.append(ProgramNode(op, tuple(inputs), params))
+        return len(self.nodes) - 1
+
+
+@dataclass
+class TextureImage:
+    """An image for texture lookups: a file OpenImageIO reads, or pixels (H, W, C) bottom row
+    first. ``colorspace``: "sRGB" (linearised on load) or "Non-Color" (used as is; also
+    right for linear float images)."""
+
+    name: str
+    path: str | None = None
+    pixels: np.ndarray | None = None
+    colorspace: str = "sRGB"
 
 
 DEFAULT_MATERIAL = Material("Default", [Closure("PRINCIPLED", color=(0.8, 0.8, 0.8))])
@@ -96,6 +136,10 @@ class Mesh:
     ``material_indices`` (T,) index ``SceneData.materials``. ``uvs`` (T, 3, 2) or None.
     ``motion_vertices`` (S, V, 3): object-space vertices at S evenly spaced shutter times
     for a mesh that deforms (same topology throughout), else None.
+    ``attributes``: per-corner data by name, (T, 3, 2) for UV maps and (T, 3, 4) for colour
+    attributes; ``uvs`` is the default (active render) UV map and ``colors`` the default
+    colour attribute. ``texspace`` (location, size) maps object space to generated
+    coordinates ((p - location + size) / (2 size)); None: the vertices' bounds.
     """
 
     name: str
@@ -105,6 +149,9 @@ class Mesh:
     corner_normals: np.ndarray | None = None
     uvs: np.ndarray | None = None
     motion_vertices: np.ndarray | None = None
+    attributes: dict = field(default_factory=dict)
+    colors: np.ndarray | None = None
+    texspace: tuple | None = None
 
     def __post_init__(self):
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
@@ -120,6 +167,10 @@ class Mesh:
             self.corner_normals = np.asarray(self.corner_normals, dtype=np.float32).reshape(-1, 3, 3)
         if self.uvs is not None:
             self.uvs = np.asarray(self.uvs, dtype=np.float32).reshape(-1, 3, 2)
+        if self.colors is not None:
+            self.colors = np.asarray(self.colors, dtype=np.float32).reshape(-1, 3, 4)
+        self.attributes = {k: np.asarray(v, dtype=np.float32).reshape(len(self.triangles), 3, -1)
+                           for k, v in self.attributes.items()}
 
 
 @dataclass
@@ -209,9 +260,25 @@ class Light:
 
 @dataclass
 class World:
-    """Uniform environment: ``radiance`` seen by rays that escape (colour times strength)."""
+    """The environment seen by rays that escape: ``radiance`` (colour times strength), or,
+    with a ``program``, the radiance its output ``color`` gives per direction (the program's
+    "generated" and "object" inputs are the world-space ray direction).
+
+    Blender's world ray visibility: ``visible_camera`` (seen by camera rays),
+    ``visible_diffuse`` (lights diffuse lobes), ``visible_glossy`` (lights and is seen by
+    reflection), ``visible_transmission`` (lights and is seen through refraction)."""
 
     radiance: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    program: Program | None = None
+    color: tuple | None = None
+    visible_camera: bool = True
+    visible_diffuse: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
+
+    @property
+    def visible_lighting(self) -> bool:
+        return self.visible_diffuse or self.visible_glossy or self.visible_transmission
 
     def __post_init__(self):
         self.radiance = _vec3(self.radiance)
@@ -281,6 +348,8 @@ class SceneData:
     lights: list[Light] = field(default_factory=list)
     world: World = field(default_factory=World)
     film_transparent: bool = False
+    images: list[TextureImage] = field(default_factory=list)
+    """Images the programs' "image" nodes index."""
     warnings: list[str] = field(default_factory=list)
     """Messages for the user gathered during export (unsupported nodes and the like)."""
 

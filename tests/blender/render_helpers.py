@@ -181,3 +181,20 @@ def save_side_by_side(name: str, left: np.ndarray, right: np.ndarray, folder=COM
     output.write_image(pixels)
     output.close()
     return path
+
+
+def environment_texture(world, path: str, rotation_z: float, strength: float, interpolation="Linear"):
+    """Feed ``world``'s Background from an Environment Texture of the image at ``path``, through
+    a Mapping turned by ``rotation_z`` (radians) about Z, at ``strength``."""
+    tree = world.node_tree
+    env = tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = bpy.data.images.load(path)
+    env.interpolation = interpolation
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    background = tree.nodes["Background"]
+    background.inputs["Strength"].default_value = strength
+    tree.links.new(env.outputs["Color"], background.inputs["Color"])

@@ -348,7 +348,7 @@ def test_linked_sockets_fall_back_to_defaults_with_one_warning():
     assert closure.roughness == pytest.approx(0.4)
     assert closure.metallic == pytest.approx(0.9)
     assert len(data.warnings) == 1
-    assert "Textured" in data.warnings[0] and "Base Color" in data.warnings[0]
+    assert "Textured" in data.warnings[0] and "Noise Texture" in data.warnings[0]
 
 
 def test_unconnected_surface_has_no_closures():
@@ -509,7 +509,8 @@ def test_world_background_colour_times_strength():
     assert data.warnings == []
 
 
-def test_world_texture_falls_back_to_the_colour_with_one_warning():
+def test_world_texture_without_image_is_magenta_with_one_warning():
+    """As Cycles (measured: an Image Texture without an image renders (1, 0, 1))."""
     scene = empty_scene()
     scene.world = bpy.data.worlds.new("Sky")
     tree = scene.world.node_tree
@@ -518,7 +519,7 @@ def test_world_texture_falls_back_to_the_colour_with_one_warning():
     background.inputs["Strength"].default_value = 1.5
     tree.links.new(tree.nodes.new("ShaderNodeTexEnvironment").outputs["Color"], background.inputs["Color"])
     data = render_export(scene)
-    np.testing.assert_allclose(data.world.radiance, np.array([0.2, 0.3, 0.4]) * 1.5, rtol=1e-6)
+    np.testing.assert_allclose(data.world.radiance, np.array([1.0, 0.0, 1.0]) * 1.5, rtol=1e-6)
     assert len(data.warnings) == 1 and "Sky" in data.warnings[0]
 
 

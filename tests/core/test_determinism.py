@@ -46,3 +46,24 @@ def test_bit_identical_when_waves_are_split_over_threads(monkeypatch):
     one, two, three = render(1), render(2), render(3)
     for name in one:
         assert np.array_equal(one[name], two[name]) and np.array_equal(one[name], three[name]), name
+
+
+def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
+    from drt_engine.core.scene import TextureImage
+    from textured_scenes import environment_world, image_program
+
+    base = scene()
+    rng = np.random.default_rng(4)
+    prog, ref = image_program()
+    base.materials[0] = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.6, 0.6), inputs={"color": ref})], prog)
+    base.meshes[0].uvs = rng.random((len(base.meshes[0].triangles), 3, 2)).astype(np.float32)
+    base.images = [TextureImage("noise", pixels=rng.random((16, 16, 4)), colorspace="sRGB"),
+                   TextureImage("sky", pixels=rng.random((8, 16, 4)) * 4, colorspace="Non-Color")]
+    base.world = environment_world(image=1, rotation=(0.1, 0.2, 0.3))
+    images = []
+    for threads in (1, 2):
+        s = RenderSettings(samples=8, seed=3, threads=threads, passes=PASSES)
+        images.append(Renderer(base, s).render().passes)
+    for name in images[0]:
+        assert np.array_equal(images[0][name], images[1][name]), name
+        assert np.isfinite(images[0][name]).all(), name

@@ -17,6 +17,7 @@ from .geometry import GeometryExporter
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key
+from .shader_graph import ImageTable
 from .world import export_world
 
 CANCEL_CHECK_INTERVAL = 256
@@ -41,7 +42,8 @@ def export_scene(
         camera_object = camera_object.evaluated_get(depsgraph)  # animated and constrained transform
     camera = export_camera(scene, camera_object)
     warnings: list[str] = []
-    materials = MaterialTable(warnings)
+    images = ImageTable(warnings)
+    materials = MaterialTable(warnings, images)
     geometry = GeometryExporter(materials, depsgraph.view_layer.material_override)
     lights = []
     light_keys = []
@@ -66,7 +68,8 @@ def export_scene(
         instances=geometry.instances,
         materials=materials.materials,
         lights=lights,
-        world=export_world(getattr(depsgraph.view_layer, "world_override", None) or scene.world, warnings),
+        world=export_world(getattr(depsgraph.view_layer, "world_override", None) or scene.world, warnings, images),
+        images=images.images,
         film_transparent=scene.render.film_transparent,
         warnings=warnings,
     )

@@ -38,19 +38,51 @@ def _corner_normals(mesh, tri_vertices, tri_loops):
     return normals[tri_loops]
 
 
-def _render_uvs(mesh, tri_loops):
-    layer = next((uv for uv in mesh.uv_layers if uv.active_render), None)
-    if layer is None or len(mesh.loops) == 0:
-        return None
-    uvs = _read(layer.uv, "vector", len(mesh.loops), 2, np.float32)
-    return uvs[tri_loops]
+def _corner_attributes(mesh, tri_vertices, tri_loops):
+    """(UV maps and colour attributes by name, per triangle corner; the render UV map; the
+    default colour attribute)."""
+    out = {}
+    render_uv = None
+    if len(mesh.loops):
+        for layer in mesh.uv_layers:
+            out[layer.name] = _read(layer.uv, "vector", len(mesh.loops), 2, np.float32)[tri_loops]
+            if layer.active_render:
+                render_uv = out[layer.name]
+    for attr in mesh.color_attributes:
+        if attr.domain not in ("POINT", "CORNER"):
+            continue
+        values = _read(attr.data, "color", len(attr.data), 4, np.float32)
+        out[attr.name] = values[tri_vertices if attr.domain == "POINT" else tri_loops]
+    name = mesh.color_attributes.default_color_name
+    return out, render_uv, out.get(name) if name else None
 
 
-def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray) -> Mesh | None:
+def _tangents(mesh, uv_maps, tri_loops, attributes, warnings):
+    """MikkTSpace tangents (and bitangent signs) per corner for the UV maps Normal Maps use,
+    as Blender computes them, under "tangent:<map>" ('' for the render UV map)."""
+    render = next((uv.name for uv in mesh.uv_layers if uv.active_render), None)
+    for name in uv_maps:
+        layer = name or render
+        if layer is None or layer not in mesh.uv_layers:
+            continue
+        try:
+            mesh.calc_tangents(uvmap=layer)
+        except RuntimeError:
+            warnings.append(f"mesh '{mesh.name}': no tangents for its n-gons (normal maps use triangle tangents)")
+            return
+        n = len(mesh.loops)
+        tangent = _read(mesh.loops, "tangent", n, 3, np.float32)
+        sign = _read(mesh.loops, "bitangent_sign", n, 1, np.float32)
+        attributes["tangent:" + name] = np.concatenate([tangent, sign[:, None]], axis=1)[tri_loops]
+        mesh.free_tangents()
+
+
+def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
-    a face's slot index is clamped to the slots present, as Cycles does.
+    a face's slot index is clamped to the slots present, as Cycles does. ``tangent_maps``:
+    UV maps whose tangents the materials' Normal Map nodes need.
     """
     triangles = mesh.loop_triangles
     count = len(triangles)
@@ -61,13 +93,19 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray) -> Mesh | Non
     tri_loops = _read(triangles, "loops", count, 3, np.int32)
     slots = _read(triangles, "material_index", count, 1, np.int32)
     materials = slot_materials[np.clip(slots, 0, len(slot_materials) - 1)]
+    attributes, uvs, colors = _corner_attributes(mesh, tri_vertices, tri_loops)
+    if tangent_maps and len(mesh.loops):
+        _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
     return Mesh(
         name=name,
         vertices=vertices,
         triangles=tri_vertices,
         material_indices=materials,
         corner_normals=_corner_normals(mesh, tri_vertices, tri_loops),
-        uvs=_render_uvs(mesh, tri_loops),
+        uvs=uvs,
+        attributes=attributes,
+        colors=colors,
+        texspace=(tuple(mesh.texspace_location), tuple(mesh.texspace_size)),
     )
 
 
@@ -125,14 +163,24 @@ class GeometryExporter:
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
             self.keys.append(key)
 
+    def _tangent_maps(self, slot_materials) -> set:
+        maps = set()
+        for index in set(slot_materials.tolist()):
+            program = self.materials.materials[index].program
+            if program is not None:
+                maps |= {n.params.get("map", "") for n in program.nodes if n.op == "normal_map"}
+        return maps
+
     def _export(self, obj, slot_materials) -> int:
+        maps = self._tangent_maps(slot_materials)
+        warnings = self.materials.warnings
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings)
         if mesh is None:
             return -1
         self.meshes.append(mesh)

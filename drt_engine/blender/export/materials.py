@@ -12,7 +12,8 @@ import bpy
 import numpy as np
 
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
-from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
+from .nodes import Issues, find_input, flatten, rgb
+from .shader_graph import Compiler, ImageTable, is_ref
 
 
 def uses_nodes(idblock) -> bool:
@@ -31,11 +32,54 @@ def _multiscatter(node, issues) -> bool:
     return distribution == "MULTI_GGX"
 
 
-def _principled(node, weight, issues):
-    def value(default, *names):
-        return input_value(node, issues, default, *names)
+VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
+           "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint", "normal")
+"""Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
-    alpha = float(np.clip(value(1.0, "Alpha"), 0.0, 1.0))
+
+class _Inputs:
+    """Reads a closure node's inputs: constants, or references into the material's program."""
+
+    def __init__(self, node, compiler, issues):
+        self.node, self.compiler, self.issues = node, compiler, issues
+        self.varying: dict = {}
+
+    def __call__(self, default, *names, field=None, kind=None):
+        socket = find_input(self.node, *names)
+        if socket is None:
+            return default
+        value = self.compiler.value(socket, kind)
+        if not is_ref(value):
+            return value
+        if field in VARYING:
+            self.varying[field] = value
+        else:
+            self.issues.add(f"'{self.node.name}' input '{socket.name}' from a texture (its default value used)")
+        value = socket.default_value
+        return float(value) if isinstance(value, (int, float)) else np.array(value[:], dtype=np.float64)
+
+    def normal(self):
+        socket = find_input(self.node, "Normal")
+        if socket is not None and socket.is_linked:
+            value = self.compiler.value(socket, "vector")
+            if is_ref(value):
+                self.varying["normal"] = value
+
+
+def _weighted(closure, weight, compiler, inputs):
+    """The closure with its (constant or varying) weight and varying inputs."""
+    closure.inputs = dict(inputs)
+    if is_ref(weight):
+        closure.inputs["weight"] = weight
+    else:
+        closure.weight = np.asarray(weight, float) * closure.weight
+    return closure
+
+
+def _principled(node, weight, issues, compiler):
+    value = _Inputs(node, compiler, issues)
+    alpha_socket = find_input(node, "Alpha")
+    alpha = compiler.value(alpha_socket, "float") if alpha_socket is not None else 1.0
     for feature, names in (
         ("Subsurface", ("Subsurface Weight", "Subsurface")),
         ("Sheen", ("Sheen Weight", "Sheen")),
@@ -46,49 +90,74 @@ def _principled(node, weight, issues):
             issues.add(f"'{node.name}' {feature}")
     principled = Closure(
         "PRINCIPLED",
-        weight=weight * alpha,
-        color=rgb(value(0.8, "Base Color")),
-        metallic=value(0.0, "Metallic"),
-        roughness=value(0.5, "Roughness"),
-        ior=value(1.5, "IOR"),
-        specular_ior_level=value(0.5, "Specular IOR Level"),
-        specular_tint=rgb(value(1.0, "Specular Tint")),
-        transmission=value(0.0, "Transmission Weight", "Transmission"),
-        coat_weight=value(0.0, "Coat Weight", "Coat"),
-        coat_roughness=value(0.03, "Coat Roughness"),
-        coat_ior=value(1.5, "Coat IOR"),
-        coat_tint=rgb(value(1.0, "Coat Tint")),
-        emission=rgb(value(1.0, "Emission Color", "Emission")) * value(0.0, "Emission Strength"),
+        color=rgb(value(0.8, "Base Color", field="color", kind="color")),
+        metallic=value(0.0, "Metallic", field="metallic", kind="float"),
+        roughness=value(0.5, "Roughness", field="roughness", kind="float"),
+        ior=value(1.5, "IOR", field="ior", kind="float"),
+        specular_ior_level=value(0.5, "Specular IOR Level", field="specular_ior_level", kind="float"),
+        specular_tint=rgb(value(1.0, "Specular Tint", field="specular_tint", kind="color")),
+        transmission=value(0.0, "Transmission Weight", "Transmission", field="transmission", kind="float"),
+        coat_weight=value(0.0, "Coat Weight", "Coat", field="coat_weight", kind="float"),
+        coat_roughness=value(0.03, "Coat Roughness", field="coat_roughness", kind="float"),
+        coat_ior=value(1.5, "Coat IOR", field="coat_ior", kind="float"),
+        coat_tint=rgb(value(1.0, "Coat Tint", field="coat_tint", kind="color")),
         multiscatter=_multiscatter(node, issues),
     )
-    closures = [principled] if alpha > 0.0 else []
+    _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
+    value.normal()
+    if is_ref(alpha):
+        opaque = compiler.scale(weight, compiler.clamp01(alpha))
+        clear = compiler.scale(weight, compiler.one_minus(compiler.clamp01(alpha)))
+        return [_weighted(principled, opaque, compiler, value.varying),
+                _weighted(Closure("TRANSPARENT", color=np.ones(3)), clear, compiler, {})]
+    alpha = float(np.clip(alpha, 0.0, 1.0))
+    closures = [_weighted(principled, compiler.scale(weight, alpha), compiler, value.varying)] if alpha > 0.0 else []
     if alpha < 1.0:
-        closures.append(Closure("TRANSPARENT", weight=weight * (1.0 - alpha), color=np.ones(3)))
+        closures.append(_weighted(Closure("TRANSPARENT", color=np.ones(3)), compiler.scale(weight, 1.0 - alpha),
+                                  compiler, {}))
     return closures
 
 
 def _bsdf(kind):
-    def make(node, weight, issues):
-        closure = Closure(kind, weight=weight, color=rgb(input_value(node, issues, 0.8, "Color")))
+    def make(node, weight, issues, compiler):
+        value = _Inputs(node, compiler, issues)
+        closure = Closure(kind, color=rgb(value(0.8, "Color", field="color", kind="color")))
         if kind != "TRANSPARENT":
-            closure.roughness = input_value(node, issues, 0.5, "Roughness")
+            closure.roughness = value(0.5, "Roughness", field="roughness", kind="float")
         if kind in ("GLOSSY", "GLASS", "REFRACTION"):
             closure.multiscatter = _multiscatter(node, issues)
         if kind in ("GLASS", "REFRACTION"):
-            closure.ior = input_value(node, issues, 1.5, "IOR")
-        if kind == "DIFFUSE" and closure.roughness > 0.0:
+            closure.ior = value(1.5, "IOR", field="ior", kind="float")
+        if kind == "DIFFUSE" and (closure.roughness > 0.0 or "roughness" in value.varying):
             issues.add(f"'{node.name}' Oren-Nayar roughness")
-        if kind == "GLOSSY" and input_value(node, issues, 0.0, "Anisotropy") > 0.0:
+            value.varying.pop("roughness", None)
+        if kind == "GLOSSY" and value(0.0, "Anisotropy") > 0.0:
             issues.add(f"'{node.name}' anisotropy")
-        return [closure]
+        if kind != "TRANSPARENT":
+            value.normal()
+        return [_weighted(closure, weight, compiler, value.varying)]
 
     return make
 
 
-def _emission(node, weight, issues):
-    color = rgb(input_value(node, issues, 1.0, "Color"))
-    strength = input_value(node, issues, 1.0, "Strength")
-    return [Closure("EMISSION", weight=weight, color=color, emission=color * strength)]
+def _emission_input(closure, value, compiler, default_strength, color_names, strength_names):
+    """Emission colour x strength: constant, or a varying input of the closure."""
+    color = value(1.0, *color_names, field="emission_color", kind="color")
+    strength = value(default_strength, *strength_names, field="emission_strength", kind="float")
+    color_ref = value.varying.pop("emission_color", None)
+    strength_ref = value.varying.pop("emission_strength", None)
+    closure.emission = rgb(color) * strength
+    if color_ref is not None or strength_ref is not None:
+        value.varying["emission"] = compiler.scale(color_ref if color_ref is not None else rgb(color),
+                                                   strength_ref if strength_ref is not None else strength)
+    return rgb(color)
+
+
+def _emission(node, weight, issues, compiler):
+    value = _Inputs(node, compiler, issues)
+    closure = Closure("EMISSION")
+    closure.color = _emission_input(closure, value, compiler, 1.0, ("Color",), ("Strength",))
+    return [_weighted(closure, weight, compiler, value.varying)]
 
 
 CLOSURE_NODES = {
@@ -103,24 +172,26 @@ CLOSURE_NODES = {
 }
 
 
-def export_material(material) -> tuple[Material, str | None]:
+def export_material(material, images: ImageTable) -> tuple[Material, str | None]:
     """The material as closures, and a warning (or None) about what was approximated."""
     if not uses_nodes(material):
         color = np.array(material.diffuse_color[:3], dtype=np.float64)
         return Material(material.name, [Closure("DIFFUSE", color=color, roughness=0.0)]), None
     issues = Issues()
+    compiler = Compiler(images, issues)
 
     def leaf(node, weight):
         make = CLOSURE_NODES.get(node.bl_idname)
         if make is None:
             issues.add(f"shader node '{node.name}' ({node.bl_label}, rendered as default grey)")
-            return [replace(c, weight=weight * c.weight) for c in DEFAULT_MATERIAL.closures]
-        report_linked_inputs(node, issues)
-        return make(node, weight, issues)
+            return [_weighted(replace(c), weight, compiler, {}) for c in DEFAULT_MATERIAL.closures]
+        return make(node, weight, issues, compiler)
 
     output = material.node_tree.get_output_node("CYCLES")
-    closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues)
-    return Material(material.name, closures), issues.message(f"Material '{material.name}'")
+    closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
+    varying = any(c.inputs for c in closures)
+    return (Material(material.name, closures, compiler.program if varying else None),
+            issues.message(f"Material '{material.name}'"))
 
 
 class MaterialTable:
@@ -130,9 +201,10 @@ class MaterialTable:
     materials, as Cycles uses its default surface.
     """
 
-    def __init__(self, warnings: list[str]):
+    def __init__(self, warnings: list[str], images: ImageTable):
         self.materials = [DEFAULT_MATERIAL]
         self.warnings = warnings
+        self.images = images
         self._index: dict[int, int] = {}
 
     def index(self, material) -> int:
@@ -141,7 +213,7 @@ class MaterialTable:
         key = material.original.as_pointer()
         found = self._index.get(key)
         if found is None:
-            exported, warning = export_material(material)
+            exported, warning = export_material(material, self.images)
             if warning:
                 self.warnings.append(warning)
             found = self._index[key] = len(self.materials)

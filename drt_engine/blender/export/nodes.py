@@ -44,6 +44,16 @@ def find_input(node, *names):
 
 def linked_from(socket):
     """The (node, output socket) feeding ``socket`` through reroutes, or None."""
+    found = follow(socket)
+    return None if found is None or found[0] is None else found[:2]
+
+
+def follow(socket, groups=()):
+    """(node, output socket, group stack) feeding ``socket`` through reroutes and, inside the
+    group nodes ``groups`` (outermost first), out through their Group Input nodes; node None
+    for an unlinked input of a group node (``socket`` is then that input); None when nothing
+    feeds it."""
+    stack = list(groups)
     while socket.is_linked:
         link = socket.links[0]
         if link.is_muted or not link.is_valid:
@@ -52,7 +62,16 @@ def linked_from(socket):
         if node.bl_idname == "NodeReroute":
             socket = node.inputs[0]
             continue
-        return node, link.from_socket
+        if node.bl_idname == "NodeGroupInput" and stack:
+            group = stack.pop()
+            outer = next((s for s in group.inputs if s.identifier == link.from_socket.identifier), None)
+            if outer is None:
+                return None
+            if not outer.is_linked:
+                return None, outer, stack
+            socket = outer
+            continue
+        return node, link.from_socket, stack
     return None
 
 
@@ -113,12 +132,13 @@ def report_linked_inputs(node, issues: Issues, ignored=("Weight",)) -> None:
             issues.add(f"'{node.name}' input '{socket.name}' linked to '{source[0].name}'")
 
 
-def flatten(socket, leaf, issues: Issues, weight=None) -> list:
+def flatten(socket, leaf, issues: Issues, weight=None, compiler=None) -> list:
     """Walk Mix and Add Shader nodes down from ``socket`` into weighted leaves.
 
     ``leaf(node, weight)`` turns a closure node into a list of closures with
     ``weight`` (RGB) applied. An unconnected shader socket contributes nothing, as
-    in Cycles.
+    in Cycles. With a ``compiler`` (shader_graph.Compiler) a Mix Shader factor may vary
+    over the surface: the weight is then a reference into its program.
     """
     weight = np.ones(3) if weight is None else weight
     source = linked_from(socket)
@@ -127,15 +147,20 @@ def flatten(socket, leaf, issues: Issues, weight=None) -> list:
     node, output = source
     if node.mute:  # Blender passes a muted node's matching input through, if it has one
         inputs = [link.from_socket for link in node.internal_links if link.to_socket == output]
-        return flatten(inputs[0], leaf, issues, weight) if inputs else []
+        return flatten(inputs[0], leaf, issues, weight, compiler) if inputs else []
     kind = node.bl_idname
     if kind == "ShaderNodeMixShader":
-        fac = float(np.clip(input_value(node, issues, 0.5, "Fac", "Factor"), 0.0, 1.0))
         shaders = [s for s in node.inputs if s.type == "SHADER"]
-        return flatten(shaders[0], leaf, issues, weight * (1.0 - fac)) + flatten(
-            shaders[1], leaf, issues, weight * fac
-        )
+        if compiler is None:
+            fac = float(np.clip(input_value(node, issues, 0.5, "Fac", "Factor"), 0.0, 1.0))
+            first, second = weight * (1.0 - fac), weight * fac
+        else:
+            fac = compiler.clamp01(compiler.value(find_input(node, "Fac", "Factor"), "float"))
+            first, second = compiler.scale(weight, compiler.one_minus(fac)), compiler.scale(weight, fac)
+        return flatten(shaders[0], leaf, issues, first, compiler) + flatten(shaders[1], leaf, issues, second,
+                                                                            compiler)
     if kind == "ShaderNodeAddShader":
         shaders = [s for s in node.inputs if s.type == "SHADER"]
-        return flatten(shaders[0], leaf, issues, weight) + flatten(shaders[1], leaf, issues, weight)
+        return flatten(shaders[0], leaf, issues, weight, compiler) + flatten(shaders[1], leaf, issues, weight,
+                                                                             compiler)
     return leaf(node, weight)

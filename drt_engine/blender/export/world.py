@@ -1,7 +1,10 @@
-"""The world as a uniform environment: Background colour × strength.
+"""The world: Background colour x strength, constant or from shader nodes per direction.
 
-Mix and Add Shader with constant factors are flattened; a World without a node
-tree uses ``world.color`` as Cycles does; no world at all is black.
+Mix and Add Shader are flattened; a World without a node tree uses ``world.color`` as
+Cycles does; no world at all is black. A Background whose colour or strength comes from
+nodes (an Environment Texture through Mapping, say) becomes a program the core evaluates
+per ray direction and importance samples. Ray visibility: Camera, Diffuse, Glossy and
+Transmission.
 """
 from __future__ import annotations
 
@@ -9,12 +12,19 @@ import numpy as np
 
 from ...core.scene import World
 from .materials import uses_nodes
-from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
+from .nodes import Issues, find_input, flatten, rgb
+from .shader_graph import Compiler, ImageTable, is_ref
 
 EMITTERS = ("ShaderNodeBackground", "ShaderNodeEmission")
 
 
-def export_world(world, warnings: list[str]) -> World:
+def _visibility(world) -> dict:
+    vis = world.cycles_visibility
+    return {"visible_camera": vis.camera, "visible_diffuse": vis.diffuse, "visible_glossy": vis.glossy,
+            "visible_transmission": vis.transmission}
+
+
+def export_world(world, warnings: list[str], images: ImageTable) -> World:
     if world is None:
         return World()
     if not uses_nodes(world):
@@ -23,17 +33,26 @@ def export_world(world, warnings: list[str]) -> World:
     if output is None:
         return World()
     issues = Issues()
+    compiler = Compiler(images, issues, world=True)
 
     def leaf(node, weight):
         if node.bl_idname not in EMITTERS:
             issues.add(f"shader node '{node.name}'")
             return []
-        report_linked_inputs(node, issues)
-        color = rgb(input_value(node, issues, 0.05, "Color"))
-        return [weight * color * input_value(node, issues, 1.0, "Strength")]
+        color = compiler.value(find_input(node, "Color"), "color")
+        strength = compiler.value(find_input(node, "Strength"), "float")
+        return [compiler.scale(compiler.mul(weight, color), strength)]
 
-    parts = flatten(output.inputs["Surface"], leaf, issues)
+    parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
+    visibility = _visibility(world)
     message = issues.message(f"World '{world.name}'")
     if message:
         warnings.append(message)
-    return World(radiance=np.sum(parts, axis=0) if parts else np.zeros(3))
+    if not any(is_ref(p) for p in parts):
+        radiance = np.sum([rgb(p) for p in parts], axis=0) if parts else np.zeros(3)
+        return World(radiance=radiance, **visibility)
+    total = compiler.ref(np.zeros(3))
+    for p in parts:
+        total = compiler.op("vector_math", (total, compiler.ref(rgb(p)) if not is_ref(p) else p, np.zeros(3), 1.0),
+                            operation="ADD"), 0
+    return World(program=compiler.program, color=total, **visibility)

@@ -1,0 +1,398 @@
+"""Shader node subgraphs compiled into a core ``Program`` (plain data, no bpy in the core).
+
+``Compiler.value(socket)`` gives a socket's constant value when nothing varying feeds it,
+or a reference ``(node, output)`` into the program. Node groups are inlined, reroutes and
+muted nodes passed through. A node the core cannot evaluate yields its socket's default
+value and one line in the owner's warning naming the node type.
+"""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+
+from ...core import shadernodes as sn
+from ...core.scene import Program, TextureImage
+from ...core.textures import MAGENTA
+from .nodes import LUMINANCE, Issues, follow
+
+COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
+                     "Generic Data")
+
+
+def is_ref(value) -> bool:
+    return isinstance(value, tuple)
+
+
+class ImageTable:
+    """Images used by the scene's programs, each exported once."""
+
+    def __init__(self, warnings: list[str]):
+        self.images: list[TextureImage] = []
+        self.warnings = warnings
+        self._index: dict[int, int] = {}
+
+    def index(self, image) -> int:
+        key = image.as_pointer()
+        found = self._index.get(key)
+        if found is None:
+            found = self._index[key] = len(self.images)
+            self.images.append(self._export(image))
+        return found
+
+    def _export(self, image) -> TextureImage:
+        space = image.colorspace_settings.name
+        if space != "sRGB" and space not in COLORSPACES_AS_IS:
+            self.warnings.append(f"image '{image.name}': colour space {space} used as linear")
+        colorspace = "sRGB" if space == "sRGB" else "Non-Color"
+        if image.packed_file is not None or image.source == "GENERATED":
+            w, h = image.size
+            if w * h > 0:
+                pixels = np.empty(w * h * 4, np.float32)
+                image.pixels.foreach_get(pixels)
+                # byte images hold encoded values; float images are linear already
+                return TextureImage(image.name, pixels=pixels.reshape(h, w, 4),
+                                    colorspace=colorspace if not image.is_float else "Non-Color")
+        if image.source != "FILE":
+            self.warnings.append(f"image '{image.name}': {image.source.lower()} images are not supported")
+        path = bpy.path.abspath(image.filepath, library=image.library)
+        return TextureImage(image.name, path=bpy.path.native_pathsep(path), colorspace=colorspace)
+
+
+def _socket_kind(socket) -> str:
+    return {"VALUE": "float", "INT": "float", "BOOLEAN": "float", "RGBA": "color"}.get(socket.type, "vector")
+
+
+def _const(value):
+    if isinstance(value, (int, float, bool)):
+        return float(value)
+    return np.array(value[:], dtype=np.float64)
+
+
+def _fit(value, kind):
+    """A constant in the shape of a socket kind (Blender's implicit conversions)."""
+    if kind == "float":
+        if isinstance(value, np.ndarray):
+            return float(LUMINANCE @ value[:3]) if len(value) == 4 else float(value[:3].mean())
+        return value
+    if isinstance(value, float):
+        return np.full(3, value)
+    return np.asarray(value, float)[:3]
+
+
+class Compiler:
+    """Compiles the sockets of one material or world into one program."""
+
+    def __init__(self, images: ImageTable, issues: Issues, world: bool = False):
+        self.program = Program()
+        self.images = images
+        self.issues = issues
+        self.world = world
+        self._memo: dict = {}
+        self._groups: list = []  # stack of group nodes being inlined
+
+    # -- references and constants ---------------------------------------------------
+    def ref(self, value, kind=None):
+        if is_ref(value):
+            return value
+        return self.program.add("const", value=value if kind is None else _fit(value, kind)), 0
+
+    def op(self, name, inputs=(), **params):
+        """A program node; a missing input (None) is 0, as an unconnected socket of value 0."""
+        return self.program.add(name, [self.ref(0.0 if x is None else x) for x in inputs], **params)
+
+    def mul(self, a, b):
+        """a * b for two colours, folded when both are constant."""
+        if not is_ref(a) and not is_ref(b):
+            return np.asarray(a, float) * np.asarray(b, float)
+        a3 = a if is_ref(a) else self.ref(_fit(a, "vector"))
+        b3 = b if is_ref(b) else self.ref(_fit(b, "vector"))
+        return self.op("vector_math", (a3, b3, np.zeros(3), 1.0), operation="MULTIPLY"), 0
+
+    def scale(self, a, s):
+        """Colour a times scalar s, folded when both are constant."""
+        if not is_ref(a) and not is_ref(s):
+            return np.asarray(a, float) * s
+        a3 = a if is_ref(a) else self.ref(_fit(a, "vector"))
+        return self.op("vector_math", (a3, np.zeros(3), np.zeros(3), s), operation="SCALE"), 0
+
+    def clamp01(self, a):
+        if not is_ref(a):
+            return float(np.clip(a, 0.0, 1.0))
+        return self.op("clamp", (a, 0.0, 1.0), type="MINMAX"), 0
+
+    def one_minus(self, a):
+        if not is_ref(a):
+            return 1.0 - a
+        return self.op("math", (self.ref(1.0), a, self.ref(0.0)), operation="SUBTRACT"), 0
+
+    # -- sockets ----------------------------------------------------------------------
+    def value(self, socket, kind=None):
+        """Constant or reference for an input socket, in ``kind`` ("float", "color", "vector")."""
+        kind = kind or _socket_kind(socket)
+        default = _fit(_const(socket.default_value), kind) if hasattr(socket, "default_value") else None
+        source = follow(socket, self._groups)
+        if source is None:
+            return default
+        node, output, stack = source
+        if node is None:  # an unlinked input of a group node: its value there
+            return _fit(_const(output.default_value), kind) if hasattr(output, "default_value") else default
+        saved, self._groups = self._groups, stack
+        try:
+            out = self._output(node, output)
+        finally:
+            self._groups = saved
+        return default if out is None else self._convert(out, _socket_kind(output), kind)
+
+    def _convert(self, value, have, want):
+        if have == want or (have != "float" and want != "float"):
+            return value
+        if not is_ref(value):
+            if want == "float" and have == "color":
+                return float(LUMINANCE @ np.asarray(value, float)[:3])
+            return _fit(value, want)
+        kind = "float_to_vector" if have == "float" else ("color_to_float" if have == "color" else "vector_to_float")
+        return self.program.add("convert", [value], kind=kind), 0
+
+    def _output(self, node, output):
+        key = (node.as_pointer(), output.identifier, tuple(g.as_pointer() for g in self._groups))
+        if key not in self._memo:
+            self._memo[key] = self._compile(node, output)
+        return self._memo[key]
+
+    def _in(self, node, name, kind=None):
+        socket = next((s for s in node.inputs if s.identifier == name and s.enabled), None)
+        if socket is None:
+            socket = node.inputs.get(name)
+        return self.value(socket, kind) if socket is not None else None
+
+    def _unsupported(self, node, what=None):
+        self.issues.add(f"'{node.name}' ({what or node.bl_label} node, its input's default value used)")
+        return None
+
+    # -- nodes ------------------------------------------------------------------------
+    def _compile(self, node, output):
+        kind = node.bl_idname
+        if node.mute:
+            inputs = [link.from_socket for link in node.internal_links if link.to_socket == output]
+            return self.value(inputs[0], _socket_kind(output)) if inputs else None
+        handler = getattr(self, "_node_" + kind, None)
+        if handler is None:
+            return self._unsupported(node)
+        return handler(node, output)
+
+    def _node_ShaderNodeRGB(self, node, output):
+        return _const(output.default_value)[:3]
+
+    def _node_ShaderNodeValue(self, node, output):
+        return float(output.default_value)
+
+    def _node_ShaderNodeGroup(self, node, output):
+        tree = node.node_tree
+        if tree is None:
+            return None
+        out = next((n for n in tree.nodes if n.bl_idname == "NodeGroupOutput" and n.is_active_output), None)
+        out = out or next((n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"), None)
+        if out is None:
+            return None
+        socket = next((s for s in out.inputs if s.identifier == output.identifier), None)
+        if socket is None:
+            return None
+        self._groups.append(node)
+        try:
+            return self.value(socket, _socket_kind(output))
+        finally:
+            self._groups.pop()
+
+    def _coord(self, name, uv_map=""):
+        return self.program.add("coord", name=name, map=uv_map), 0
+
+    def _node_ShaderNodeTexCoord(self, node, output):
+        name = output.identifier
+        if self.world:
+            return self._coord("generated")
+        if getattr(node, "object", None) is not None and name == "Object":
+            return self._unsupported(node, "Texture Coordinate from another object")
+        table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal"}
+        if name not in table:
+            return self._unsupported(node, f"Texture Coordinate {name}")
+        return self._coord(table[name])
+
+    def _node_ShaderNodeUVMap(self, node, output):
+        return self._coord("uv", node.uv_map)
+
+    def _node_ShaderNodeNewGeometry(self, node, output):
+        table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming"}
+        name = table.get(output.identifier)
+        if name is None:
+            return self._unsupported(node, f"Geometry {output.identifier}")
+        return self._coord(name)
+
+    def _attribute(self, name, output):
+        i = self.program.add("attribute", name=name)
+        return i, {"Color": 0, "Vector": 0, "Fac": 1, "Alpha": 2}.get(output.identifier, 0)
+
+    def _node_ShaderNodeAttribute(self, node, output):
+        if node.attribute_type != "GEOMETRY":
+            return self._unsupported(node, f"{node.attribute_type.title()} Attribute")
+        return self._attribute(node.attribute_name, output)
+
+    def _node_ShaderNodeVertexColor(self, node, output):
+        return self._attribute(node.layer_name, output)
+
+    def _vector_or(self, node, default):
+        socket = node.inputs.get("Vector")
+        if socket is not None and socket.is_linked:
+            return self.ref(self.value(socket, "vector"))
+        return self._coord(default)
+
+    def _no_image(self, node, output):
+        """Cycles renders a texture node without an image in magenta (measured), as a missing file."""
+        self.issues.add(f"'{node.name}' has no image (magenta)")
+        return MAGENTA[:3].astype(float) if output.identifier == "Color" else 1.0
+
+    def _node_ShaderNodeTexImage(self, node, output):
+        if node.image is None:
+            return self._no_image(node, output)
+        if node.projection != "FLAT":
+            self.issues.add(f"'{node.name}' {node.projection.title()} projection (rendered as Flat)")
+        interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
+        if node.interpolation not in ("Linear", "Closest"):
+            self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")
+        vector = self._vector_or(node, "generated" if self.world else "uv")
+        i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
+                             extension=node.extension)
+        return i, 0 if output.identifier == "Color" else 1
+
+    def _node_ShaderNodeTexEnvironment(self, node, output):
+        if node.image is None:
+            return self._no_image(node, output)
+        if node.projection != "EQUIRECTANGULAR":
+            return self._unsupported(node, f"Environment Texture {node.projection.title()} projection")
+        vector = self._vector_or(node, "generated")
+        interpolation = "Closest" if node.interpolation == "Closest" else "Linear"
+        i = self.program.add("environment", [vector], image=self.images.index(node.image),
+                             interpolation=interpolation)
+        return i, 0 if output.identifier == "Color" else 1
+
+    def _node_ShaderNodeMapping(self, node, output):
+        v = self._in(node, "Vector", "vector")
+        loc = self._in(node, "Location", "vector")
+        rot = self._in(node, "Rotation", "vector")
+        scale = self._in(node, "Scale", "vector")
+        return self.op("mapping", (v, np.zeros(3) if loc is None else loc, rot, scale), type=node.vector_type), 0
+
+    def _node_ShaderNodeMath(self, node, output):
+        if node.operation not in sn.MATH_OPS:
+            return self._unsupported(node, f"Math {node.operation.title()}")
+        a, b, c = (self.value(s, "float") for s in list(node.inputs)[:3])
+        return self.op("math", (a, b, c), operation=node.operation, clamp=node.use_clamp), 0
+
+    def _node_ShaderNodeVectorMath(self, node, output):
+        if node.operation not in sn.VECTOR_MATH_OPS:
+            return self._unsupported(node, f"Vector Math {node.operation.title()}")
+        a, b, c = (self.value(s, "vector") for s in list(node.inputs)[:3])
+        scale = self._in(node, "Scale", "float")
+        i = self.op("vector_math", (a, b, c, 1.0 if scale is None else scale), operation=node.operation)
+        return i, 0 if output.identifier == "Vector" else 1
+
+    def _mix(self, node, data_type, blend, fac, a, b, clamp_factor, clamp_result):
+        if data_type == "RGBA" and blend not in sn.BLEND_MODES:
+            return self._unsupported(node, f"Mix {blend.title()}")
+        return self.op("mix", (fac, a, b), data_type=data_type, blend=blend, clamp_factor=clamp_factor,
+                       clamp_result=clamp_result), 0
+
+    def _node_ShaderNodeMix(self, node, output):
+        t = node.data_type
+        if t not in ("FLOAT", "VECTOR", "RGBA"):
+            return self._unsupported(node, f"Mix {t.title()}")
+        suffix = {"FLOAT": "Float", "VECTOR": "Vector", "RGBA": "Color"}[t]
+        kind = {"FLOAT": "float", "VECTOR": "vector", "RGBA": "color"}[t]
+        vector_fac = t == "VECTOR" and node.factor_mode == "NON_UNIFORM"
+        fac = self._in(node, "Factor_Vector" if vector_fac else "Factor_Float", "vector" if vector_fac else "float")
+        a = self._in(node, "A_" + suffix, kind)
+        b = self._in(node, "B_" + suffix, kind)
+        return self._mix(node, t, node.blend_type, fac, a, b, node.clamp_factor, node.clamp_result)
+
+    def _node_ShaderNodeMixRGB(self, node, output):
+        fac = self._in(node, "Fac", "float")
+        return self._mix(node, "RGBA", node.blend_type, fac, self._in(node, "Color1", "color"),
+                         self._in(node, "Color2", "color"), True, node.use_clamp)
+
+    def _node_ShaderNodeInvert(self, node, output):
+        return self.op("invert", (self._in(node, "Fac", "float"), self._in(node, "Color", "color"))), 0
+
+    def _node_ShaderNodeGamma(self, node, output):
+        return self.op("gamma", (self._in(node, "Color", "color"), self._in(node, "Gamma", "float"))), 0
+
+    def _node_ShaderNodeHueSaturation(self, node, output):
+        names = ("Hue", "Saturation", "Value", "Fac")
+        args = [self._in(node, n, "float") for n in names] + [self._in(node, "Color", "color")]
+        return self.op("hsv", args), 0
+
+    def _node_ShaderNodeRGBToBW(self, node, output):
+        return self.op("rgb_to_bw", (self._in(node, "Color", "color"),)), 0
+
+    def _separate(self, node, output, mode, names):
+        socket = node.inputs[0]
+        i = self.op("separate", (self.value(socket, "vector"),), mode=mode)
+        return i, names.index(output.identifier) if output.identifier in names else 0
+
+    def _node_ShaderNodeSeparateColor(self, node, output):
+        if node.mode not in ("RGB", "HSV"):
+            return self._unsupported(node, f"Separate Color {node.mode}")
+        return self._separate(node, output, node.mode, ("Red", "Green", "Blue"))
+
+    def _node_ShaderNodeSeparateXYZ(self, node, output):
+        return self._separate(node, output, "RGB", ("X", "Y", "Z"))
+
+    def _combine(self, node, mode):
+        args = [self.value(s, "float") for s in list(node.inputs)[:3]]
+        return self.op("combine", args, mode=mode), 0
+
+    def _node_ShaderNodeCombineColor(self, node, output):
+        if node.mode not in ("RGB", "HSV"):
+            return self._unsupported(node, f"Combine Color {node.mode}")
+        return self._combine(node, node.mode)
+
+    def _node_ShaderNodeCombineXYZ(self, node, output):
+        return self._combine(node, "RGB")
+
+    def _node_ShaderNodeValToRGB(self, node, output):
+        ramp = node.color_ramp
+        if ramp.interpolation not in ("LINEAR", "CONSTANT", "EASE") or ramp.color_mode != "RGB":
+            self.issues.add(f"'{node.name}' Color Ramp {ramp.interpolation.title()} (rendered as Linear)")
+        elements = sorted(ramp.elements, key=lambda e: e.position)
+        interpolation = ramp.interpolation if ramp.interpolation in ("CONSTANT", "EASE") else "LINEAR"
+        i = self.op("ramp", (self._in(node, "Fac", "float"),), positions=[e.position for e in elements],
+                    colors=[list(e.color) for e in elements], interpolation=interpolation)
+        return i, 0 if output.identifier == "Color" else 1
+
+    def _node_ShaderNodeTexChecker(self, node, output):
+        args = (self._vector_or(node, "generated"), self._in(node, "Color1", "color"),
+                self._in(node, "Color2", "color"), self._in(node, "Scale", "float"))
+        return self.op("checker", args), 0 if output.identifier == "Color" else 1
+
+    def _node_ShaderNodeNormalMap(self, node, output):
+        if node.space != "TANGENT":
+            return self._unsupported(node, f"Normal Map {node.space.title()} space")
+        args = (self._in(node, "Strength", "float"), self._in(node, "Color", "color"))
+        return self.op("normal_map", args, map=node.uv_map), 0
+
+    def _node_ShaderNodeBump(self, node, output):
+        height = self.ref(self._in(node, "Height", "float"), "float")
+        normal_socket = node.inputs.get("Normal")
+        normal = self.ref(self.value(normal_socket, "vector")) if normal_socket.is_linked else None
+        refs = (self.ref(self._in(node, "Strength", "float")), self.ref(self._in(node, "Distance", "float")),
+                height, normal)
+        return self.program.add("bump", refs, invert=node.invert), 0
+
+    def _node_ShaderNodeClamp(self, node, output):
+        args = [self._in(node, n, "float") for n in ("Value", "Min", "Max")]
+        return self.op("clamp", args, type=node.clamp_type), 0
+
+    def _node_ShaderNodeMapRange(self, node, output):
+        if node.data_type != "FLOAT":
+            return self._unsupported(node, "Map Range Vector")
+        names = ("Value", "From Min", "From Max", "To Min", "To Max", "Steps")
+        args = [self._in(node, n, "float") for n in names]
+        return self.op("map_range", args, type=node.interpolation_type, clamp=node.clamp), 0
