@@ -431,6 +431,7 @@ class MaterialShader:
     # -- lobe selection ---------------------------------------------------------------
     def selection(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L) probabilities of continuing through each non-diffuse lobe."""
+        rows = np.arange(len(mu_o)) if rows is None else rows
         p = np.stack([mf.max3(lobe.albedo_at(mu_o, rows)) for lobe in self.sampled], axis=1)
         total = p.sum(axis=1, keepdims=True)
         return np.where(total > 0, p / np.maximum(total, _TINY), 1.0 / len(self.sampled))

@@ -55,7 +55,9 @@ def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
     base = scene()
     rng = np.random.default_rng(4)
     prog, ref = image_program()
-    base.materials[0] = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.6, 0.6), inputs={"color": ref})], prog)
+    rough = prog.add("convert", [ref], kind="color_to_float")
+    base.materials[0] = Material("floor", [Closure("PRINCIPLED", metallic=0.5, inputs={"color": ref, "roughness": (rough, 0)})],
+                                 prog)
     base.meshes[0].uvs = rng.random((len(base.meshes[0].triangles), 3, 2)).astype(np.float32)
     base.images = [TextureImage("noise", pixels=rng.random((16, 16, 4)), colorspace="sRGB"),
                    TextureImage("sky", pixels=rng.random((8, 16, 4)) * 4, colorspace="Non-Color")]
