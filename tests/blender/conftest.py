@@ -8,12 +8,12 @@ from types import SimpleNamespace
 
 import bpy
 import numpy as np
-import OpenImageIO as oiio
 import pytest
 
 import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
 from drt_engine.core.settings import PASS_CHANNELS
+from render_helpers import read_channels
 
 CAMERA_HEIGHT = 5.0
 
@@ -83,24 +83,6 @@ def emission_scene(width=16, height=12, strength=2.0, world=(0.0, 0.0, 0.0), sam
     subject.objects.link(plane)
     set_world(scene, world)
     return scene
-
-
-def read_channels(path) -> dict:
-    """Every channel of an image file, all EXR parts included: full name -> (h, w) float32, top row first."""
-    image = oiio.ImageInput.open(str(path))
-    assert image is not None, oiio.geterror()
-    channels = {}
-    try:
-        index = 0
-        while image.seek_subimage(index, 0):
-            spec = image.spec()
-            pixels = image.read_image(format="float").reshape(spec.height, spec.width, spec.nchannels)
-            for c, name in enumerate(spec.channelnames):
-                channels[name] = pixels[..., c]
-            index += 1
-    finally:
-        image.close()
-    return channels
 
 
 def render_exr(scene, path) -> dict:
