@@ -12,9 +12,9 @@ ROOT=${1:?usage: tools/blender-env.sh ROOT}
 ROOT=${ROOT%/}
 MIRROR=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 MARK=.drt-blender-env
-# Debian's blender only recommends python3-numpy; pytest runs the core tests on its Python 3.13;
-# xvfb, Mesa and ImageMagick's `import` run the GUI.
-PACKAGES=(blender python3-numpy python3-pytest xvfb xauth libgl1-mesa-dri libegl1 libgl1 imagemagick)
+# Debian's blender only recommends python3-numpy; pytest runs the core tests on its Python 3.13, whose texture tests
+# write and read images with python3-openimageio; xvfb, Mesa and ImageMagick's `import` run the GUI.
+PACKAGES=(blender python3-numpy python3-openimageio python3-pytest xvfb xauth libgl1-mesa-dri libegl1 libgl1 imagemagick)
 HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 
 fail() { echo "blender-env: $*" >&2; exit 1; }

@@ -10,6 +10,8 @@ A missing or unreadable image is Blender's magenta (1, 0, 1, 1).
 """
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 
 from .scene import TextureImage
@@ -33,13 +35,20 @@ def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((np.maximum(c, 0.04045) + 0.055) / 1.055) ** 2.4)
 
 
+def openimageio_available() -> bool:
+    """Whether image files can be read here (Debian's Blender, for one, has no OpenImageIO module)."""
+    return importlib.util.find_spec("OpenImageIO") is not None
+
+
 def read_pixels(image: TextureImage) -> tuple[np.ndarray | None, str | None]:
     """(H, W, 4) float32 pixels, bottom row first, linear; or (None, reason)."""
     if image.pixels is not None:
         px = np.asarray(image.pixels, np.float32)
     else:
-        import OpenImageIO as oiio
-
+        try:
+            import OpenImageIO as oiio
+        except ImportError:  # e.g. a distribution's Blender without its Python bindings
+            return None, "cannot be read: this Python has no OpenImageIO module"
         buf = oiio.ImageBuf(image.path)
         if buf.has_error:
             return None, buf.geterror().strip() or "cannot be read"

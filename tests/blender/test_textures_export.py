@@ -112,6 +112,41 @@ def test_non_color_and_packed_images(saved_scene, texels):
     assert np.abs(centres(packed_img) - srgb_to_linear(texels[::-1] / 255.0)).max() < 1e-6
 
 
+def test_without_openimageio_file_images_come_from_blender(saved_scene, texels, monkeypatch):
+    """A Blender without OpenImageIO (Debian's) reads image files through Blender's own loader:
+    the same texels as OpenImageIO's, sRGB linearised and Non-Color as is."""
+    import drt_engine.blender.export.shader_graph as shader_graph
+
+    scene, image = saved_scene
+    monkeypatch.setattr(shader_graph, "openimageio_available", lambda: False)
+    data = render_export(scene)
+    assert data.images[0].pixels is not None
+    img, warnings = render_data(data)
+    assert not warnings
+    assert np.abs(centres(img) - srgb_to_linear(texels[::-1] / 255.0)).max() < 1e-6
+    image.colorspace_settings.name = "Non-Color"
+    img, _ = render_data(render_export(scene))
+    assert np.abs(centres(img) - texels[::-1] / 255.0).max() < 1e-6
+
+
+def test_reading_a_file_without_openimageio_is_magenta_with_a_reason(monkeypatch):
+    import builtins
+
+    from drt_engine.core.scene import TextureImage
+    from drt_engine.core.textures import read_pixels
+
+    real_import = builtins.__import__
+
+    def no_oiio(name, *args, **kwargs):
+        if name == "OpenImageIO":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_oiio)
+    pixels, reason = read_pixels(TextureImage("Tex", path="/nowhere/tex.png"))
+    assert pixels is None and "OpenImageIO" in reason
+
+
 def test_missing_image_renders_magenta_with_one_warning(tmp_path):
     scene, mat = textured_scene()
     image = bpy.data.images.new("Lost", 4, 4)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ...core import shadernodes as sn
 from ...core.scene import Program, TextureImage
-from ...core.textures import MAGENTA
+from ...core.textures import MAGENTA, openimageio_available
 from .nodes import LUMINANCE, Issues, follow
 
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
@@ -44,7 +44,8 @@ class ImageTable:
         if space != "sRGB" and space not in COLORSPACES_AS_IS:
             self.warnings.append(f"image '{image.name}': colour space {space} used as linear")
         colorspace = "sRGB" if space == "sRGB" else "Non-Color"
-        if image.packed_file is not None or image.source == "GENERATED":
+        # Blender's own pixels where they are the only source, or where OpenImageIO is missing
+        if image.packed_file is not None or image.source == "GENERATED" or not openimageio_available():
             w, h = image.size
             if w * h > 0:
                 pixels = np.empty(w * h * 4, np.float32)

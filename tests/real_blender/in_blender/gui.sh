@@ -7,7 +7,7 @@ set -eu
 : > "$2/display"
 Xvfb -displayfd 3 -screen 0 1600x900x24 -nolisten tcp 3> "$2/display" > "$2/xvfb.log" 2>&1 &
 xvfb=$!
-trap 'kill $xvfb 2>/dev/null || true' EXIT
+trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null || true' EXIT  # wait: gone before the test looks
 trap 'exit 143' TERM INT HUP  # so the EXIT trap also runs when the wrapper's timeout fires
 for _ in $(seq 200); do [ -s "$2/display" ] && break; sleep 0.1; done
 [ -s "$2/display" ] || { echo "Xvfb did not start" >&2; cat "$2/xvfb.log" >&2; exit 1; }
