@@ -28,8 +28,10 @@ from blender_env import IGNIS_SCENES, REPO, SAMPLE_SCENES, check_output, read_pa
 NAMES = SAMPLE_SCENES + tuple(f"ignis_{name}" for name in IGNIS_SCENES)
 SAME_SEED_SHARE = 0.25
 """Largest RMS difference real Blender vs wheel, as a share of the independent-render spread."""
-MEMORY_GROWTH_MB = 8.0
-"""Largest rise of Blender's resident memory in the last animation frame over the earlier ones."""
+MEMORY_GROWTH_MB = 16.0
+"""Largest rise of Blender's resident memory over the second half of the animation, against the first."""
+FRAMES = 6
+"""Frames of the animation test (-s 1 -e 6 -a): two halves of three."""
 
 
 def wheel_render(blend: Path, out: Path, seed: int) -> list[np.ndarray]:
@@ -80,24 +82,29 @@ def test_command_line_render_matches_the_bpy_wheel(installed, scenes, measured, 
 
 
 def test_animation_writes_every_frame_without_growing(installed, scenes, measured):
-    """``-s 1 -e 3 -a`` on the motion-blur scene: three frames written, memory and DRT's live
+    """``-s 1 -e 6 -a`` on the motion-blur scene: every frame written, memory and DRT's live
     objects flat from frame to frame."""
     env = installed
     out = env.work / "animation" / "frame_"
     log = env.work / "animation.log"
     env.blender("-b", env.inside(scenes["motion_blur"]), "--python", env.inside(env.work / "in_blender" / "memory_log.py"),
-                "-E", "DRT", "-o", env.inside(out), "-F", "PNG", "-s", "1", "-e", "3", "-a", "--", env.inside(log))
-    for frame in (1, 2, 3):
+                "-E", "DRT", "-o", env.inside(out), "-F", "PNG", "-s", "1", "-e", str(FRAMES), "-a", "--", env.inside(log))
+    for frame in range(1, FRAMES + 1):
         assert Path(f"{out}{frame:04d}.png").is_file()
     lines = log.read_text().splitlines()
     assert lines[0] == "motion_blur True"
     frames = {int(f): (float(mb), int(objects)) for f, mb, objects in (line.split() for line in lines[1:])}
     measured["animation"] = {"rss_mb_after_frame": {f: mb for f, (mb, _) in frames.items()},
                              "live_drt_objects_after_frame": {f: n for f, (_, n) in frames.items()}}
-    assert sorted(frames) == [1, 2, 3], lines
-    # The first frames pay for imports and one-off allocations and the allocator moves the
-    # resident size by a few MB either way (seen: 282.0, 278.6, 283.7 and 281.5, 291.5, 292.3):
-    # the last frame may not rise above the earlier ones' high mark by more than that. A leak of
-    # these small scenes hides in that noise; the live-object count finds it.
-    assert frames[3][0] - max(frames[1][0], frames[2][0]) <= MEMORY_GROWTH_MB, frames
-    assert frames[3][1] <= frames[2][1] <= frames[1][1], frames
+    assert sorted(frames) == list(range(1, FRAMES + 1)), lines
+    # The first frames pay for imports and one-off allocations, and the allocator moves the
+    # resident size by tens of MB either way (seen after frames 1-3: 292.6, 323.4, 310.9 and
+    # 293.2, 317.9, 333.4): the second half of the range may not rise above the first half's high
+    # mark by more than MEMORY_GROWTH_MB, which a leak of a frame's working set (tens of MB) over
+    # three frames exceeds. A leaked scene or renderer shows in the live-object count.
+    half = FRAMES // 2
+    first = max(frames[f][0] for f in range(1, half + 1))
+    second = max(frames[f][0] for f in range(half + 1, FRAMES + 1))
+    assert second - first <= MEMORY_GROWTH_MB, frames
+    objects = [frames[f][1] for f in range(1, FRAMES + 1)]
+    assert objects == sorted(objects, reverse=True), frames
