@@ -210,7 +210,7 @@ def _render(args) -> str:
         raise CLIError(f"cannot write {output}")
     stats = _write_report(output, blend, args.frame, engine.last_reports)
     width, height = (side * render.resolution_percentage // 100 for side in (render.resolution_x, render.resolution_y))
-    error = report.relative_error_text(math.inf if stats["relmse"] is None else stats["relmse"])
+    error = report.relative_error_text(stats["relmse"])
     return (f"DRT: wrote {output} ({width}x{height}, {stats['samples']} samples, est. error {error}, "
             f"stopped by {report.STOP_REASONS[stats['stopped_by']]}, {elapsed:.1f} s) and its report")
 

@@ -80,8 +80,7 @@ def stats_line(samples_done: int, samples_total: int, relmse: float, elapsed: fl
 
 def done_line(stats: dict, cancelled: bool) -> str:
     """The last stats line: samples, estimated error, time, what stopped the render, the render plan."""
-    relmse = stats.get("relmse")
-    error = report.relative_error_text(float("inf") if relmse is None else relmse)
+    error = report.relative_error_text(stats.get("relmse"))
     state = "Cancelled" if cancelled else "Done"
     samples = f"{stats['samples']} samples"
     if stats.get("adaptive_threshold") is not None:

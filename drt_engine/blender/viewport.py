@@ -7,7 +7,7 @@ publishing the image after every round of samples; ``view_draw`` only uploads th
 newest image and draws it. A new scene or a new view stops the running worker (it
 notices at its next progress call) and starts another one. The worker never holds the
 engine: it asks for redraws through a weak reference, so Blender can free the engine
-whenever it wants, and the engine's ``__del__`` stops the worker first.
+whenever it wants, and a ``weakref.finalize`` on the engine stops the worker first.
 """
 from __future__ import annotations
 
@@ -70,22 +70,23 @@ class ViewportRender:
 
     def _run(self, scene_data, settings, stop: threading.Event) -> None:
         from ..core.render import Renderer
+        from .engine import done_line, stats_line
 
         try:
             renderer = Renderer(scene_data, settings)
+            if stop.is_set():  # the view changed while the scene was being prepared
+                return
 
             def progress(update) -> bool:
                 if stop.is_set():
                     return False
                 self._publish(update.passes()["Combined"], stop,
-                              f"Sample {update.samples_done}/{update.samples_total}")
+                              stats_line(update.samples_done, update.samples_total, update.error, update.elapsed))
                 return not stop.is_set()
 
             result = renderer.render(progress=progress)
             if not result.cancelled:
-                self._publish(result.passes["Combined"], stop,
-                              f"Done | {result.stats.get('samples', settings.samples)} samples "
-                              f"| {result.stats.get('elapsed', 0.0):.2f} s")
+                self._publish(result.passes["Combined"], stop, done_line(result.stats, False))
         except DRTError as error:
             self._fail(" ".join(str(error).split()), stop)
         except Exception as error:  # a bug of ours: keep the UI alive, details in the console

@@ -15,10 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from .scene import World
-from .shadernodes import DirectionContext, Evaluator
+from .shadernodes import LUMINANCE, DirectionContext, Evaluator
 from .textures import Texture, equirect_direction, equirect_uv
 
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 MAX_WIDTH = 1024
 MIN_WIDTH = 64
 CELL_POINTS = ((0.5, 0.5), (0.05, 0.05), (0.95, 0.05), (0.05, 0.95), (0.95, 0.95))
@@ -77,14 +76,25 @@ class Environment:
         row = np.clip(np.searchsorted(self.row_cdf, u[:, 0], side="right") - 1, 0, self.h - 1)
         lo, hi = self.row_cdf[row], self.row_cdf[row + 1]
         fv = np.clip((u[:, 0] - lo) / np.maximum(hi - lo, 1e-300), 0.0, 1.0)
-        cdf = self.col_cdf[row]
-        col = np.clip((u[:, 1:2] >= cdf).sum(axis=1) - 1, 0, self.w - 1)
-        clo = cdf[np.arange(len(u)), col]
-        chi = cdf[np.arange(len(u)), col + 1]
+        col = np.clip(self._column(row, u[:, 1]), 0, self.w - 1)
+        clo = self.col_cdf[row, col]
+        chi = self.col_cdf[row, col + 1]
         fu = np.clip((u[:, 1] - clo) / np.maximum(chi - clo, 1e-300), 0.0, 1.0)
         uv = np.stack([(col + fu) / self.w, (row + fv) / self.h], axis=1)
         dirs = equirect_direction(uv)
         return dirs, self.pdf(dirs)
+
+    def _column(self, row: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Largest k with col_cdf[row, k] <= u, by bisection (rows are non-decreasing from 0):
+        the count of entries <= u, less one, without an (N, W) comparison per wave."""
+        lo = np.zeros(len(u), np.int64)
+        hi = np.full(len(u), self.w, np.int64)
+        while (lo < hi).any():
+            mid = (lo + hi + 1) >> 1
+            up = u >= self.col_cdf[row, mid]
+            lo = np.where(up, mid, lo)
+            hi = np.where(up, hi, mid - 1)
+        return lo
 
     def pdf(self, dirs: np.ndarray) -> np.ndarray:
         uv = equirect_uv(dirs)

@@ -148,14 +148,6 @@ class Film:
         """Slices covering the film a bounded block of pixels at a time."""
         return [slice(a, a + _IMAGE_BLOCK) for a in range(0, self.n, _IMAGE_BLOCK)]
 
-    def standard_error(self) -> np.ndarray:
-        """Per-pixel standard error of the Combined RGB mean (the Noise pass).
-
-        Sample ids 0 and 1 are both class B, so a pixel with fewer than three samples
-        has no estimate yet; it reports its own value, a 100% error.
-        """
-        return _standard_error(self.count, self.count_a, self.sums["Combined"][:, :3], self.sum_a)
-
     def images(self) -> dict[str, np.ndarray]:
         """Each enabled pass as (height, width, channels) float32, rows from the bottom.
 

@@ -16,6 +16,7 @@ from . import microfacet as mf
 from .errors import SceneError
 from .environment import Environment
 from .motion import Motion
+from .shadernodes import LUMINANCE
 from .shading import SurfaceAttributes, SurfaceContext
 from .scene import Light, SceneData
 
@@ -42,10 +43,6 @@ class LightSample:
 def _smoothstep(t):
     t = np.clip(t, 0.0, 1.0)
     return t * t * (3.0 - 2.0 * t)
-
-
-def _lum(c):
-    return float(np.dot(c, [0.2126, 0.7152, 0.0722]))
 
 
 _orthonormal = mf.orthonormal_basis
@@ -177,7 +174,7 @@ class Lights:
         estimate = tri_emission.copy()
         for m in self.textured:
             estimate[geometry.material == m] = self._textured_estimate(m)
-        power = estimate @ np.array([0.2126, 0.7152, 0.0722]) * geometry.area
+        power = estimate @ LUMINANCE * geometry.area
         self.emissive = np.flatnonzero(power > 0)
         if len(self.emissive):
             cdf = np.cumsum(power[self.emissive])
@@ -281,21 +278,20 @@ class Lights:
 
     # -- choosing among many lights ---------------------------------------------------
     def _prepare_selection(self):
-        lum = np.array([0.2126, 0.7152, 0.0722])
         self._sel_pos = np.array([light.position for light in self.lights])
         self._sel_power = np.empty(len(self.lights))
         self._sel_distant = np.array([light.kind == "SUN" for light in self.lights])
         self._sel_size2 = np.empty(len(self.lights))
         for i, light in enumerate(self.lights):
             if light.kind == "SUN":
-                self._sel_power[i] = light.irradiance @ lum
+                self._sel_power[i] = light.irradiance @ LUMINANCE
                 self._sel_size2[i] = 0.0
             elif light.kind == "AREA":
                 *_, sx, sy, _disk, area = self._area_frame(light)
-                self._sel_power[i] = (light.radiance @ lum) * area
+                self._sel_power[i] = (light.radiance @ LUMINANCE) * area
                 self._sel_size2[i] = 0.25 * (sx * sx + sy * sy)
             else:
-                self._sel_power[i] = light.intensity @ lum
+                self._sel_power[i] = light.intensity @ LUMINANCE
                 self._sel_size2[i] = light.radius**2
 
     def selection_probability(self, pos: np.ndarray) -> np.ndarray:

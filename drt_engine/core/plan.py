@@ -49,11 +49,12 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     moving = [inst.name or f"instance {i}" for i, inst in enumerate(scene.instances)
               if Motion(inst.matrices).moving or _deforms(scene.meshes[inst.mesh])]
     moving += [f"light {light.name or i}" for i, light in enumerate(lights.lights) if i in lights.motions]
-    if Motion(camera.matrices).moving:
+    camera_moves = Motion(camera.matrices).moving
+    if camera_moves:
         moving.append("camera")
-    time = geometry.moving or lights.moving or "camera" in moving
+    time = geometry.moving or lights.moving or camera_moves
 
-    used = {int(m) for m in set(geometry.material.tolist())}
+    used = {int(m) for m in np.unique(geometry.material)}
     kinds = {lobe.kind for m in used for lobe in shaders[m].lobes}
     bounces = settings.max_depth > 0
     rays = {"camera": True,

@@ -288,7 +288,6 @@ class Renderer:
         s = self.settings
         passes = set(s.passes)
         n = len(pixel)
-        pix_id = pixel.astype(np.uint32)
         seed_pixel = (pixel % w + x0) + (pixel // w + y0) * self.camera.resolution[0]  # stable across windows
         seed_pixel = seed_pixel.astype(np.uint32)
         off = self.filter.offset(self.sampler.get2d(seed_pixel, sample, _Dims.PIXEL))

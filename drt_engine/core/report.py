@@ -63,9 +63,9 @@ STOP_REASONS = {
 """What ``stats['stopped_by']`` means, as the stats line and the CLI say it."""
 
 
-def relative_error_text(relmse: float) -> str:
+def relative_error_text(relmse: float | None) -> str:
     """The estimated relative RMS error as the stats line shows it ('0.8%'), or '?' while unknown."""
-    if not math.isfinite(relmse):
+    if relmse is None or not math.isfinite(relmse):
         return "?"
     pct = 100.0 * math.sqrt(max(relmse, 0.0))
     return f"{pct:.2g}%" if pct < 1 else f"{pct:.1f}%"

@@ -111,10 +111,9 @@ _SOBOL = _byte_tables(_sobol_matrices())
 
 
 def sobol_u32(index: np.ndarray, dim: int) -> np.ndarray:
-    """Unscrambled Sobol point ``index`` in dimension ``dim`` (0-3) as 32-bit fixed point."""
+    """Unscrambled Sobol point ``index`` in dimension ``dim`` (1-3; dimension 0, the bit reversal, is
+    Sampler._sobol's own) as 32-bit fixed point."""
     index = np.asarray(index, dtype=_U32)
-    if dim == 0:
-        return _reverse_bits(index)  # the van der Corput sequence
     t = _SOBOL[dim]
     out = np.take(t[0], index & _U32(0xFF))
     out ^= np.take(t[1], (index >> _U32(8)) & _U32(0xFF))

@@ -20,6 +20,7 @@ from .scene import Program
 from .textures import Texture, equirect_uv
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+"""Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
 _TINY = 1e-30
 
 
@@ -255,11 +256,6 @@ def _map_range(kind, v, a, b, c, d, steps, clamp):
     if clamp and kind in ("LINEAR", "STEPPED"):
         out = np.clip(out, np.minimum(c, d), np.maximum(c, d))
     return out
-
-
-OPS = ("const", "coord", "attribute", "image", "environment", "math", "vector_math", "mix", "invert", "gamma",
-       "hsv", "rgb_to_bw", "separate", "combine", "ramp", "checker", "mapping", "normal_map", "bump",
-       "clamp", "map_range", "convert")
 
 
 class Evaluator:

@@ -17,8 +17,6 @@ import numpy as np
 from .scene import TextureImage
 
 MAGENTA = np.array([1.0, 0.0, 1.0, 1.0], np.float32)
-EXTENSIONS = ("REPEAT", "EXTEND", "CLIP", "MIRROR")
-INTERPOLATIONS = ("Linear", "Closest")
 MAX_TAPS = 8
 FILTER_SCALE = 0.25
 """Filter extent per footprint. The pixel filter already integrates over the footprint; the

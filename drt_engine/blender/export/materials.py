@@ -66,7 +66,7 @@ class _Inputs:
                 self.varying["normal"] = value
 
 
-def _weighted(closure, weight, compiler, inputs):
+def _weighted(closure, weight, inputs):
     """The closure with its (constant or varying) weight and varying inputs."""
     closure.inputs = dict(inputs)
     if is_ref(weight):
@@ -108,13 +108,12 @@ def _principled(node, weight, issues, compiler):
     if is_ref(alpha):
         opaque = compiler.scale(weight, compiler.clamp01(alpha))
         clear = compiler.scale(weight, compiler.one_minus(compiler.clamp01(alpha)))
-        return [_weighted(principled, opaque, compiler, value.varying),
-                _weighted(Closure("TRANSPARENT", color=np.ones(3)), clear, compiler, {})]
+        return [_weighted(principled, opaque, value.varying),
+                _weighted(Closure("TRANSPARENT", color=np.ones(3)), clear, {})]
     alpha = float(np.clip(alpha, 0.0, 1.0))
-    closures = [_weighted(principled, compiler.scale(weight, alpha), compiler, value.varying)] if alpha > 0.0 else []
+    closures = [_weighted(principled, compiler.scale(weight, alpha), value.varying)] if alpha > 0.0 else []
     if alpha < 1.0:
-        closures.append(_weighted(Closure("TRANSPARENT", color=np.ones(3)), compiler.scale(weight, 1.0 - alpha),
-                                  compiler, {}))
+        closures.append(_weighted(Closure("TRANSPARENT", color=np.ones(3)), compiler.scale(weight, 1.0 - alpha), {}))
     return closures
 
 
@@ -135,7 +134,7 @@ def _bsdf(kind):
             issues.add(f"'{node.name}' anisotropy")
         if kind != "TRANSPARENT":
             value.normal()
-        return [_weighted(closure, weight, compiler, value.varying)]
+        return [_weighted(closure, weight, value.varying)]
 
     return make
 
@@ -157,7 +156,7 @@ def _emission(node, weight, issues, compiler):
     value = _Inputs(node, compiler, issues)
     closure = Closure("EMISSION")
     closure.color = _emission_input(closure, value, compiler, 1.0, ("Color",), ("Strength",))
-    return [_weighted(closure, weight, compiler, value.varying)]
+    return [_weighted(closure, weight, value.varying)]
 
 
 CLOSURE_NODES = {
@@ -184,7 +183,7 @@ def export_material(material, images: ImageTable) -> tuple[Material, str | None]
         make = CLOSURE_NODES.get(node.bl_idname)
         if make is None:
             issues.add(f"shader node '{node.name}' ({node.bl_label}, rendered as default grey)")
-            return [_weighted(replace(c), weight, compiler, {}) for c in DEFAULT_MATERIAL.closures]
+            return [_weighted(replace(c), weight, {}) for c in DEFAULT_MATERIAL.closures]
         return make(node, weight, issues, compiler)
 
     output = material.node_tree.get_output_node("CYCLES")

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...core.shadernodes import LUMINANCE
+
 CONSTANT_NODES = ("ShaderNodeRGB", "ShaderNodeValue")
 
 
@@ -93,8 +95,6 @@ def socket_value(socket, issues: Issues):
     return _constant(socket.default_value)
 
 
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
-"""Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
 
 
 def _coerce(value, socket):
