@@ -144,8 +144,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     use_adaptive_sampling: BoolProperty(
         name="Adaptive Sampling",
-        description="After the minimum samples, stop sampling pixels that need no more, "
-        "testing every 16 samples (as Cycles)",
+        description="After the minimum samples, stop sampling pixels that need no more and "
+        "spend the samples where the image is still noisy",
         default=False,
     )
     adaptive_mode: EnumProperty(
@@ -153,7 +153,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         description="How a pixel is judged to need more samples",
         items=(
             ("NOISE", "Noise", "Until the estimated error of the pixel's mean is under the noise "
-             "threshold, with Cycles' measure and threshold"),
+             "threshold, with Cycles' measure and threshold; the pixels still sampling share each "
+             "round in proportion to their error"),
             ("CONTRAST", "Contrast", "While the samples in the pixel's 3x3 neighbourhood differ in "
              "contrast beyond Mitchell's (1987) thresholds (the noise threshold is not used)"),
         ),

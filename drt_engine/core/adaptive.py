@@ -2,13 +2,18 @@
 
 Two modes decide which pixels keep receiving samples after the minimum:
 
-- NOISE, with Cycles' semantics so its settings carry over (kernel/film/adaptive_sampling.h,
-  scene/integrator.cpp): a pixel converges when the sum over RGB of its standard
-  error, divided by sqrt(R+G+B) below 1 and by R+G+B above, is under 5 x threshold;
-  threshold 0 means max(0.001, 1 / samples); 0 min samples means
-  max(4, ceil(16 / threshold^0.3)); the first test is at sample ((min + 1) | 15) + 1,
-  then every 16 samples; unconverged pixels keep their neighbours sampling (a
-  one-pixel dilation), and a converged pixel is tested again at every step.
+- NOISE, with Cycles' semantics for its settings so they carry over
+  (kernel/film/adaptive_sampling.h, scene/integrator.cpp): a pixel converges when the
+  sum over RGB of its standard error, divided by sqrt(R+G+B) below 1 and by R+G+B
+  above, is under 5 x threshold; threshold 0 means max(0.001, 1 / samples); 0 min
+  samples means max(4, ceil(16 / threshold^0.3)); unconverged pixels keep their
+  neighbours sampling (a one-pixel dilation), and a converged pixel is tested again
+  at every round. Two things differ from Cycles, both for the error of the image:
+  the first test comes right after Min Samples (Cycles waits for the next multiple of
+  16, its GPU batch), and the pixels still sampling do not get one more batch each but
+  share a round in proportion to their estimated error per sample (``allocate``):
+  a threshold alone makes every pixel equally noisy, which for the image's mean
+  squared error is barely better than sampling all pixels alike.
 - CONTRAST, the classic refinement of Mitchell (1987): a pixel keeps sampling while
   the samples in its 3x3 neighbourhood differ, i.e. (max - min) / (max + min) of some
   channel exceeds Mitchell's thresholds (0.4, 0.3, 0.6 for R, G, B). It looks at
@@ -40,6 +45,16 @@ MIN_ROUND = 1 << 14
 22k, so about 0.06 s plus 5 us a sample), so rounds over a small image or a few active
 pixels are lengthened until they hold this many samples: tracing stays efficient and
 the tests get sparser."""
+
+ROUND_GROWTH = 0.5
+"""A NOISE round adds this fraction of the samples traced so far (at least MIN_ROUND): the
+rounds grow geometrically, so their fixed costs stay a small share of the render and the
+image is tested and logged at every 1.5-fold of its samples."""
+
+DEFENSIVE = 0.25
+"""Every pixel's share counts this fraction of the mean spread on top of its own, so a pixel
+whose few samples all missed a rare bright path still gains samples (a defensive mixture
+with uniform sampling, as in Hesterberg 1995)."""
 
 MITCHELL_CONTRAST = np.array([0.4, 0.3, 0.6])
 RELMSE_EPSILON = 1e-2
@@ -99,8 +114,8 @@ def next_checkpoint(points: list[int], done: int, active: int, first: int) -> in
 
 
 def first_test(min_count: int) -> int:
-    """Sample count of the first test, as Cycles: 0-based sample (min + 1) | (step - 1)."""
-    return ((min_count + 1) | (ADAPTIVE_STEP - 1)) + 1
+    """Sample count of the first test: right after the minimum (see the module docstring)."""
+    return min_count
 
 
 def dilate(mask: np.ndarray) -> np.ndarray:
@@ -176,3 +191,51 @@ def true_error(image: np.ndarray, reference: np.ndarray, reference_variance=None
         d2 = d2 - np.asarray(reference_variance, float)
     denom = np.asarray(reference, float) ** 2 + RELMSE_EPSILON
     return float(np.sqrt(max(d2.mean(), 0.0))), float(max((d2 / denom).mean(), 0.0))
+
+
+def sample_spread(film: Film) -> np.ndarray:
+    """Per pixel, the relative error of one sample, regularised: the share to give it.
+
+    A pixel's relMSE is r / n with r = n x the estimated variance of its mean over
+    (value^2 + 0.01), summed over RGB; the image relMSE is the mean of those, so a given
+    number of samples makes it least when pixel i holds samples in proportion to
+    sqrt(r_i) (Neyman allocation). r comes from the film's two replicates, one degree
+    of freedom a pixel: a low draw would starve a noisy pixel for good (its estimate
+    changes only with new samples), so a pixel takes the larger of its own r and the
+    mean over its 3x3 neighbourhood, plus the defensive share. Pixels without both
+    replicates yet take the largest r seen.
+    """
+    h, w = film.height, film.width
+    r = np.empty(film.n, np.float32)
+    for span in film.blocks():  # whole-film float64 temporaries of an 8K image are GBs
+        n = film.count[span]
+        mean = film.sums["Combined"][span, :3] / np.maximum(n, 1)[:, None]
+        r[span] = (film.variance(span) / (mean * mean + RELMSE_EPSILON)).sum(axis=1) * n
+    known = np.isfinite(r)
+    r[~known] = r[known].max() if known.any() else 1.0
+    grid = np.pad(r.reshape(h, w), 1, mode="edge")
+    box = sum(grid[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9.0
+    spread = np.sqrt(np.maximum(r, box.reshape(-1)))
+    return spread + DEFENSIVE * float(spread.mean()) + np.float32(1e-12)
+
+
+def allocate(film: Film, active: np.ndarray, budget: int, cap: int) -> np.ndarray:
+    """Samples each of the ``active`` pixels gets in the next round, about ``budget`` in all.
+
+    Water-filling: the totals are raised toward lambda x sample_spread (no pixel loses
+    samples or passes ``cap``), lambda found by bisection so the round holds ``budget``.
+    """
+    spread = sample_spread(film)[active].astype(np.float64)
+    have = film.count[active]
+    room = np.maximum(cap - have, 0.0)
+    if room.sum() <= budget:
+        return room.astype(np.int64)
+
+    def given(lam):
+        return np.clip(lam * spread - have, 0.0, room)
+
+    lo, hi = 0.0, float(cap / spread.min())  # at hi every pixel reaches the cap
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if given(mid).sum() < budget else (lo, mid)
+    return np.ceil(given(hi)).astype(np.int64)

@@ -156,8 +156,9 @@ class Renderer:
         so the film's two halves are independent estimates and its error estimate holds.
 
         Only active pixels are traced: a round gives every active pixel the samples it
-        lacks to reach the next checkpoint, sample after sample over the active pixels
-        (so a round cut short leaves an even image), in waves of at most WAVE. Each
+        lacks to reach the next checkpoint (after NOISE's first test: its share of a round
+        that grows with the render, adaptive.allocate), sample after sample over the
+        active pixels (so a round cut short leaves an even image), in waves of at most WAVE. Each
         pixel draws sample ids 0, 1, 2, ... in order, so its sequence stays stratified.
         """
         start = time.perf_counter()
@@ -199,11 +200,18 @@ class Renderer:
             return progress is None or progress(update) is not False
 
         target = 0
+        allocating = False
+        unconverged = 1.0  # fraction of the pixels the last test left unconverged
         try:
             while True:
-                target = adaptive.next_checkpoint(points, target, len(active), first)
                 base = _counts(self.film.count, active)
-                need = target - base
+                if allocating:
+                    budget = max(adaptive.MIN_ROUND, int(adaptive.ROUND_GROWTH * traced))
+                    need = adaptive.allocate(self.film, active, budget, cap)
+                    target = int((base + need).max())
+                else:
+                    target = adaptive.next_checkpoint(points, target, len(active), first)
+                    need = target - base
                 keep = need > 0
                 pix, base, need = (active, base, need) if keep.all() else (active[keep], base[keep], need[keep])
                 left = int(need.sum(dtype=np.int64))
@@ -224,11 +232,13 @@ class Renderer:
                         break
                 if stopped:
                     break
-                if s.use_adaptive_sampling and target >= first and target < cap:
+                if s.use_adaptive_sampling and target >= first and (allocating or target < cap):
                     mask = adaptive.still_active(self.film, s.adaptive_mode, threshold)
-                    active = np.flatnonzero(mask)
-                entry = log.record(time.perf_counter() - start, self.film, self.rays, len(active) / max(n_pix, 1))
-                if target == cap:
+                    unconverged = float(mask.mean())
+                    active = np.flatnonzero(mask & (self.film.count < cap))
+                    allocating = s.adaptive_mode == "NOISE"
+                entry = log.record(time.perf_counter() - start, self.film, self.rays, unconverged)
+                if self.film.count.min() >= cap if allocating else target == cap:
                     stopped = "samples"
                 elif len(active) == 0:
                     stopped = "threshold"
@@ -242,7 +252,7 @@ class Renderer:
                     entry["stopped"] = stopped
                     break
             if stopped in ("time_limit", "cancelled") and (not log.last or "stopped" not in log.last):
-                log.record(time.perf_counter() - start, self.film, self.rays, len(active) / max(n_pix, 1), stopped)
+                log.record(time.perf_counter() - start, self.film, self.rays, unconverged, stopped)
         finally:
             if self.pool is not None:
                 self.pool.shutdown(wait=True)

@@ -273,7 +273,7 @@ def test_done_line_says_what_stopped_the_render():
                                                                 adaptive_min_samples=8))
     outcome = renderer.render()
     line = engine_module.done_line(outcome.stats, outcome.cancelled)
-    assert re.fullmatch(r"Done \| 16 samples \(mean 16\.0\) \| est\. error 0% \| \d+\.\d\d s "
+    assert re.fullmatch(r"Done \| 8 samples \(mean 8\.0\) \| est\. error 0% \| \d+\.\d\d s "
                         r"\| stopped by noise threshold \| plan: .+", line), line
     assert engine_module.stats_line(12, 64, 6.4e-5, 12.34) == "Sample 12/64 | est. error 0.8% | 12.3 s"
     assert engine_module.stats_line(1, 64, float("inf"), 0.0) == "Sample 1/64 | est. error ? | 0.0 s"
