@@ -104,6 +104,9 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--adaptive-threshold", type=_float_in(0.0, 1.0), metavar="T",
                         help="noise threshold, 0 = automatic; turns adaptive sampling on "
                         "(scene.drt.adaptive_threshold)")
+    render.add_argument("--adaptive-min-samples", type=_at_least(0), metavar="N",
+                        help="samples every pixel takes before adaptive sampling starts, 0 = automatic; "
+                        "turns adaptive sampling on (scene.drt.adaptive_min_samples)")
     render.add_argument("--adaptive-mode", type=_mode, metavar="NOISE|CONTRAST",
                         help="adaptive sampling mode; turns adaptive sampling on (scene.drt.adaptive_mode)")
     return parser
@@ -186,6 +189,9 @@ def _render(args) -> str:
     if args.adaptive_threshold is not None:
         scene.drt.use_adaptive_sampling = True
         scene.drt.adaptive_threshold = args.adaptive_threshold
+    if args.adaptive_min_samples is not None:
+        scene.drt.use_adaptive_sampling = True
+        scene.drt.adaptive_min_samples = args.adaptive_min_samples
     if args.adaptive_mode is not None:
         scene.drt.use_adaptive_sampling = True
         scene.drt.adaptive_mode = args.adaptive_mode

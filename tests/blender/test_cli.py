@@ -50,7 +50,7 @@ def test_help():
     result = run_cli("render", "--help", timeout=60)
     assert result.returncode == 0
     for option in ("--samples", "--seed", "--frame", "--resolution", "--engine-threads", "-o", "--time-limit",
-                   "--target-error", "--adaptive-threshold", "--adaptive-mode"):
+                   "--target-error", "--adaptive-threshold", "--adaptive-min-samples", "--adaptive-mode"):
         assert option in result.stdout
     assert result.stderr == ""
 
@@ -89,7 +89,8 @@ def test_render_to_png_through_the_view_transform(bl, blend, tmp_path):
 def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
     out = tmp_path / "out.exr"
     result = run_cli("render", blend, "-o", out, "--resolution", "128x96", "--samples", 32, "--time-limit", 60,
-                     "--target-error", 0, "--adaptive-threshold", 0.05, "--adaptive-mode", "noise")
+                     "--target-error", 0, "--adaptive-threshold", 0.05, "--adaptive-min-samples", 8,
+                     "--adaptive-mode", "noise")
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     assert result.stderr == ""
     report = json.loads((tmp_path / "out.drt.json").read_text())
@@ -97,15 +98,16 @@ def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
     settings = report["settings"]
     assert settings["use_adaptive_sampling"] and settings["adaptive_mode"] == "NOISE"
     assert settings["time_limit"] == 60 and settings["samples"] == 32
-    assert settings["adaptive_threshold"] == pytest.approx(0.05)
+    assert settings["adaptive_threshold"] == pytest.approx(0.05) and settings["adaptive_min_samples"] == 8
     assert report["scene"]["resolution"] == [128, 96] and report["scene"]["triangles"] == 2
     log = report["log"]
     assert len(log) >= 3
     for key in ("elapsed", "samples", "spp_max"):
         values = [entry[key] for entry in log]
         assert all(a < b for a, b in zip(values, values[1:])), (key, values)
-    assert log[-1]["samples"] == report["stats"]["rays"]["camera"] == 128 * 96 * 32
-    assert log[-1]["stopped"] == report["stats"]["stopped_by"] == "samples"
+    # a noiseless emitter: every pixel converges at the first test, after the 8 minimum samples
+    assert log[-1]["samples"] == report["stats"]["rays"]["camera"] == 128 * 96 * 8
+    assert log[-1]["stopped"] == report["stats"]["stopped_by"] == "threshold"
     plot = bl.read_channels(tmp_path / "out.error.png")
     assert plot["R"].shape == (420, 640)
     assert plot["R"].min() < 0.5  # axes and curves drawn on the white page
@@ -113,7 +115,7 @@ def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
 
 @pytest.mark.parametrize("option, value", [("--time-limit", "-1"), ("--target-error", "abc"),
                                            ("--adaptive-threshold", "2"), ("--adaptive-threshold", "nan"),
-                                           ("--adaptive-mode", "FAST")])
+                                           ("--adaptive-min-samples", "-4"), ("--adaptive-mode", "FAST")])
 def test_bad_stop_rule_values(blend, tmp_path, option, value):
     out = tmp_path / "o.exr"
     assert_one_line_error(run_cli("render", blend, "-o", out, option, value), option)
