@@ -42,7 +42,6 @@ sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
-import OpenImageIO as oiio  # noqa: E402
 
 import drt_engine  # noqa: E402
 from drt_engine.core.adaptive import true_error  # noqa: E402
@@ -50,6 +49,9 @@ from drt_engine.core.render import Renderer  # noqa: E402
 from drt_engine.core.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
 from scenes import SCENES, load  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "tests" / "blender"))
+from render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)
 
 LEVELS = (1e-2, 3e-3, 1e-3, 1e-4)
 SWEEP = (4, 16, 64, 256, 1024)
@@ -100,30 +102,6 @@ def drt_run(data, settings, reference=None, repeat=REPEAT):
     return runs[0][0], points, min(r[2] for r in runs)
 
 
-def configure_cycles(scene, samples, seed, threshold=None):
-    """Cycles as a distribution ray tracer: no indirect diffuse, DRT's depth and filter, no denoising."""
-    c = scene.cycles
-    depth = scene.drt.max_depth
-    c.device = "CPU"
-    c.samples = samples
-    c.seed = seed
-    c.use_animated_seed = False
-    c.use_adaptive_sampling = threshold is not None
-    if threshold is not None:
-        c.adaptive_threshold = threshold
-        c.adaptive_min_samples = 0
-    c.use_denoising = False
-    c.diffuse_bounces = 0
-    c.glossy_bounces = c.transmission_bounces = c.transparent_max_bounces = c.max_bounces = depth
-    c.volume_bounces = 0
-    c.caustics_reflective = c.caustics_refractive = True
-    c.blur_glossy = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.pixel_filter_type = scene.drt.filter_type
-    c.filter_width = scene.render.filter_size
-    c.time_limit = 0.0
-
-
 def cycles_run(scene, out_dir, samples, seed=0, threshold=None):
     configure_cycles(scene, samples, seed, threshold)
     scene.render.engine = "CYCLES"
@@ -137,11 +115,8 @@ def cycles_run(scene, out_dir, samples, seed=0, threshold=None):
     start = time.process_time()
     bpy.ops.render.render(write_still=True, scene=scene.name)
     seconds = time.process_time() - start
-    image = oiio.ImageInput.open(str(path))
-    spec = image.spec()
-    pixels = image.read_image(format="float").reshape(spec.height, spec.width, spec.nchannels)[..., :3]
-    image.close()
-    return pixels.astype(np.float64), seconds
+    channels = read_channels(path)
+    return np.stack([channels[c] for c in "RGB"], axis=-1).astype(np.float64), seconds
 
 
 def time_to(points, level):

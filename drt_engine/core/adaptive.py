@@ -129,13 +129,21 @@ def dilate(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def _rgb_blocks(film: Film):
+    """(span, variance of the mean, mean) of the Combined RGB, a block of pixels at a time:
+    whole-film float64 temporaries of an 8K image are GBs."""
+    for span in film.blocks():
+        yield span, film.variance(span), film.sums["Combined"][span, :3] / np.maximum(film.count[span], 1)[:, None]
+
+
 def noise_error(film: Film) -> np.ndarray:
     """Cycles' per-pixel error: summed RGB standard error over the tone-aware intensity."""
-    mean = film.sums["Combined"][:, :3] / np.maximum(film.count, 1)[:, None]
-    difference = np.sqrt(film.variance()).sum(axis=1)
-    intensity = mean.sum(axis=1)
-    normalize = np.where(intensity < 1.0, np.sqrt(np.maximum(intensity, 0.0)), intensity)
-    return difference / (1e-4 + normalize)
+    out = np.empty(film.n)
+    for span, var, mean in _rgb_blocks(film):
+        intensity = mean.sum(axis=1)
+        normalize = np.where(intensity < 1.0, np.sqrt(np.maximum(intensity, 0.0)), intensity)
+        out[span] = np.sqrt(var).sum(axis=1) / (1e-4 + normalize)
+    return out
 
 
 def contrast(film: Film) -> np.ndarray:
@@ -168,16 +176,13 @@ def still_active(film: Film, mode: str, threshold: float) -> np.ndarray:
 def image_error(film: Film) -> tuple[float, float]:
     """Estimated (RMSE, relMSE) of the Combined RGB image; inf until every pixel has an estimate.
 
-    Summed a block of pixels at a time: whole-film temporaries of an 8K image are GBs.
     """
     if film.n == 0:
         return 0.0, 0.0
     squared = relative = 0.0
-    for span in film.blocks():
-        var = film.variance(span)
+    for _, var, mean in _rgb_blocks(film):
         if not np.isfinite(var).all():
             return math.inf, math.inf
-        mean = film.sums["Combined"][span, :3] / np.maximum(film.count[span], 1)[:, None]
         squared += float(var.sum())
         relative += float((var / (mean * mean + RELMSE_EPSILON)).sum())
     values = 3 * film.n
@@ -207,10 +212,8 @@ def sample_spread(film: Film) -> np.ndarray:
     """
     h, w = film.height, film.width
     r = np.empty(film.n, np.float32)
-    for span in film.blocks():  # whole-film float64 temporaries of an 8K image are GBs
-        n = film.count[span]
-        mean = film.sums["Combined"][span, :3] / np.maximum(n, 1)[:, None]
-        r[span] = (film.variance(span) / (mean * mean + RELMSE_EPSILON)).sum(axis=1) * n
+    for span, var, mean in _rgb_blocks(film):
+        r[span] = (var / (mean * mean + RELMSE_EPSILON)).sum(axis=1) * film.count[span]
     known = np.isfinite(r)
     r[~known] = r[known].max() if known.any() else 1.0
     grid = np.pad(r.reshape(h, w), 1, mode="edge")

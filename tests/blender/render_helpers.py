@@ -58,15 +58,21 @@ def set_resolution(scene, width: int, height: int) -> None:
     render.use_border = False
 
 
-def configure_cycles(scene, samples: int, seed: int) -> None:
-    """Cycles as a distribution ray tracer with DRT's depth, filter and no noise tricks."""
+def configure_cycles(scene, samples: int, seed: int, threshold: float | None = None) -> None:
+    """Cycles as a distribution ray tracer with DRT's depth, filter and no noise tricks; with a
+    ``threshold``, its adaptive sampling at that noise threshold and automatic min samples
+    (the benchmark's "Cycles adaptive")."""
     cycles = scene.cycles
     depth = scene.drt.max_depth
     cycles.device = "CPU"
     cycles.samples = samples
     cycles.seed = seed
     cycles.use_animated_seed = False
-    cycles.use_adaptive_sampling = False
+    cycles.use_adaptive_sampling = threshold is not None
+    if threshold is not None:
+        cycles.adaptive_threshold = threshold
+        cycles.adaptive_min_samples = 0
+    cycles.time_limit = 0.0
     cycles.use_denoising = False
     cycles.diffuse_bounces = 0
     cycles.glossy_bounces = depth
