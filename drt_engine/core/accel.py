@@ -354,8 +354,8 @@ class Geometry:
                 linear, translation, inv = at.frames[k]
                 normal_matrix = np.transpose(inv, (0, 2, 1))
                 p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
-                ng[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ng[sel]))
-                ns[sel] = _unit(np.einsum("nij,nj->ni", normal_matrix, ns[sel]))
+                ng[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ng[sel]), 1e-300)
+                ns[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ns[sel]), 1e-300)
             else:
                 bucket = np.minimum((at.values * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
                 for b in np.unique(bucket):
@@ -399,7 +399,7 @@ class Geometry:
         if self.ns is None:
             return ng.copy()
         c = self.ns[prim]
-        return _unit(np.einsum("ni,nij->nj", bary, c))
+        return mf.normalize(np.einsum("ni,nij->nj", bary, c), 1e-300)
 
     def offset_scale(self, prim: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Distance that safely clears the surface of triangle ``prim`` at ``pos``."""
@@ -411,10 +411,6 @@ def spawn(pos: np.ndarray, ng: np.ndarray, direction: np.ndarray, scale: np.ndar
     """Ray origin pushed off the surface to the side ``direction`` leaves through."""
     side = np.where(np.einsum("ij,ij->i", ng, direction) >= 0.0, 1.0, -1.0)
     return pos + ng * (side * scale)[:, None]
-
-
-def _unit(v):
-    return v / np.maximum(mf.norm(v)[..., None], 1e-300)
 
 
 def _normal_matrix(linear: np.ndarray) -> np.ndarray:

@@ -102,10 +102,6 @@ class _SphericalRectangle:
         return self.origins[index] + xu[:, None] * self.ex + yv[:, None] * self.ey + z0[:, None] * z_axis
 
 
-def _unit(v):
-    return v / np.maximum(mf.norm(v)[:, None], _TINY)
-
-
 def _spread(spread: float, cos_l: np.ndarray) -> np.ndarray:
     """Cycles' area light spread: emission narrowed to a cone, normalised to keep power.
 

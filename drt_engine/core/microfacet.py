@@ -59,8 +59,9 @@ def orthonormal_basis(n):
     return t, bt
 
 
-def normalize(v):
-    return v / np.maximum(norm(v)[..., None], _TINY)
+def normalize(v, tiny: float = _TINY):
+    """Unit vectors along the last axis; lengths under ``tiny`` count as ``tiny``."""
+    return v / np.maximum(norm(v)[..., None], tiny)
 
 
 def ggx_d(cos_h: np.ndarray, alpha: float) -> np.ndarray:

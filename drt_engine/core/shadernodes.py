@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import microfacet as mf
 from .microfacet import orthonormal_basis
 from .scene import Program
 from .textures import Texture, equirect_uv
@@ -82,12 +83,9 @@ MATH_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "L
             "ARCTAN2", "SINH", "COSH", "TANH", "RADIANS", "DEGREES")
 
 
-def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
-
-
 def _normalize(v):
-    length = np.linalg.norm(v, axis=1, keepdims=True)
+    """Unit vectors, and 0 where the length is not positive (a NaN input gives 0, as in Cycles)."""
+    length = mf.norm(v)[:, None]
     return np.where(length > 0, v / np.maximum(length, _TINY), 0.0)
 
 
@@ -98,8 +96,8 @@ def _vector_math(op, a, b, c, s):
             "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
             "DIVIDE": lambda: _safe_div(a, b), "MULTIPLY_ADD": lambda: a * b + c,
             "CROSS_PRODUCT": lambda: np.cross(a, b),
-            "PROJECT": lambda: _safe_div(_dot(a, b), _dot(b, b))[:, None] * b,
-            "REFLECT": lambda: a - 2 * _dot(_normalize(b), a)[:, None] * _normalize(b),
+            "PROJECT": lambda: _safe_div(mf.dot(a, b), mf.dot(b, b))[:, None] * b,
+            "REFLECT": lambda: a - 2 * mf.dot(_normalize(b), a)[:, None] * _normalize(b),
             "SCALE": lambda: a * s[:, None], "NORMALIZE": lambda: _normalize(a), "ABSOLUTE": lambda: np.abs(a),
             "MINIMUM": lambda: np.minimum(a, b), "MAXIMUM": lambda: np.maximum(a, b),
             "FLOOR": lambda: np.floor(a), "CEIL": lambda: np.ceil(a), "FRACTION": lambda: a - np.floor(a),
@@ -108,7 +106,7 @@ def _vector_math(op, a, b, c, s):
             "SINE": lambda: np.sin(a), "COSINE": lambda: np.cos(a), "TANGENT": lambda: np.tan(a),
         }
         val = {
-            "DOT_PRODUCT": lambda: _dot(a, b), "DISTANCE": lambda: np.linalg.norm(a - b, axis=1),
+            "DOT_PRODUCT": lambda: mf.dot(a, b), "DISTANCE": lambda: np.linalg.norm(a - b, axis=1),
             "LENGTH": lambda: np.linalg.norm(a, axis=1),
         }
         n = len(a)

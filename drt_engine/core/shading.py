@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from . import microfacet as mf
 from .bsdf import MaterialShader, Tables
 from .scene import Closure, Material, SceneData
 from .shadernodes import Evaluator
@@ -27,10 +28,6 @@ MAX_GROUPS = 64
 CACHE_LIMIT = 4096
 GRID_TABLES = Tables(grid=True)
 EXACT_TABLES = Tables()
-
-
-def _unit(v):
-    return v / np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-300)
 
 
 class SurfaceContext:
@@ -83,8 +80,8 @@ class SurfaceContext:
         along = d - n * np.einsum("ij,ij->i", d, n)[:, None]
         fallback = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
         along = np.where((np.linalg.norm(along, axis=1) > 1e-9)[:, None], along, fallback)
-        major = _unit(along)
-        minor = _unit(np.cross(n, major))
+        major = mf.normalize(along, 1e-300)
+        minor = mf.normalize(np.cross(n, major), 1e-300)
         w = self.width[:, None]
         return major * w / np.maximum(cos, 1e-2)[:, None], minor * w
 
@@ -137,7 +134,7 @@ class SurfaceAttributes:
     def object_normal(self, prim, normal):
         out = np.zeros((len(prim), 3))
         for sel, inst, _, _ in self._groups(prim):
-            out[sel] = _unit(normal[sel] @ inst.matrix[:3, :3])
+            out[sel] = mf.normalize(normal[sel] @ inst.matrix[:3, :3], 1e-300)
         return out
 
     def texspace(self, prim):
@@ -186,7 +183,7 @@ class SurfaceAttributes:
             world = v[:, :3] @ inst.matrix[:3, :3].T
             world -= normal[sel] * np.einsum("ij,ij->i", world, normal[sel])[:, None]
             ok = np.linalg.norm(world, axis=1) > 1e-12
-            t[sel[ok]] = _unit(world[ok])
+            t[sel[ok]] = mf.normalize(world[ok], 1e-300)
             sign[sel] = np.where(v[:, 3] < 0, -1.0, 1.0) * np.sign(np.linalg.det(inst.matrix[:3, :3]) or 1.0)
         return t, sign
 
@@ -202,7 +199,7 @@ class SurfaceAttributes:
         e1, e2 = self._edges(prim)
         dpdu = (e1 * dv2[:, None] - e2 * dv1[:, None]) / det[:, None]
         dpdv = (e2 * du1[:, None] - e1 * du2[:, None]) / det[:, None]
-        t = _unit(dpdu - normal * np.einsum("ij,ij->i", dpdu, normal)[:, None])
+        t = mf.normalize(dpdu - normal * np.einsum("ij,ij->i", dpdu, normal)[:, None], 1e-300)
         sign = np.where(np.einsum("ij,ij->i", np.cross(normal, t), dpdv) < 0, -1.0, 1.0)
         return t, sign
 
