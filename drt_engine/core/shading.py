@@ -100,7 +100,8 @@ class SurfaceAttributes:
         self.scene = scene
         self.geometry = geometry
         self.source = geometry.source
-        self._mesh_of = np.array([scene.instances[i].mesh for i in range(len(scene.instances))], np.int64)
+        self._mesh_of = np.array([instance.mesh for instance in scene.instances], np.int64)
+        self._texspaces = {}  # id(mesh) -> (corner, size); the scene outlives this object
 
     def _groups(self, prim):
         inst = self.source[prim, 0]
@@ -141,14 +142,20 @@ class SurfaceAttributes:
         lo = np.zeros((len(prim), 3))
         size = np.ones((len(prim), 3))
         for sel, _, mesh, _ in self._groups(prim):
+            lo[sel], size[sel] = self._texspace_of(mesh)
+        return lo, size
+
+    def _texspace_of(self, mesh):
+        """(corner, size) of the mesh's texture space: its own, or its bounds, found once a render."""
+        found = self._texspaces.get(id(mesh))
+        if found is None:
             if mesh.texspace is not None:
                 loc, half = (np.asarray(x, float) for x in mesh.texspace)
             else:
                 a, b = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
                 loc, half = 0.5 * (a + b), 0.5 * (b - a)
-            lo[sel] = loc - half
-            size[sel] = 2.0 * half
-        return lo, size
+            found = self._texspaces[id(mesh)] = (loc - half, 2.0 * half)
+        return found
 
     def _edges(self, prim):
         """World-space edges (mid-shutter) of triangles ``prim`` from their first corner."""
