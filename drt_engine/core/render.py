@@ -432,7 +432,10 @@ class Renderer:
             scale = self.geometry.offset_scale(prim, pos)
             u = self._draw(depth, seed_pixel[p_ids], sample[p_ids], mat, depth < s.max_depth)
             thr_s, straight_s = throughput[surf], straight[p_ids]
-            lift = self.geometry.smooth_offset(hits, surf, ray_times)
+
+            def lift(g):  # the terminator lift of hits g, worked out only for materials that use it
+                return self.geometry.smooth_offset(hits, surf[g], ray_times)
+
             next_state = []
             shadow = []
             for g, shader in self._bind_materials(mat, prim, hits, surf, pos, ng_o, ns_o, tangent, bitangent,
@@ -546,7 +549,7 @@ class Renderer:
         sel_g = shader.selection(wo_g[:, 2]) if shader.sampled else None
         # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
         # rough-glass cylinder, lifting glass as well doubled the noise of its highlights)
-        lift_g = lift[g] if any(lobe.kind == "diffuse" for lobe in shader.lobes) else np.zeros_like(pos_g)
+        lift_g = lift(g) if any(lobe.kind == "diffuse" for lobe in shader.lobes) else np.zeros_like(pos_g)
         for k in range(lights.strategies):
             u_k = u["light"][k][g]
             u_light = u["choice"][k][g] if lights.selecting else None
