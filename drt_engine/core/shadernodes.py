@@ -264,6 +264,7 @@ class Evaluator:
         self.ctx = ctx
         self.textures = textures
         self.memo: dict[int, tuple] = {}
+        self._footprint: tuple | None = None  # evaluators one pixel-footprint step away in x and y
 
     def __call__(self, ref) -> np.ndarray:
         node, output = ref
@@ -277,6 +278,14 @@ class Evaluator:
 
     def _shifted(self, dp) -> "Evaluator":
         return Evaluator(self.program, self.ctx.shifted(dp), self.textures)
+
+    def _footprint_evaluators(self) -> tuple | None:
+        """Evaluators at the hit moved across its pixel footprint (None without one), made once
+        for all the image nodes of the program, so the nodes upstream of them run once per step."""
+        if self._footprint is None:
+            dx, dy = self.ctx.footprint()
+            self._footprint = (None,) if dx is None else (self._shifted(dx), self._shifted(dy))
+        return None if self._footprint[0] is None else self._footprint
 
     def _run(self, node) -> tuple:
         n = self.ctx.n
@@ -366,9 +375,9 @@ class Evaluator:
         uv = uv3[:, :2]
         footprint = None
         if p.get("interpolation", "Linear") != "Closest":
-            dx, dy = self.ctx.footprint()
-            if dx is not None:
-                footprint = (self._shifted(dx)(vector_ref)[:, :2] - uv, self._shifted(dy)(vector_ref)[:, :2] - uv)
+            shifted = self._footprint_evaluators()
+            if shifted is not None:
+                footprint = tuple(e(vector_ref)[:, :2] - uv for e in shifted)
         rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
         return rgba[:, :3], rgba[:, 3]
 
