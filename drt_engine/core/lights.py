@@ -478,7 +478,8 @@ class Lights:
             pdf = local[:, 2] / np.pi
             value = np.where((pdf > 0)[:, None], self.world / np.maximum(pdf, _TINY)[:, None], 0.0)
             return LightSample(wi, np.full(len(u), np.inf), value, pdf)
-        wi = np.where(on_map[:, None], self.environment.sample(np.clip(u_map, 0.0, 1.0 - 1e-12))[0], wi)
+        if on_map.any():  # the map is sampled for its share of the rows only
+            wi[on_map] = self.environment.sample(np.clip(u_map[on_map], 0.0, 1.0 - 1e-12))[0]
         pdf = self.pdf_world(normal, wi)
         up = mf.dot(wi, normal) > 0
         value = np.zeros((len(u), 3))
