@@ -8,13 +8,15 @@ warning.
 """
 from __future__ import annotations
 
+from dataclasses import fields
+
 import numpy as np
 
 from .errors import SceneError
-from .scene import SceneData
+from .scene import Closure, SceneData
 
-_CLOSURE_FIELDS = ("weight", "color", "roughness", "metallic", "ior", "specular_ior_level", "specular_tint",
-                   "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint", "emission")
+_CLOSURE_FIELDS = tuple(f.name for f in fields(Closure) if f.type in ("float", "np.ndarray"))
+"""The closure's numeric fields (its colours, weights and factors), in declaration order."""
 
 
 def _finite(value) -> bool:
