@@ -349,15 +349,15 @@ class Geometry:
             sel = np.flatnonzero(self.part[prim] == k)
             if len(sel) == 0:
                 continue
-            at = times[index[sel]]
-            if part.kind == "rigid":
-                linear, translation, inv = at.frames[k]
+            rays = index[sel]
+            if part.kind == "rigid":  # this part's transforms only: gathering every part's is quadratic
+                linear, translation, inv = (a[rays] for a in times.frames[k])
                 normal_matrix = np.transpose(inv, (0, 2, 1))
                 p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
                 ng[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ng[sel]), 1e-300)
                 ns[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ns[sel]), 1e-300)
             else:
-                bucket = np.minimum((at.values * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
+                bucket = np.minimum((times.values[rays] * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
                 for b in np.unique(bucket):
                     world, mirrored = part.buckets[b]
                     s = sel[bucket == b]
