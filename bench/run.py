@@ -48,7 +48,7 @@ from drt_engine.core.adaptive import true_error  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
 from drt_engine.core.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from scenes import SCENES, load  # noqa: E402
+from scenes import SCENES, load, settings  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tests" / "blender"))
 from render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)
@@ -65,10 +65,7 @@ CURVES = ("GRID", "JITTERED", "SOBOL", "SOBOL+NOISE", "SOBOL+NOISE auto min", "S
 
 
 def drt_settings(scene, **kw) -> RenderSettings:
-    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
-                filter_size=scene.render.filter_size, threads=0, passes=("Combined", "Noise"))
-    base.update(kw)
-    return RenderSettings(**base)
+    return settings(scene, **{"threads": 0, "passes": ("Combined", "Noise"), **kw})
 
 
 def drt_run(data, settings, reference=None, repeat=REPEAT):

@@ -10,6 +10,7 @@ from pathlib import Path
 import bpy
 
 from drt_engine.blender.export import export_scene
+from drt_engine.core.settings import RenderSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
@@ -25,3 +26,11 @@ def load(name, width, height=None):
     r.use_border = False
     frame_set = lambda frame, sub: scene.frame_set(frame, subframe=sub)  # noqa: E731
     return scene, export_scene(bpy.context.evaluated_depsgraph_get(), frame_set=frame_set)
+
+
+def settings(scene, **kw) -> RenderSettings:
+    """DRT's settings for the scene: its depth and pixel filter, Combined only unless ``kw`` says."""
+    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
+                filter_size=scene.render.filter_size, passes=("Combined",))
+    base.update(kw)
+    return RenderSettings(**base)

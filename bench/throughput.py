@@ -35,18 +35,10 @@ import numpy as np  # noqa: E402
 import drt_engine  # noqa: E402
 from drt_engine.core import camera as camera_rays  # noqa: E402
 from drt_engine.core.render import WAVE, Renderer  # noqa: E402
-from drt_engine.core.settings import RenderSettings  # noqa: E402
-from scenes import SCENES, load  # noqa: E402
+from scenes import SCENES, load, settings  # noqa: E402
 
 TARGET_RATIO = 0.4
 MARK_BEGIN, MARK_END = "<!-- throughput: begin -->", "<!-- throughput: end -->"
-
-
-def settings(scene, **kw) -> RenderSettings:
-    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
-                filter_size=scene.render.filter_size, passes=("Combined",))
-    base.update(kw)
-    return RenderSettings(**base)
 
 
 def camera_batch(data, n, seed=0):
@@ -124,8 +116,7 @@ MEMORY_SCRIPT = """
 import resource, sys
 sys.path[:0] = [{root!r}, {root!r} + '/bench']
 sys.argv = ["x"]
-from scenes import load
-from throughput import settings
+from scenes import load, settings
 from drt_engine.core.render import Renderer
 import drt_engine
 drt_engine.register()

@@ -14,8 +14,6 @@ import math
 import time
 from pathlib import Path
 
-import numpy as np
-
 from .adaptive import image_error
 
 

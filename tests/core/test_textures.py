@@ -3,11 +3,10 @@ import numpy as np
 import pytest
 
 from drt_engine.core.render import Renderer
-from drt_engine.core.scene import (Camera, Closure, Instance, Light, Material, Program, SceneData, TextureImage,
-                                   World)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Program, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.textures import MAGENTA, Texture, srgb_to_linear
-from scenes import look_at, translation, uv_sphere
+from scenes import look_at, uv_sphere
 from textured_scenes import (constant_world_scene, diffuse_textured, image_program, ortho_top, uv_plane,
                              write_image)
 

@@ -1,12 +1,10 @@
 """Cameras at their limits: f/0.01 focused at the clip start, orthographic depth of field, shift 10,
 1x1 and 4x4 images, 7680x4320 in bounded memory, inside a closed mesh, clip 1e-6 to 1e9."""
-import math
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 import blender_scenes as bs
 from core_cases import Camera, Closure, Instance, Material, SceneData, render
