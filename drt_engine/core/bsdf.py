@@ -235,15 +235,12 @@ def _affine(lobe: Lobe, a: Callable, b: Callable, tables: Tables, key, parts=Non
     return a, b, np.broadcast_to(ea, (len(mu), 3)), np.broadcast_to(eb, (len(mu), 3)), e1, a_avg, b_avg
 
 
-_K82 = (1.0 - 1.0 / 7.0) ** 5
-_M82 = (1.0 / 7.0) * (1.0 - 1.0 / 7.0) ** 6
-
-
 def _f82_term(kind):
     def term(c):
         c = np.clip(c, 0.0, 1.0)
-        bump = c * (1.0 - c) ** 6 / _M82
-        return {"a0": 1.0 - (1.0 - c) ** 5, "a1": (1.0 - _K82) * bump, "b0": (1.0 - c) ** 5, "b1": _K82 * bump}[kind]
+        bump = c * (1.0 - c) ** 6 / mf.F82_M
+        return {"a0": 1.0 - (1.0 - c) ** 5, "a1": (1.0 - mf.F82_K) * bump, "b0": (1.0 - c) ** 5,
+                "b1": mf.F82_K * bump}[kind]
     return term
 
 
@@ -253,9 +250,8 @@ _F82_TERMS = tuple(_f82_term(k) for k in ("a0", "a1", "b0", "b1"))
 
 def _f82_parts(f82: np.ndarray) -> tuple[Callable, Callable]:
     """mf.fresnel_f82 (before clipping) as f0 A(c) + B(c)."""
-    mu = 1.0 / 7.0
-    k = (1.0 - mu) ** 5 * 1.0
-    scale = (1.0 - f82) / (mu * (1.0 - mu) ** 6)
+    k = mf.F82_K
+    scale = (1.0 - f82) / mf.F82_M
 
     def a(c):
         c = np.clip(c, 0.0, 1.0)[:, None]

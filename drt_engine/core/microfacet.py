@@ -133,13 +133,18 @@ def ior_from_f0(f0):
     return (1.0 + s) / (1.0 - s)
 
 
+F82_K = (1.0 - 1.0 / 7.0) ** 5
+"""Schlick's (1 - c)^5 at the F82 cosine c = 1/7."""
+F82_M = (1.0 / 7.0) * (1.0 - 1.0 / 7.0) ** 6
+"""The F82 correction's c (1 - c)^6 at c = 1/7."""
+
+
 def fresnel_f82(cos_i: np.ndarray, f0: np.ndarray, f82: np.ndarray) -> np.ndarray:
     """Metal Fresnel: Schlick with the F82-tint correction (Hoffman 2019), as Cycles."""
     c = np.clip(cos_i, 0.0, 1.0)[:, None]
     schlick = f0 + (1.0 - f0) * (1.0 - c) ** 5
-    mu = 1.0 / 7.0
-    schlick_mu = f0 + (1.0 - f0) * (1.0 - mu) ** 5
-    b = schlick_mu * (1.0 - f82) / (mu * (1.0 - mu) ** 6)
+    schlick_mu = f0 + (1.0 - f0) * F82_K
+    b = schlick_mu * (1.0 - f82) / F82_M
     return np.clip(schlick - b * c * (1.0 - c) ** 6, 0.0, 1.0)
 
 
