@@ -84,6 +84,7 @@ extension: $(WHEELS) | $(STAMP)
 	$(BLENDER_EXT) build --source-dir $(STAGE) --output-dir $(DIST) --split-platforms
 	@rm -rf $(STAGE)
 	@for zip in $(DIST)/drt_engine-*.zip; do $(BLENDER_EXT) validate "$$zip" || exit 1; done
+	$(PY) tools/zip_sizes.py --dist $(DIST)
 
 scenes: $(STAMP)
 	@for script in sample_scenes/build_*.py; do echo "$(PY) $$script"; $(PY) "$$script" || exit 1; done

@@ -1,0 +1,48 @@
+"""Sizes of the extension zips in dist/ and of the numba + llvmlite wheels inside them.
+
+`make extension` prints the table; `python tools/zip_sizes.py --publish` also writes it into
+README.md between its markers, so the sizes there are the ones measured, not typed.
+"""
+import argparse
+import re
+import sys
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BEGIN, END = "<!-- zip sizes: begin -->", "<!-- zip sizes: end -->"
+NOTES = {"macos_arm64": " (PyPI has no embreex 4.4 wheel for Intel Macs)"}
+
+
+def table(dist: Path) -> str:
+    rows = ["| zip | size | of which numba + llvmlite, both Pythons |", "|---|---|---|"]
+    zips = sorted(dist.glob("drt_engine-*.zip"))
+    if not zips:
+        sys.exit(f"error: no extension zips in {dist}: run make extension first")
+    for path in zips:
+        with zipfile.ZipFile(path) as z:
+            compiled = sum(i.file_size for i in z.infolist() if re.search(r"/(numba|llvmlite)-", i.filename))
+        platform = path.stem.rsplit("-", 1)[1]
+        rows.append(f"| `dist/{path.name}`{NOTES.get(platform, '')} | {path.stat().st_size / 1e6:.0f} MB "
+                    f"| {compiled / 1e6:.0f} MB |")
+    return "\n".join(rows)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--dist", type=Path, default=ROOT / "dist")
+    parser.add_argument("--publish", action="store_true", help="write the table into README.md")
+    args = parser.parse_args()
+    text = table(args.dist)
+    print(text)
+    if args.publish:
+        readme = ROOT / "README.md"
+        body = readme.read_text()
+        if BEGIN not in body or END not in body:
+            sys.exit("error: README.md has no zip-size markers")
+        head, rest = body.split(BEGIN, 1)
+        readme.write_text(head + BEGIN + "\n" + text + "\n" + END + rest.split(END, 1)[1])
+
+
+if __name__ == "__main__":
+    main()
