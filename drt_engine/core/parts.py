@@ -54,7 +54,7 @@ class Part:
 
     def settings(self) -> RenderSettings:
         """The part's render settings with the full sample range (the merged render's)."""
-        values = dict(self.header["settings"], sample_start=0, sample_end=0)
+        values = dict(self.header["settings"], threads=self.header.get("threads", 0))
         values["passes"] = tuple(values["passes"])
         return RenderSettings(**values)
 
@@ -104,7 +104,7 @@ def fingerprint(scene) -> str:
 
 def from_film(film: Film, settings: RenderSettings, header: dict) -> Part:
     """The part a render of ``settings.sample_range()`` leaves in ``film`` (arrays copied)."""
-    header = dict(header, format=FORMAT, seed=settings.seed, settings=compared_settings(settings),
+    header = dict(header, format=FORMAT, seed=settings.seed, settings=compared_settings(settings), threads=settings.threads,
                   sample_range=list(settings.sample_range()), passes=list(film.passes),
                   channels={name: total.shape[1] for name, total in film.sums.items()})
     return Part(film.width, film.height, film.count.copy(), film.count_a.copy(), film.sum_a.copy(),
@@ -183,17 +183,10 @@ def check(parts: list[Part], names: list[str] | None = None) -> list[Part]:
     if not parts:
         raise PartError("no parts to merge")
     names = names or [f"part {i + 1}" for i in range(len(parts))]
-    first, first_name = parts[0], names[0]
     for part, name in zip(parts[1:], names[1:]):
-        for key, what in (("fingerprint", "scene"), ("seed", "seed"), ("settings", "settings"),
-                          ("frame", "frame"), ("view_layer", "view layer")):
-            if part.header.get(key) != first.header.get(key):
-                detail = _difference(first.header.get(key), part.header.get(key))
-                raise PartError(f"{name} and {first_name} are parts of different {what}s{detail}")
-        if (part.width, part.height) != (first.width, first.height):
-            raise PartError(f"{name} and {first_name} differ in size")
+        check_same(parts[0], part, names[0], name)
     order = sorted(range(len(parts)), key=lambda i: parts[i].sample_range)
-    samples = int(first.header["settings"]["samples"])
+    samples = int(parts[0].header["settings"]["samples"])
     reached, reached_by = 0, None
     for i in order:
         start, end = parts[i].sample_range
@@ -205,6 +198,17 @@ def check(parts: list[Part], names: list[str] | None = None) -> list[Part]:
     if reached < samples:
         raise PartError(f"samples {reached}:{samples} are missing (of 0:{samples})")
     return [parts[i] for i in order]
+
+
+def check_same(first: Part, part: Part, first_name: str, name: str) -> None:
+    """PartError unless ``part`` is of the same scene, seed, settings, frame, view layer and size."""
+    for key, what in (("fingerprint", "scene"), ("seed", "seed"), ("settings", "settings"),
+                      ("frame", "frame"), ("view_layer", "view layer")):
+        if part.header.get(key) != first.header.get(key):
+            detail = _difference(first.header.get(key), part.header.get(key))
+            raise PartError(f"{name} and {first_name} are parts of different {what}s{detail}")
+    if (part.width, part.height) != (first.width, first.height):
+        raise PartError(f"{name} and {first_name} differ in size")
 
 
 def _difference(a, b) -> str:
@@ -224,17 +228,3 @@ def add(film: Film, part: Part) -> None:
     for name, total in film.sums.items():
         total += part.sums[name]
 
-
-def merge(parts: list[Part], names: list[str] | None = None) -> Film:
-    """The film of the whole render: the checked parts added in order of their ranges.
-
-    The whole render adds one wave's sums at a time into the film; a part's sums are those
-    waves' totals over its range, so the merged sums differ from the whole render's only in
-    how float64 additions are grouped (measured and tested within 1e-6 relative, see README).
-    """
-    parts = check(parts, names)
-    first = parts[0]
-    film = Film(first.width, first.height, tuple(first.header["passes"]))
-    for part in parts:
-        add(film, part)
-    return film

@@ -4,7 +4,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from drt_engine.core import parts
+from drt_engine.core import merge, parts, report
 from drt_engine.core.adaptive import image_error
 from drt_engine.core.errors import SettingsError
 from drt_engine.core.render import Renderer
@@ -15,13 +15,18 @@ SAMPLES = 12
 RELATIVE = 1e-6
 
 
+def result_settings(pattern, start=0, end=0, seed=3):
+    return RenderSettings(samples=SAMPLES, seed=seed, threads=1, sampling_pattern=pattern, passes=PASSES,
+                          sample_start=start, sample_end=end)
+
+
 def render_part(pattern, start=0, end=0, seed=3):
-    settings = RenderSettings(samples=SAMPLES, seed=seed, threads=1, sampling_pattern=pattern, passes=PASSES,
-                              sample_start=start, sample_end=end)
+    settings = result_settings(pattern, start, end, seed)
     data = scene()
     renderer = Renderer(data, settings)
     result = renderer.render()
-    header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data)}
+    summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(data))
+    header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data), "report": summary}
     return parts.from_film(renderer.film, settings, header), result
 
 
@@ -38,7 +43,8 @@ def test_merged_ranges_equal_the_whole_render(pattern, tmp_path):
     pieces = [render_part(pattern, a, b)[0] for a, b in ((5, 12), (0, 2), (2, 5))]
     for i, piece in enumerate(pieces):  # through the file: the float64 sums are stored losslessly
         parts.write(tmp_path / f"{i}.exr", piece)
-    film = parts.merge([parts.read(tmp_path / f"{i}.exr") for i in range(3)])
+    merger = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(3)], ["A", "B", "C"])
+    film = merger.film
     assert np.array_equal(film.count, whole.count) and np.array_equal(film.count_a, whole.count_a)
     assert close(film.sum_a, whole.sum_a)
     for name in whole.sums:
@@ -49,6 +55,11 @@ def test_merged_ranges_equal_the_whole_render(pattern, tmp_path):
         assert close(images[name], image, combined if name == "Noise" else None), name
     # the same error estimate as the whole render's
     assert image_error(film) == pytest.approx((result.stats["rmse"], result.stats["relmse"]), rel=RELATIVE)
+    merged = merger.report(1.0)
+    assert merged["settings"] == report.report_dict(result_settings(pattern), {}, [])["settings"]
+    assert merged["stats"]["relmse"] == pytest.approx(result.stats["relmse"], rel=RELATIVE)
+    assert merged["stats"]["rays"] == result.stats["rays"]
+    assert [e["samples"] for e in merged["log"]] == [2 * 576, 5 * 576, 12 * 576]  # as ranges 0:2, 2:5, 5:12 merge
     # a part alone is not the image: its sums differ from the whole's
     assert not close(pieces[0].sums["Combined"], whole.sums["Combined"])
 
