@@ -64,10 +64,12 @@ class Merger:
         last = self.log.last
         last["stopped"] = "samples"
         count = self.film.count
-        stats = dict(first["stats"], samples=int(count.max()), samples_mean=float(count.mean()),
+        settings = self.first.settings()
+        stats = dict(first["stats"], samples=int(count.max()), samples_requested=settings.samples,
+                     samples_mean=float(count.mean()),
                      elapsed=float(elapsed), cpu=self.cpu, rays=dict(self.rays), stopped_by="samples",
                      rmse=last["rmse"], relmse=last["relmse"], parts=len(self.ranges))
-        summary = report_dict(self.first.settings(), stats, self.log.entries, first["scene"])
+        summary = report_dict(settings, stats, self.log.entries, first["scene"])
         summary["view_layer"] = self.first.header["view_layer"]
         return summary
 
