@@ -346,10 +346,11 @@ def write_output(output: Path, merger) -> None:
         raise CLIError(f"cannot write {output}: {error.strerror or error}") from None
 
 
-def write_merged_report(output: Path, merger, summary: dict) -> dict:
-    """The merged render's report files beside OUT, as a whole render writes them."""
+def write_merged_report(output: Path, merger, summary: dict, blend: Path | None = None) -> dict:
+    """The merged render's report files beside OUT, as a whole render writes them (``blend``: the
+    scene's file, when the parts' own record of it is a worker's copy)."""
     header = merger.first.header
-    return _write_report(output, Path(header["blend"]), header["frame"], {header["view_layer"]: summary})
+    return _write_report(output, blend or Path(header["blend"]), header["frame"], {header["view_layer"]: summary})
 
 
 def report_paths(output: Path) -> tuple[Path, Path]:

@@ -15,8 +15,8 @@ import re
 import time
 from pathlib import Path
 
-from .cli import CLIError, _open_scene, check_splittable, done_line, report, write_merged_report, write_output
-from .core import merge
+from .cli import CLIError, _open_scene, check_splittable, done_line, write_merged_report, write_output
+from .core import merge, report
 
 LOCALHOST = "127.0.0.1"
 
@@ -55,13 +55,16 @@ def render(args, blend: Path, output: Path) -> str:
     data = blend.read_bytes()
 
     began = time.perf_counter()
-    client, cluster = _connect(args)
+    client = cluster = None
     futures = []
     try:
+        client, cluster = _connect(args)
         workers = _check_workers(client, args)
+        timing = {"connect": time.perf_counter() - began, "workers": len(workers)}
         tasks = args.tasks or (len(workers) if len(frames) == 1 else 1)
         ranges = split(samples, tasks)
         shipped = client.scatter(data, broadcast=True, hash=False)
+        timing["ship"] = time.perf_counter() - began - timing["connect"]
         from . import farm_task
 
         futures = [client.submit(farm_task.render_range, shipped, blend.name, options, frame, a, b, pure=False,
@@ -69,9 +72,10 @@ def render(args, blend: Path, output: Path) -> str:
                    for frame in frames for a, b in ranges]
         print(f"DRT: {len(futures)} tasks ({len(frames)} frame(s) x {len(ranges)} sample range(s)) on "
               f"{len(workers)} worker(s)", flush=True)
-        lines = _gather(client, futures, frames, ranges, output, began)
+        lines = _gather(futures, frames, ranges, blend, output, began, timing)
     except KeyboardInterrupt:
-        client.cancel(futures, force=True)
+        if futures:
+            client.cancel(futures, force=True)
         raise CLIError("cancelled: the tasks were cancelled" + (" and the local cluster shut down" if cluster
                                                                 else ""), 130) from None
     finally:
@@ -79,10 +83,17 @@ def render(args, blend: Path, output: Path) -> str:
     return "\n".join(lines)
 
 
-def _gather(client, futures, frames, ranges, output, began) -> list[str]:
+def _gather(futures, frames, ranges, blend, output, began, farm: dict) -> list[str]:
+    """Merge the parts as they come, print progress, write each frame when its parts are in.
+
+    ``farm`` (timings so far) goes into each frame's report as stats["farm"], with every
+    task's seconds on its worker, rendering, and from submission to its part's arrival here.
+    """
     from distributed import as_completed
 
     mergers = {frame: merge.Merger(ranges) for frame in frames}
+    submitted = time.perf_counter() - began
+    tasks = {frame: [] for frame in frames}
     done, lines = 0, []
     for future in as_completed(futures):
         try:
@@ -92,7 +103,10 @@ def _gather(client, futures, frames, ranges, output, began) -> list[str]:
         done += 1
         frame = part.header["frame"]
         merger = mergers[frame]
-        entry = merger.add(part, time.perf_counter() - began, f"the part of samples {part.sample_range}")
+        arrived = time.perf_counter()
+        entry = merger.add(part, arrived - began, f"the part of samples {part.sample_range}")
+        tasks[frame].append(dict(timing, range=list(part.sample_range), returned=arrived - began - submitted,
+                                 merge=time.perf_counter() - arrived))
         error = report.relative_error_text(entry["relmse"]) if entry else "?"
         print(f"DRT: {done}/{len(futures)} tasks done (frame {frame} samples {part.sample_range[0]}:"
               f"{part.sample_range[1]}, {timing['task']:.1f} s on {timing['worker']}, {timing['render']:.1f} s "
@@ -101,7 +115,9 @@ def _gather(client, futures, frames, ranges, output, began) -> list[str]:
         if merger.done:
             path = frame_output(output, frame, len(frames) > 1)
             write_output(path, merger)
-            stats = write_merged_report(path, merger, merger.report(time.perf_counter() - began))
+            summary = merger.report(time.perf_counter() - began)
+            summary["stats"]["farm"] = dict(farm, tasks=tasks.pop(frame))
+            stats = write_merged_report(path, merger, summary, blend)
             lines.append(done_line(path, merger.film.width, merger.film.height, stats,
                                    time.perf_counter() - began, f"{stats['samples']} samples in {len(ranges)} parts"))
             del mergers[frame]
@@ -115,7 +131,11 @@ def _connect(args):
     if args.workers:
         cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True, host=LOCALHOST,
                                dashboard_address=None, silence_logs=logging.ERROR)
-        return Client(cluster), cluster
+        try:
+            return Client(cluster), cluster
+        except BaseException:
+            cluster.close()
+            raise
     security = _security(args)
     logging.getLogger("distributed").setLevel(logging.CRITICAL)  # the one line below says it
     try:
@@ -154,7 +174,8 @@ def _check_workers(client, args) -> list[str]:
 
 def _close(client, cluster) -> None:
     try:
-        client.close(timeout=10)
+        if client is not None:
+            client.close(timeout=10)
     finally:
         if cluster is not None:
             cluster.close(timeout=30)

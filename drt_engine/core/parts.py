@@ -133,7 +133,7 @@ def write(path, part: Part) -> None:
     spec = oiio.ImageSpec(part.width, part.height, len(names), oiio.UINT32)
     spec.channelnames = tuple(names)
     spec.attribute(HEADER, json.dumps(part.header))
-    spec.attribute("compression", "zip")
+    spec.attribute("compression", "none")
     out = oiio.ImageOutput.create(str(path))
     if out is None or not out.open(str(path), spec):
         raise OSError(f"cannot write {path}: {oiio.geterror() or (out and out.geterror())}")
