@@ -40,31 +40,19 @@ def frame_output(output: Path, frame: int, several: bool) -> Path:
 def render(args, blend: Path, output: Path) -> str:
     if output.suffix.lower() != ".exr":
         raise CLIError(f"a render split over a cluster is written as .exr: {output}")
-    scene = _open_scene(args, blend)
-    check_splittable(scene, blend)
-    samples = scene.drt.samples
-    frames = list(range(args.frames[0], args.frames[1] + 1)) if args.frames else [scene.frame_current]
-    options = ["--samples", str(samples), "--seed", str(scene.drt.seed)]
-    if args.resolution:
-        options += ["--resolution", "{}x{}".format(*args.resolution)]
-    threads = args.engine_threads
-    if threads is None and args.workers:  # the local workers share this machine's cores
-        threads = max(1, (os.cpu_count() or 1) // args.workers)
-    if threads is not None:
-        options += ["--engine-threads", str(threads)]
-    data = blend.read_bytes()
-
     began = time.perf_counter()
     client = cluster = None
     futures = []
     try:
-        client, cluster = _connect(args)
+        client, cluster = _connect(args)  # first: a missing scheduler or a broken worker is said at once
         workers = _check_workers(client, args)
         timing = {"connect": time.perf_counter() - began, "workers": len(workers)}
+        samples, frames, options = _plan(args, blend)
         tasks = args.tasks or (len(workers) if len(frames) == 1 else 1)
         ranges = split(samples, tasks)
-        shipped = client.scatter(data, broadcast=True, hash=False)
-        timing["ship"] = time.perf_counter() - began - timing["connect"]
+        shipping = time.perf_counter()
+        shipped = client.scatter(blend.read_bytes(), broadcast=True, hash=False)
+        timing["ship"] = time.perf_counter() - shipping
         from . import farm_task
 
         futures = [client.submit(farm_task.render_range, shipped, blend.name, options, frame, a, b, pure=False,
@@ -81,6 +69,23 @@ def render(args, blend: Path, output: Path) -> str:
     finally:
         _close(client, cluster)
     return "\n".join(lines)
+
+
+def _plan(args, blend: Path) -> tuple[int, list[int], list[str]]:
+    """(samples, frames, the render options every task passes on) from the .blend and the overrides."""
+    scene = _open_scene(args, blend)
+    check_splittable(scene, blend)
+    samples = scene.drt.samples
+    frames = list(range(args.frames[0], args.frames[1] + 1)) if args.frames else [scene.frame_current]
+    options = ["--samples", str(samples), "--seed", str(scene.drt.seed)]
+    if args.resolution:
+        options += ["--resolution", "{}x{}".format(*args.resolution)]
+    threads = args.engine_threads
+    if threads is None and args.workers:  # the local workers share this machine's cores
+        threads = max(1, (os.cpu_count() or 1) // args.workers)
+    if threads is not None:
+        options += ["--engine-threads", str(threads)]
+    return samples, frames, options
 
 
 def _gather(futures, frames, ranges, blend, output, began, farm: dict) -> list[str]:
