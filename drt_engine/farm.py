@@ -165,7 +165,8 @@ def _security(args):
 
 
 def _check_workers(client, args) -> list[str]:
-    """The workers' addresses, after checking each can import DRT, embreex and bpy (one line naming a worker that cannot)."""
+    """The workers' addresses, after checking each can import DRT, embreex and bpy (one line naming
+    a worker that cannot)."""
     try:
         client.wait_for_workers(1, timeout=args.connect_timeout)
     except (TimeoutError, OSError):

@@ -98,7 +98,7 @@ def write_exr(path, film: Film, view_layer: str) -> None:
     spec.attribute("compression", "zip")
     out = oiio.ImageOutput.create(str(path))
     if out is None or not out.open(str(path), spec):
-        raise OSError(f"cannot write {path}: {oiio.geterror()}")
+        raise OSError(f"cannot write {path}: {(out.geterror() if out else '') or oiio.geterror()}")
     try:
         if not out.write_image(np.ascontiguousarray(pixels)):
             raise OSError(f"cannot write {path}: {out.geterror()}")

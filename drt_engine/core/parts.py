@@ -104,8 +104,8 @@ def fingerprint(scene) -> str:
 
 def from_film(film: Film, settings: RenderSettings, header: dict) -> Part:
     """The part a render of ``settings.sample_range()`` leaves in ``film`` (arrays copied)."""
-    header = dict(header, format=FORMAT, seed=settings.seed, settings=compared_settings(settings), threads=settings.threads,
-                  sample_range=list(settings.sample_range()), passes=list(film.passes),
+    header = dict(header, format=FORMAT, seed=settings.seed, settings=compared_settings(settings),
+                  threads=settings.threads, sample_range=list(settings.sample_range()), passes=list(film.passes),
                   channels={name: total.shape[1] for name, total in film.sums.items()})
     return Part(film.width, film.height, film.count.copy(), film.count_a.copy(), film.sum_a.copy(),
                 {name: total.copy() for name, total in film.sums.items()}, header)
@@ -117,26 +117,25 @@ def _channel_names(passes, channels: dict) -> list[str]:
     return names + [f"sum.{name}.{c}" for name in passes if name in channels for c in range(channels[name])]
 
 
-def _arrays(part: Part) -> list[tuple[str, np.ndarray]]:
-    """(channel prefix, (n, k) float64) in file order."""
-    out = [("count", part.count[:, None]), ("count_a", part.count_a[:, None]), ("sum_a", part.sum_a)]
-    return out + [(f"sum.{name}", total) for name, total in part.sums.items()]
+def _arrays(part: Part) -> list[np.ndarray]:
+    """The (n, k) float64 arrays, in ``_channel_names`` order."""
+    sums = [part.sums[name] for name in part.header["passes"] if name in part.sums]
+    return [part.count[:, None], part.count_a[:, None], part.sum_a, *sums]
 
 
 def write(path, part: Part) -> None:
     import OpenImageIO as oiio
 
-    arrays = _arrays(part)
     names = [f"{name}.{word}" for name in _channel_names(part.header["passes"], part.header["channels"])
              for word in ("lo", "hi")]
-    bits = np.concatenate([np.ascontiguousarray(a, np.float64).view(np.uint32) for _, a in arrays], axis=1)
+    bits = np.concatenate([np.ascontiguousarray(a, np.float64).view(np.uint32) for a in _arrays(part)], axis=1)
     spec = oiio.ImageSpec(part.width, part.height, len(names), oiio.UINT32)
     spec.channelnames = tuple(names)
     spec.attribute(HEADER, json.dumps(part.header))
     spec.attribute("compression", "none")
     out = oiio.ImageOutput.create(str(path))
     if out is None or not out.open(str(path), spec):
-        raise OSError(f"cannot write {path}: {oiio.geterror() or (out and out.geterror())}")
+        raise OSError(f"cannot write {path}: {(out.geterror() if out else '') or oiio.geterror()}")
     try:
         if not out.write_image(bits.reshape(part.height, part.width, len(names))):
             raise OSError(f"cannot write {path}: {out.geterror()}")
@@ -150,7 +149,8 @@ def read(path) -> Part:
 
     image = oiio.ImageInput.open(str(path))
     if image is None:
-        raise PartError(f"cannot read {path}: {oiio.geterror().splitlines()[0] if oiio.geterror() else 'unknown'}")
+        message = oiio.geterror().strip()
+        raise PartError(f"cannot read {path}: {message.splitlines()[0] if message else 'not an image'}")
     try:
         spec = image.spec()
         text = spec.get_string_attribute(HEADER)
@@ -160,6 +160,8 @@ def read(path) -> Part:
         if header.get("format") != FORMAT:
             raise PartError(f"{path} is a DRT part of format {header.get('format')}, this DRT reads {FORMAT}")
         bits = image.read_image(format=oiio.UINT32)
+        if bits is None:
+            raise PartError(f"cannot read {path}: {image.geterror().strip() or 'damaged pixels'}")
     finally:
         image.close()
     n = spec.width * spec.height
@@ -167,6 +169,8 @@ def read(path) -> Part:
     index = {name: i for i, name in enumerate(spec.channelnames)}  # EXR keeps channels sorted by name
     columns = {}
     for name in _channel_names(header["passes"], header["channels"]):
+        if f"{name}.lo" not in index or f"{name}.hi" not in index:
+            raise PartError(f"{path} is a damaged DRT part: channel {name} is missing")
         lo, hi = words[:, index[f"{name}.lo"]], words[:, index[f"{name}.hi"]]
         columns.setdefault(name.rsplit(".", 1)[0], []).append(((hi << np.uint64(32)) | lo).view(np.float64))
     array = {prefix: np.stack(cols, axis=1) for prefix, cols in columns.items()}
