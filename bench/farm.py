@@ -22,6 +22,7 @@ import math
 import os
 import pickle
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -44,20 +45,25 @@ FRAME_4K = (3840, 2160, 1024)
 ANIMATION = (1920, 1080, 128, 240)  # width, height, samples, frames
 
 
-def cli(folder: Path, name: str, *args) -> tuple[float, dict]:
-    """Run the CLI; (wall seconds, its .drt.json)."""
+def children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def cli(folder: Path, name: str, *args) -> tuple[float, float, dict]:
+    """Run the CLI; (wall seconds, CPU seconds of it and every process it started, its .drt.json)."""
     out = folder / f"{name}.exr"
-    began = time.perf_counter()
+    began, cpu = time.perf_counter(), children_cpu()
     proc = subprocess.run([sys.executable, "-m", "drt_engine", "render", str(SCENE), "-o", str(out), *map(str, args)],
                           cwd=ROOT, capture_output=True, text=True, timeout=3600)
-    wall = time.perf_counter() - began
+    wall, cpu = time.perf_counter() - began, children_cpu() - cpu
     if proc.returncode:
         raise SystemExit(f"{name} failed: {proc.stderr.strip()}")
-    return wall, json.loads(out.with_name(f"{name}.drt.json").read_text())
+    return wall, cpu, json.loads(out.with_name(f"{name}.drt.json").read_text())
 
 
 def part_costs(width=1920, height=1080) -> dict:
-    """Seconds per megapixel to write, read and add a Combined-only part, and its bytes per pixel."""
+    """CPU seconds per megapixel to write, read and add a Combined-only part, and its bytes per pixel."""
     n = width * height
     rng = np.random.default_rng(0)
     film = Film(width, height, ("Combined",))
@@ -71,16 +77,16 @@ def part_costs(width=1920, height=1080) -> dict:
     part = parts.from_film(film, RenderSettings(samples=8, sample_end=4), settings_header)
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "part.exr"
-        began = time.perf_counter()
+        began = time.process_time()
         parts.write(path, part)
-        written = time.perf_counter()
+        written = time.process_time()
         back = parts.read(path)
-        read = time.perf_counter()
+        read = time.process_time()
         file_bytes = path.stat().st_size
     target = Film(width, height, ("Combined",))
-    began_add = time.perf_counter()
+    began_add = time.process_time()
     parts.add(target, back)
-    added = time.perf_counter()
+    added = time.process_time()
     mp = n / 1e6
     return {"write_s_per_mp": (written - began) / mp, "read_s_per_mp": (read - written) / mp,
             "add_s_per_mp": (added - began_add) / mp, "pickle_bytes_per_px": len(pickle.dumps(back)) / n,
@@ -90,18 +96,19 @@ def part_costs(width=1920, height=1080) -> dict:
 def model(m: dict) -> dict:
     """Speed-ups on N machines, one worker each, from the measured figures.
 
-    A task costs its share of the render (at this machine's measured rate, all cores), the
-    worker overhead (child process, bpy, opening the file, export, preparation: measured), and
+    A task costs its share of the render (this machine's measured samples per CPU second, on
+    every core), the worker overhead (child process, bpy, opening the file, export, preparation:
+    its measured CPU seconds, on one core), and
     its part's write and read on the worker (per pixel, measured in (c)). The client receives
     and adds the parts one after another: bytes at NETWORK, then the add (measured). One machine
     without a farm pays the render plus one CLI process's overhead (measured). A frame is split
     into N ranges; an animation is one task per frame, in ceil(frames / N) rounds, its parts
     received while later frames render.
     """
-    rate = m["single"]["samples_per_s"]
-    worker = m["farm"]["worker_overhead_s"]
+    rate = m["single"]["samples_per_cpu_s"] * m["cores"]  # every core of an idle machine
+    worker = m["farm"]["worker_overhead_cpu_s"]
     fixed = m["farm"]["connect_s"] + m["farm"]["ship_s"]
-    alone = m["single"]["wall_s"] - m["single"]["render_s"]
+    alone = m["single"]["cpu_s"] - m["single"]["render_cpu_s"]
     p = m["parts"]
 
     def on_worker(px):
@@ -128,61 +135,67 @@ def model(m: dict) -> dict:
 def measure(size: int, samples: int) -> dict:
     threads = os.cpu_count() or 1
     common = ["--samples", samples, "--seed", 1, "--resolution", f"{size}x{size}"]
+    load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        wall, single = cli(folder, "single", *common, "--engine-threads", threads)
-        farm_wall, farm = cli(folder, "farm", *common, "--workers", 2)
+        wall, cpu, single = cli(folder, "single", *common, "--engine-threads", threads)
+        farm_wall, farm_cpu, farm = cli(folder, "farm", *common, "--workers", 2)
     tasks = farm["stats"]["farm"]["tasks"]
-    px_samples = size * size * samples
+    stats = single["stats"]
     return {
         "scene": SCENE.name, "size": size, "samples": samples, "cores": threads,
-        "single": {"wall_s": wall, "render_s": single["stats"]["elapsed"],
-                   "samples_per_s": px_samples / single["stats"]["elapsed"]},
-        "farm": {"workers": 2, "wall_s": farm_wall, "connect_s": farm["stats"]["farm"]["connect"],
+        "load": [load, os.getloadavg()[0]],
+        "single": {"wall_s": wall, "cpu_s": cpu, "render_s": stats["elapsed"], "render_cpu_s": stats["cpu"],
+                   "samples_per_cpu_s": size * size * samples / stats["cpu"]},
+        "farm": {"workers": 2, "wall_s": farm_wall, "cpu_s": farm_cpu, "connect_s": farm["stats"]["farm"]["connect"],
                  "ship_s": farm["stats"]["farm"]["ship"], "tasks": tasks,
-                 "worker_overhead_s": float(np.mean([t["task"] - t["render"] for t in tasks])),
+                 "worker_overhead_cpu_s": float(np.mean([t["cpu"] - t["render_cpu"] for t in tasks])),
                  "return_overhead_s": float(np.mean([t["returned"] - t["task"] for t in tasks])),
                  "merge_s": float(sum(t["merge"] for t in tasks))},
         "parts": part_costs(),
-        "same_estimate": farm["stats"]["relmse"] / single["stats"]["relmse"],
+        "same_estimate": farm["stats"]["relmse"] / stats["relmse"],
     }
 
 
 def section(m: dict) -> str:
     f, s = m["farm"], m["single"]
     mod = m["model"]
-    rows = "\n".join(f"| {t['range'][0]}:{t['range'][1]} | {t['task']:.1f} | {t['render']:.1f} | "
-                     f"{t['task'] - t['render']:.1f} | {t['returned'] - t['task']:.2f} |" for t in f["tasks"])
+    rows = "\n".join(f"| {t['range'][0]}:{t['range'][1]} | {t['task']:.1f} | {t['render']:.1f} | {t['cpu']:.1f} | "
+                     f"{t['render_cpu']:.1f} | {t['cpu'] - t['render_cpu']:.1f} | {t['returned'] - t['task']:.2f} |"
+                     for t in f["tasks"])
     w, h, spp = FRAME_4K
     aw, ah, aspp, frames = ANIMATION
     model_rows = "\n".join(f"| {n} | {mod['frame'][n]:.1f}x | {mod['animation'][n]:.1f}x |" for n in MODEL_MACHINES)
+    p = m["parts"]
     return f"""{MARK_BEGIN}
-Measured by `bench/farm.py` on this machine ({m['cores']} cores, shared with other jobs while it ran):
-`{m['scene']}` at {m['size']}x{m['size']}, {m['samples']} samples.
+Measured by `bench/farm.py` on this machine ({m['cores']} cores; load average {m['load'][0]:.0f} at the start and
+{m['load'][1]:.0f} at the end: other jobs shared the cores, so wall times are stretched several times and the
+CPU seconds are the figures to go by): `{m['scene']}` at {m['size']}x{m['size']}, {m['samples']} samples.
 
-| run | wall time | render time |
-|---|---|---|
-| 1 process, {m['cores']} threads | {s['wall_s']:.1f} s | {s['render_s']:.1f} s |
-| `--workers 2` (1 thread each), 2 tasks | {f['wall_s']:.1f} s | see the tasks |
+| run | wall (s) | CPU, all processes (s) | rendering, wall (s) | rendering, CPU (s) |
+|---|---|---|---|---|
+| 1 process, {m['cores']} threads | {s['wall_s']:.1f} | {s['cpu_s']:.1f} | {s['render_s']:.1f} | {s['render_cpu_s']:.1f} |
+| `--workers 2` (1 thread each), 2 tasks | {f['wall_s']:.1f} | {f['cpu_s']:.1f} | see the tasks | |
+
+| task (samples) | on the worker, wall (s) | rendering, wall (s) | task CPU (s) | rendering CPU (s) | overhead CPU (s) | scheduling and return, wall (s) |
+|---|---|---|---|---|---|---|
+{rows}
 
 The LocalCluster started and every worker was checked in {f['connect_s']:.1f} s; the .blend reached
 every worker in {f['ship_s']:.2f} s; adding the parts took {f['merge_s'] * 1000:.1f} ms.
-
-| task (samples) | on the worker (s) | rendering (s) | worker overhead (s) | scheduling and return (s) |
-|---|---|---|---|---|
-{rows}
-
-The worker overhead is a child process starting Python, bpy and DRT, opening the .blend, exporting it
+A task's overhead is its child process starting Python, bpy and DRT, opening the .blend, exporting it
 and preparing the render (BVH, lights, compiled kernels from the cache), then writing the part; it does
-not depend on the sample count. A part costs, per megapixel, {m['parts']['write_s_per_mp']:.2f} s to write,
-{m['parts']['read_s_per_mp']:.2f} s to read and {m['parts']['add_s_per_mp'] * 1000:.0f} ms to add, and
-{m['parts']['pickle_bytes_per_px']:.0f} bytes a pixel over the network (Combined only; 8 bytes per channel
-of every further pass). The merged estimate is {m['same_estimate']:.9f} times the single render's.
+not depend on the sample count. A part costs, in CPU seconds per megapixel, {p['write_s_per_mp']:.2f} s to
+write, {p['read_s_per_mp']:.2f} s to read and {p['add_s_per_mp']:.2f} s to add, and
+{p['pickle_bytes_per_px']:.0f} bytes a pixel over the network (Combined only; 8 bytes more a pixel for each
+further pass channel). The merged estimated relMSE is {m['same_estimate']:.9f} times the single render's.
 
-Model (`bench/farm.py`'s `model`, from the figures above and 1 Gbit/s between machines): speed-up over one
-machine of this kind rendering alone, with one worker per machine. A {w}x{h} frame at {spp} samples
+Model (`bench/farm.py`'s `model`): speed-up over one machine of this kind rendering alone, one worker per
+machine, from the CPU seconds above (a render's CPU seconds spread over the {m['cores']} cores, the overheads
+run on one core) and 1 Gbit/s between machines. A {w}x{h} frame at {spp} samples
 ({mod['frame_render_s'] / 3600:.1f} h on one machine) split into N ranges; a {frames}-frame animation at
 {aw}x{ah}, {aspp} samples ({mod['animation_frame_s'] / 60:.1f} min a frame), one task per frame.
+Per task {mod['worker_s']:.1f} s of overhead; one render alone {mod['alone_s']:.1f} s.
 
 | machines | {w}x{h} frame | {frames}-frame animation |
 |---|---|---|

@@ -69,14 +69,35 @@ def render_range(data: bytes, name: str, options: list[str], frame: int, start: 
         out = Path(folder) / "part.exr"
         command = [sys.executable, "-m", "drt_engine", "render", str(path), "-o", str(out),
                    "--frame", str(frame), "--sample-range", f"{start}:{end}", *options]
+        before = _children_cpu()
         child = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                 preexec_fn=_die_with_parent if os.name == "posix" else None)
+                                 env=_render_environment(), preexec_fn=_die_with_parent if os.name == "posix" else None)
         _, errors = child.communicate()
         if child.returncode != 0:
             lines = [line for line in errors.splitlines() if line.strip()]
             reason = lines[-1] if lines else f"exit code {child.returncode}"
             raise TaskError(f"worker {worker.address}, frame {frame} samples {start}:{end}: {reason}")
         part = parts.read(out)
-    timing = {"task": time.perf_counter() - began, "render": part.header["report"]["stats"]["elapsed"],
-              "worker": worker.address}
+        cpu = _children_cpu() - before
+    stats = part.header["report"]["stats"]
+    timing = {"task": time.perf_counter() - began, "render": stats["elapsed"], "cpu": cpu,
+              "render_cpu": stats["cpu"], "worker": worker.address}
     return part, timing
+
+
+def _render_environment() -> dict:
+    """The worker's environment without the malloc trim threshold Dask's nanny sets for its workers:
+    with it, glibc returns every freed wave array to the system and maps it again (measured on a
+    96x96 render of 128 samples: 6.4 CPU seconds instead of 3.4, most of it in the kernel)."""
+    return {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+
+
+def _children_cpu() -> float:
+    """CPU seconds of this process's finished children: a worker runs one task at a time, so the
+    difference around a task is its render process's (a loaded machine stretches wall time, not this)."""
+    if os.name != "posix":
+        return float("nan")
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
