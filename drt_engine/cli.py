@@ -202,8 +202,10 @@ def _open_scene(args, blend: Path):
     import bpy
 
     from . import register
+    from .blender.engine import DRTRenderEngine
 
-    register()
+    if not DRTRenderEngine.is_registered:  # once per process (a test may have done it)
+        register()
     try:
         bpy.ops.wm.open_mainfile(filepath=str(blend), load_ui=False)
     except RuntimeError as error:

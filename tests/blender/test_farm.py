@@ -238,3 +238,40 @@ def test_ctrl_c_cancels_and_leaves_no_process(tmp_path):
     assert len(stderr.splitlines()) == 1 and "cancelled" in stderr, stderr
     assert not (tmp_path / "x.exr").exists()
     tree.assert_all_gone()
+
+
+def test_ranges_cover_every_sample_once():
+    from drt_engine.farm import split
+
+    for samples, tasks in ((8, 2), (7, 3), (1024, 16), (3, 5)):
+        ranges = split(samples, tasks)
+        assert ranges[0][0] == 0 and ranges[-1][1] == samples
+        assert all(a < b for a, b in ranges) and all(b == c for (_, b), (c, _) in zip(ranges, ranges[1:]))
+        assert len(ranges) == min(tasks, samples)
+
+
+def test_frame_outputs():
+    from drt_engine.farm import frame_output
+
+    assert frame_output(Path("/o/shot_####.exr"), 12, True) == Path("/o/shot_0012.exr")
+    assert frame_output(Path("/o/shot_##.exr"), 7, False) == Path("/o/shot_07.exr")
+    assert frame_output(Path("/o/shot.exr"), 3, True) == Path("/o/shot0003.exr")
+    assert frame_output(Path("/o/shot.exr"), 3, False) == Path("/o/shot.exr")
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--sample-range", "5:3"], ["START < END"]),
+    (["--sample-range", "0:9"], ["goes past the 8 samples"]),
+    (["--sample-range", "0:4", "--adaptive-threshold", "0.01"], ["fixed sample count"]),
+    (["--frames", "1-3"], ["--frames needs --workers or --cluster"]),
+    (["--workers", "2", "--cluster", "tcp://127.0.0.1:1"], ["not both"]),
+])
+def test_bad_farm_options_are_one_line(drt, tmp_path, extra, words):
+    """In this process (the checks come before any render or cluster)."""
+    from drt_engine import cli
+
+    with pytest.raises(cli.CLIError) as caught:
+        cli._render(cli.build_parser().parse_args(["render", str(SCENE), "-o", str(tmp_path / "x.exr"),
+                                                   *map(str, OPTIONS), *extra]))
+    for word in words:
+        assert word in str(caught.value)
