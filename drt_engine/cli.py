@@ -121,7 +121,8 @@ def build_parser() -> argparse.ArgumentParser:
     farm.add_argument("--cluster", metavar="ADDRESS",
                       help="render on the Dask scheduler at ADDRESS (tcp://host:8786 or tls://host:8786)")
     farm.add_argument("--frames", type=_frames, metavar="A-B",
-                      help="render frames A to B, one task each (OUT's #### become the frame number)")
+                      help="render frames A to B, one task a frame unless --tasks says more (OUT's #### become "
+                      "the frame number)")
     farm.add_argument("--tasks", type=_at_least(1), metavar="K",
                       help="sample ranges per frame (default: one per worker for one frame, 1 for several)")
     farm.add_argument("--connect-timeout", type=_float_in(1.0, 600.0), default=30.0, metavar="SECONDS",

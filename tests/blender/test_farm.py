@@ -275,3 +275,22 @@ def test_bad_farm_options_are_one_line(drt, tmp_path, extra, words):
                                                    *map(str, OPTIONS), *extra]))
     for word in words:
         assert word in str(caught.value)
+
+
+def test_tls_options_make_an_encrypted_client(tmp_path):
+    from drt_engine import cli
+    from drt_engine.farm import _security
+
+    def args(*extra):
+        return cli.build_parser().parse_args(["render", str(SCENE), "-o", "x.exr", "--cluster", "tls://h:8786", *extra])
+
+    assert not _security(args()).require_encryption  # Dask's own configuration then
+    with pytest.raises(cli.CLIError, match="no such file"):
+        _security(args("--tls-ca-file", str(tmp_path / "missing.pem")))
+    for name in ("ca.pem", "cert.pem", "key.pem"):
+        (tmp_path / name).write_text("-")
+    security = _security(args("--tls-ca-file", str(tmp_path / "ca.pem"), "--tls-cert", str(tmp_path / "cert.pem"),
+                              "--tls-key", str(tmp_path / "key.pem")))
+    assert security.require_encryption
+    assert (security.tls_ca_file, security.tls_client_cert, security.tls_client_key) == tuple(
+        str(tmp_path / n) for n in ("ca.pem", "cert.pem", "key.pem"))
