@@ -112,7 +112,8 @@ def _gather(futures, frames, ranges, blend, output, began, farm: dict) -> list[s
         entry = merger.add(part, arrived - began, f"the part of samples {part.sample_range}")
         tasks[frame].append(dict(timing, range=list(part.sample_range), returned=arrived - began - submitted,
                                  merge=time.perf_counter() - arrived))
-        error = report.relative_error_text(entry["relmse"]) if entry else "?"
+        latest = entry or merger.log.last  # a part ahead of a missing range waits, the estimate stays
+        error = report.relative_error_text(latest["relmse"]) if latest else "?"
         print(f"DRT: {done}/{len(futures)} tasks done (frame {frame} samples {part.sample_range[0]}:"
               f"{part.sample_range[1]}, {timing['task']:.1f} s on {timing['worker']}, {timing['render']:.1f} s "
               f"rendering); frame {frame}: {merger.merged}/{len(ranges)} parts merged, est. error {error}",
