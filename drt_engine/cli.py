@@ -12,7 +12,8 @@ import sys
 import time
 from pathlib import Path
 
-from .core import report
+from .core import merge, parts, report
+from .core.errors import DRTError
 from .core.settings import ADAPTIVE_MODES
 
 EXIT_ERROR = 1
@@ -79,7 +80,7 @@ def _mode(text: str) -> str:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m drt_engine", description="DRT, a distribution ray tracer for Blender scenes.")
-    commands = parser.add_subparsers(dest="command", metavar="{render}", required=True, parser_class=_Parser)
+    commands = parser.add_subparsers(dest="command", metavar="{render,merge}", required=True, parser_class=_Parser)
     render = commands.add_parser(
         "render",
         help="render a .blend file with DRT",
@@ -109,7 +110,53 @@ def build_parser() -> argparse.ArgumentParser:
                         "turns adaptive sampling on (scene.drt.adaptive_min_samples)")
     render.add_argument("--adaptive-mode", type=_mode, metavar="NOISE|CONTRAST",
                         help="adaptive sampling mode; turns adaptive sampling on (scene.drt.adaptive_mode)")
+    farm = render.add_argument_group(
+        "render farm", "Split the render over processes or machines: sample ranges of a frame, frames of an "
+        "animation. Parts need a fixed sample count (no adaptive sampling, time limit or target error).")
+    farm.add_argument("--sample-range", type=_sample_range, metavar="START:END",
+                      help="render only sample ids START to END-1 of the --samples set and write OUT (.exr) as "
+                      "a part for `merge`")
+    farm.add_argument("--workers", type=_at_least(1), metavar="N",
+                      help="render on a Dask LocalCluster of N worker processes on this machine (127.0.0.1 only)")
+    farm.add_argument("--cluster", metavar="ADDRESS",
+                      help="render on the Dask scheduler at ADDRESS (tcp://host:8786 or tls://host:8786)")
+    farm.add_argument("--frames", type=_frames, metavar="A-B",
+                      help="render frames A to B, one task a frame unless --tasks says more (OUT's #### become "
+                      "the frame number)")
+    farm.add_argument("--tasks", type=_at_least(1), metavar="K",
+                      help="sample ranges per frame (default: one per worker for one frame, 1 for several)")
+    farm.add_argument("--connect-timeout", type=_float_in(1.0, 600.0), default=30.0, metavar="SECONDS",
+                      help="give up on a --cluster scheduler that does not answer in this time (default 30)")
+    farm.add_argument("--tls-ca-file", metavar="PEM", help="TLS: the certificate authority of the cluster")
+    farm.add_argument("--tls-cert", metavar="PEM", help="TLS: this client's certificate")
+    farm.add_argument("--tls-key", metavar="PEM", help="TLS: this client's private key")
+
+    merge = commands.add_parser(
+        "merge",
+        help="add parts rendered with --sample-range into the image",
+        description="Add the parts (EXR files written by `render --sample-range` or by Blender with "
+        "scene.drt.sample_offset / sample_count) into the image of all the samples and write OUT (.exr) "
+        "with its report, as a whole render does. The parts must be of one scene, seed, settings and "
+        "frame, and their ranges must cover all the samples once.",
+    )
+    merge.add_argument("parts", metavar="PART.exr", nargs="+", help="the parts, in any order")
+    merge.add_argument("-o", "--output", required=True, metavar="OUT", help="output file, .exr")
     return parser
+
+
+def _sample_range(text: str) -> tuple[int, int]:
+    match = re.fullmatch(r"\s*(\d+)\s*:\s*(\d+)\s*", text)
+    if not match or int(match[1]) >= int(match[2]):
+        raise argparse.ArgumentTypeError(f"must look like START:END with START < END, e.g. 0:256, got {text!r}")
+    return int(match[1]), int(match[2])
+
+
+def _frames(text: str) -> tuple[int, int]:
+    match = re.fullmatch(r"\s*(-?\d+)\s*(?:-\s*(-?\d+)\s*)?", text)
+    if not match or (match[2] is not None and int(match[2]) < int(match[1])):
+        raise argparse.ArgumentTypeError(f"must look like A-B with A <= B, or one frame, got {text!r}")
+    first = int(match[1])
+    return first, int(match[2]) if match[2] is not None else first
 
 
 def _check_paths(blend: Path, output: Path) -> None:
@@ -151,17 +198,15 @@ def _set_output_format(image_settings, exr: bool) -> None:
         image_settings.file_format = "PNG"
 
 
-def _render(args) -> str:
-    blend = Path(args.blend).expanduser().resolve()
-    output = Path(args.output).expanduser().resolve()
-    _check_paths(blend, output)
-
+def _open_scene(args, blend: Path):
+    """Open ``blend`` in this process's bpy with DRT registered and the overrides applied."""
     import bpy
 
     from . import register
-    from .blender import engine
+    from .blender.engine import DRTRenderEngine
 
-    register()
+    if not DRTRenderEngine.is_registered:  # once per process (a test may have done it)
+        register()
     try:
         bpy.ops.wm.open_mainfile(filepath=str(blend), load_ui=False)
     except RuntimeError as error:
@@ -195,6 +240,53 @@ def _render(args) -> str:
     if args.adaptive_mode is not None:
         scene.drt.use_adaptive_sampling = True
         scene.drt.adaptive_mode = args.adaptive_mode
+    return scene
+
+
+def check_splittable(scene, blend: Path) -> None:
+    """A render split into parts needs a fixed sample count and one view layer (a part holds one)."""
+    drt = scene.drt
+    if drt.use_adaptive_sampling or drt.time_limit > 0 or drt.target_error > 0:
+        raise CLIError(f"{blend.name}: a render split into parts needs a fixed sample count: turn off adaptive "
+                       "sampling, the time limit and the target error")
+    layers = [layer.name for layer in scene.view_layers if layer.use]
+    if len(layers) != 1:
+        raise CLIError(f"{blend.name}: a render split into parts needs exactly one view layer used for "
+                       f"rendering, the scene has {len(layers)}")
+
+
+def _render(args) -> str:
+    blend = Path(args.blend).expanduser().resolve()
+    output = Path(args.output).expanduser().resolve()
+    _check_paths(blend, output)
+    if args.workers is not None and args.cluster is not None:
+        raise CLIError("choose --workers (a local cluster) or --cluster (a running one), not both")
+    if args.workers is not None or args.cluster is not None:
+        if args.sample_range is not None:
+            raise CLIError("--sample-range renders one part here; --workers and --cluster split the render themselves")
+        from . import farm
+
+        return farm.render(args, blend, output)
+    for option, value in (("--frames", args.frames), ("--tasks", args.tasks)):
+        if value is not None:
+            raise CLIError(f"{option} needs --workers or --cluster")
+
+    import bpy
+
+    from .blender import engine, part_files
+
+    scene = _open_scene(args, blend)
+    render = scene.render
+    if args.sample_range is not None:
+        first, end = args.sample_range
+        if output.suffix.lower() != ".exr":
+            raise CLIError(f"a part is written as .exr: {output}")
+        check_splittable(scene, blend)
+        if end > scene.drt.samples:
+            raise CLIError(f"--sample-range {first}:{end} goes past the {scene.drt.samples} samples")
+        scene.drt.sample_offset, scene.drt.sample_count = first, end - first
+        part_files.collect = True
+        part_files.last_parts.clear()
 
     engine.last_reports.clear()
     start = time.perf_counter()
@@ -206,19 +298,62 @@ def _render(args) -> str:
     if not engine.last_reports:
         raise CLIError("the render produced no image")
 
-    exr = output.suffix.lower() == ".exr"
-    _set_output_format(render.image_settings, exr)
-    try:
-        bpy.data.images["Render Result"].save_render(filepath=str(output), scene=scene)
-    except RuntimeError as error:
-        raise CLIError(f"cannot write {output}: {_blender_message(error)}") from None
-    if not output.is_file():
-        raise CLIError(f"cannot write {output}")
+    if args.sample_range is not None:
+        try:
+            parts.write(output, next(iter(part_files.last_parts.values())))
+        except OSError as error:
+            raise CLIError(str(error)) from None
+        done = f"samples {args.sample_range[0]}:{args.sample_range[1]} of {scene.drt.samples} as a part"
+    else:
+        _set_output_format(render.image_settings, output.suffix.lower() == ".exr")
+        try:
+            bpy.data.images["Render Result"].save_render(filepath=str(output), scene=scene)
+        except RuntimeError as error:
+            raise CLIError(f"cannot write {output}: {_blender_message(error)}") from None
+        if not output.is_file():
+            raise CLIError(f"cannot write {output}")
+        done = None
     stats = _write_report(output, blend, args.frame, engine.last_reports)
     width, height = (side * render.resolution_percentage // 100 for side in (render.resolution_x, render.resolution_y))
+    return done_line(output, width, height, stats, elapsed, done)
+
+
+def done_line(output: Path, width: int, height: int, stats: dict, elapsed: float, samples: str | None = None) -> str:
     error = report.relative_error_text(stats["relmse"])
-    return (f"DRT: wrote {output} ({width}x{height}, {stats['samples']} samples, est. error {error}, "
+    samples = samples or f"{stats['samples']} samples"
+    return (f"DRT: wrote {output} ({width}x{height}, {samples}, est. error {error}, "
             f"stopped by {report.STOP_REASONS[stats['stopped_by']]}, {elapsed:.1f} s) and its report")
+
+
+def _merge(args) -> str:
+    output = Path(args.output).expanduser().resolve()
+    if output.suffix.lower() != ".exr":
+        raise CLIError(f"merge writes .exr: {output}")
+    paths = [Path(p).expanduser() for p in args.parts]
+    for path in paths:
+        if not path.is_file():
+            raise CLIError(f"no such file: {path}")
+    start = time.perf_counter()
+    merger = merge.merge_parts([parts.read(path) for path in paths], [path.name for path in paths])
+    write_output(output, merger)
+    stats = write_merged_report(output, merger, merger.report(merger.log.last["elapsed"]))
+    return done_line(output, merger.film.width, merger.film.height, stats, time.perf_counter() - start,
+                     f"{len(paths)} parts, {stats['samples']} samples")
+
+
+def write_output(output: Path, merger) -> None:
+    try:
+        output.parent.mkdir(parents=True, exist_ok=True)
+        merge.write_exr(output, merger.film, merger.first.header["view_layer"])
+    except OSError as error:
+        raise CLIError(f"cannot write {output}: {error.strerror or error}") from None
+
+
+def write_merged_report(output: Path, merger, summary: dict, blend: Path | None = None) -> dict:
+    """The merged render's report files beside OUT, as a whole render writes them (``blend``: the
+    scene's file, when the parts' own record of it is a worker's copy)."""
+    header = merger.first.header
+    return _write_report(output, blend or Path(header["blend"]), header["frame"], {header["view_layer"]: summary})
 
 
 def report_paths(output: Path) -> tuple[Path, Path]:
@@ -250,11 +385,11 @@ def main(argv=None) -> int:
     os.dup2(1, 2)  # Blender's own messages, Python's included, go to stdout from here on
     try:
         args = build_parser().parse_args(argv)
-        print(_render(args), flush=True)
+        print(_render(args) if args.command == "render" else _merge(args), flush=True)
         return 0
-    except CLIError as error:
-        stderr.write(f"drt: error: {error}\n")
-        return error.code
+    except (CLIError, DRTError) as error:
+        stderr.write(f"drt: error: {' '.join(str(error).split())}\n")
+        return getattr(error, "code", EXIT_ERROR)
     except Exception as error:  # a bug of ours: still one line, the details on stdout
         import traceback
 

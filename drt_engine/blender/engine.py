@@ -16,6 +16,7 @@ import numpy as np
 
 from ..core import report
 from ..core.errors import DRTError, RenderCancelled
+from . import part_files
 from .properties import enabled_passes, pass_layout, settings_from_scene
 
 DISPLAY_INTERVAL = 1.0
@@ -61,7 +62,8 @@ def write_passes(result, passes: dict) -> None:
 def preview_settings(settings):
     """Settings for a material or light preview: small and fast, Combined only."""
     return dataclasses.replace(settings, samples=min(settings.samples, PREVIEW_SAMPLES),
-                               max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",))
+                               max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",),
+                               sample_start=0, sample_end=0)
 
 
 def viewport_settings(settings):
@@ -69,7 +71,8 @@ def viewport_settings(settings):
     from .viewport import MAX_SAMPLES
 
     return dataclasses.replace(settings, samples=min(settings.samples, MAX_SAMPLES), passes=("Combined",),
-                               use_adaptive_sampling=False, time_limit=0.0, target_error=0.0)
+                               use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
+                               sample_start=0, sample_end=0)
 
 
 def stats_line(samples_done: int, samples_total: int, relmse: float, elapsed: float) -> str:
@@ -175,6 +178,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                              report.scene_summary(scene_data))
                 summary["view_layer"] = view_layer.name
                 last_reports[view_layer.name] = summary
+                if not outcome.cancelled:
+                    part_files.keep(scene, view_layer, scene_data, renderer.film, settings, summary)
         finally:
             self.end_result(result)
         if not self.is_preview:

@@ -68,6 +68,8 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         adaptive_mode=drt.adaptive_mode,
         time_limit=drt.time_limit,
         target_error=drt.target_error,
+        sample_start=drt.sample_offset,
+        sample_end=drt.sample_offset + drt.sample_count if drt.sample_count else 0,
     )
 
 
@@ -195,6 +197,21 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         min=0.0,
         soft_max=0.1,
         precision=4,
+    )
+
+    sample_offset: IntProperty(
+        name="Sample Offset",
+        description="First sample id to render, for a render farm: each job renders its own range "
+        "of the samples and writes a part file beside the output, and `python -m drt_engine merge` "
+        "adds the parts into the image of all the samples",
+        default=0,
+        min=0,
+    )
+    sample_count: IntProperty(
+        name="Sample Count",
+        description="Samples to render from the offset, for a render farm; 0 means up to Samples",
+        default=0,
+        min=0,
     )
 
 

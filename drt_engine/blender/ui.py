@@ -118,6 +118,21 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
         col.prop(drt, "adaptive_min_samples")
 
 
+class DRT_PT_sampling_range(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Sample Range"
+    bl_parent_id = "DRT_PT_sampling"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        drt = context.scene.drt
+        col = layout.column()
+        col.prop(drt, "sample_offset", text="Offset")
+        col.prop(drt, "sample_count", text="Count")
+
+
 class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
@@ -201,6 +216,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
 classes = (
     DRT_PT_sampling,
     DRT_PT_sampling_adaptive,
+    DRT_PT_sampling_range,
     DRT_PT_light_paths,
     DRT_PT_film,
     DRT_PT_motion_blur,

@@ -11,3 +11,7 @@ class SceneError(DRTError):
 
 class RenderCancelled(DRTError):
     """The user or a stop rule ended the render; the image so far is still valid."""
+
+
+class SettingsError(DRTError, ValueError):
+    """Render settings that contradict each other (a sample range with adaptive sampling...)."""

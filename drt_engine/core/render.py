@@ -167,11 +167,12 @@ class Renderer:
         w, h = self.camera.window_size
         x0, y0, _, _ = self.camera.window
         n_pix = w * h
-        cap = self.sampler.samples
+        first_id, end_id = s.sample_range()
+        cap = end_id - first_id  # samples a pixel takes here: ids first_id.. of the full set
         threshold = adaptive.effective_threshold(s.adaptive_threshold, cap)
         first = adaptive.first_test(adaptive.min_samples(threshold, s.adaptive_min_samples))
         points = adaptive.checkpoints(cap, first if s.use_adaptive_sampling else cap)
-        replicas = adaptive.replicate_samplers(s.sampling_pattern, cap, s.seed)
+        replicas = adaptive.replicate_samplers(s.sampling_pattern, self.sampler.samples, s.seed)
         main_sampler = self.sampler
         active = np.arange(n_pix)
         planned = float(n_pix) * cap
@@ -219,7 +220,7 @@ class Renderer:
                     a = 0
                     while a < len(wave_pix):  # one piece, or under a time limit what fits in the time left
                         size = _wave_size(s.time_limit, time.perf_counter() - start, traced)
-                        trace(wave_pix[a:a + size], wave_sample[a:a + size])
+                        trace(wave_pix[a:a + size], wave_sample[a:a + size] + first_id)
                         count = len(wave_pix[a:a + size])
                         a, traced, left = a + size, traced + count, left - count
                         if s.time_limit > 0 and time.perf_counter() - start >= s.time_limit:

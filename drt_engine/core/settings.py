@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .errors import SettingsError
+
 SAMPLING_PATTERNS = ("GRID", "JITTERED", "SOBOL")
 FILTER_TYPES = ("BOX", "GAUSSIAN", "BLACKMAN_HARRIS")
 ADAPTIVE_MODES = ("NOISE", "CONTRAST")
@@ -50,6 +52,8 @@ class RenderSettings:
     adaptive_mode: str = "NOISE"
     time_limit: float = 0.0
     target_error: float = 0.0
+    sample_start: int = 0  # first sample id of this render's range (a farm part renders one range)
+    sample_end: int = 0  # one past its last sample id; 0 = samples
     extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -66,3 +70,18 @@ class RenderSettings:
             raise ValueError(f"unknown passes {sorted(unknown)}")
         if "Combined" not in self.passes:
             self.passes = ("Combined",) + tuple(self.passes)
+        start, end = self.sample_range()
+        if not 0 <= start < end <= self.samples:
+            raise SettingsError(f"sample range {start}:{end} is not inside the {self.samples} samples 0:{self.samples}")
+        if self.partial and (self.use_adaptive_sampling or self.time_limit > 0 or self.target_error > 0):
+            raise SettingsError("a sample range needs a fixed sample count: turn off adaptive sampling, "
+                                "the time limit and the target error")
+
+    def sample_range(self) -> tuple[int, int]:
+        """The sample ids this render traces, start to end - 1, of the full set of ``samples``."""
+        return self.sample_start, self.sample_end or self.samples
+
+    @property
+    def partial(self) -> bool:
+        """True when only part of the samples is traced (a part to merge with others)."""
+        return self.sample_range() != (0, self.samples)
