@@ -4,7 +4,7 @@ A ``Program`` (core.scene) is Blender's node graph compiled by the export into a
 of operations; this module evaluates the outputs a material asks for, vectorised over
 the hits. Each operation follows Cycles' SVM definition of its node (svm_math_util.h,
 svm_color_util.h, svm_checker.h, svm_ramp.h, svm_mapping_util.h, svm_normal_map.h,
-svm_bump.h). Scalars are (N,) arrays, colours and vectors (N, 3).
+svm_bump.h; the procedural textures in core.proctex). Scalars are (N,) arrays, colours and vectors (N, 3).
 
 Coordinates come from a context (``SurfaceContext`` for hits, ``DirectionContext`` for
 the world). A context can be shifted by a small world-space offset: that gives image
@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import microfacet as mf
+from . import proctex
 from .microfacet import orthonormal_basis
 from .scene import Program
 from .textures import Texture, equirect_uv
@@ -339,6 +340,8 @@ class Evaluator:
             return _ramp(x[0], p["positions"], p["colors"], p["interpolation"])
         if op == "checker":
             return _checker(x[0], x[1], x[2], x[3])
+        if op in proctex.OPS:
+            return proctex.evaluate(op, p, x)
         if op == "mapping":
             return (_mapping(p["type"], x[0], x[1], x[2], x[3]),)
         if op == "normal_map":
