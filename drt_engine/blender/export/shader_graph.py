@@ -393,7 +393,8 @@ class Compiler:
 
     def _node_ShaderNodeTexVoronoi(self, node, output):
         return self._procedural(node, output, "voronoi", dims=int(node.voronoi_dimensions[0]),
-                                feature=node.feature, metric=node.distance, normalize=bool(node.normalize))
+                                feature=node.feature, metric=node.distance, normalize=bool(node.normalize),
+                                hash=proctex.HASH_PCG if bpy.app.version >= (5, 0, 0) else "lookup3")
 
     def _node_ShaderNodeTexWave(self, node, output):
         return self._procedural(node, output, "wave", type=node.wave_type, bands=node.bands_direction,

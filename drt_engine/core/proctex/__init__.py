@@ -31,6 +31,8 @@ OUTPUTS = {
     "brick": ("Color", "Fac"),
 }
 OPS = tuple(INPUTS)
+HASH_PCG = "pcg"
+"""Voronoi's cell hash in 2D to 4D from Blender 5.0 on; the exporter names Blender's ("lookup3" before)."""
 
 
 def _grey(f):
@@ -45,7 +47,7 @@ def evaluate(op: str, p: dict, x: list) -> tuple:
         return value, color
     if op == "voronoi":
         return voronoi.voronoi_texture(p["dims"], voronoi.FEATURES[p["feature"]], voronoi.METRICS[p["metric"]],
-                                       p["normalize"], *x)
+                                       p["normalize"], p.get("hash", HASH_PCG) == HASH_PCG, *x)
     if op == "wave":
         fac = patterns.wave(patterns.WAVE_TYPES[p["type"]], patterns.BANDS_DIRECTIONS[p["bands"]],
                             patterns.RINGS_DIRECTIONS[p["rings"]], patterns.WAVE_PROFILES[p["profile"]], *x)

@@ -159,3 +159,91 @@ def hash_value(dims, x, y, z, w):
     if dims == 3:
         return hash_f3(x, y, z)
     return hash_f4(x, y, z, w)
+
+
+# PCG hashes on signed 32-bit integers ("Hash Functions for GPU Rendering", JCGT 2020, as
+# Cycles modifies them for OSL): Voronoi's cell points in 2D to 4D since Blender 5.0.
+_PCG_MUL = 1664525
+_PCG_ADD = 1013904223
+_INV_INT_MAX = 1.0 / 2147483648.0  # 1 / float32(0x7FFFFFFF), exactly 2^-31
+
+
+@kernel
+def _i32(x):
+    """Wrap to a signed 32-bit integer, as C's int arithmetic does on every target Cycles runs on."""
+    x &= M32
+    return x - (1 << 32) if x >= (1 << 31) else x
+
+
+@kernel
+def _pcg_unit(h):
+    return np.float64(np.float32(h & 0x7FFFFFFF)) * _INV_INT_MAX
+
+
+@kernel
+def pcg2(x, y):
+    x = _i32(x * _PCG_MUL + _PCG_ADD)
+    y = _i32(y * _PCG_MUL + _PCG_ADD)
+    x = _i32(x + y * _PCG_MUL)
+    y = _i32(y + x * _PCG_MUL)
+    x = x ^ (x >> 16)
+    y = y ^ (y >> 16)
+    x = _i32(x + y * _PCG_MUL)
+    y = _i32(y + x * _PCG_MUL)
+    return _pcg_unit(x), _pcg_unit(y)
+
+
+@kernel
+def pcg3(x, y, z):
+    x = _i32(x * _PCG_MUL + _PCG_ADD)
+    y = _i32(y * _PCG_MUL + _PCG_ADD)
+    z = _i32(z * _PCG_MUL + _PCG_ADD)
+    x = _i32(x + y * z)
+    y = _i32(y + z * x)
+    z = _i32(z + x * y)
+    x, y, z = x ^ (x >> 16), y ^ (y >> 16), z ^ (z >> 16)
+    x = _i32(x + y * z)
+    y = _i32(y + z * x)
+    z = _i32(z + x * y)
+    return _pcg_unit(x), _pcg_unit(y), _pcg_unit(z)
+
+
+@kernel
+def pcg4(x, y, z, w):
+    x = _i32(x * _PCG_MUL + _PCG_ADD)
+    y = _i32(y * _PCG_MUL + _PCG_ADD)
+    z = _i32(z * _PCG_MUL + _PCG_ADD)
+    w = _i32(w * _PCG_MUL + _PCG_ADD)
+    x = _i32(x + y * w)
+    y = _i32(y + z * x)
+    z = _i32(z + x * y)
+    w = _i32(w + y * z)
+    x, y, z, w = x ^ (x >> 16), y ^ (y >> 16), z ^ (z >> 16), w ^ (w >> 16)
+    x = _i32(x + y * w)
+    y = _i32(y + z * x)
+    z = _i32(z + x * y)
+    w = _i32(w + y * z)
+    return _pcg_unit(x), _pcg_unit(y), _pcg_unit(z), _pcg_unit(w)
+
+
+@kernel
+def pcg_point(dims, x, y, z, w):
+    """hash_int{2,3,4}_to_float{2,3,4} of integer cell coordinates (unused lanes 0)."""
+    if dims == 2:
+        a, b = pcg2(x, y)
+        return a, b, 0.0, 0.0
+    if dims == 3:
+        a, b, c = pcg3(x, y, z)
+        return a, b, c, 0.0
+    return pcg4(x, y, z, w)
+
+
+@kernel
+def pcg_color(dims, x, y, z, w):
+    """hash_int{2,3,4}_to_float3: 2D hashes (x, y, 0) in 3D, 4D keeps the first three."""
+    if dims == 2:
+        return pcg3(x, y, 0)
+    if dims == 3:
+        return pcg3(x, y, z)
+    a, b, c, _ = pcg4(x, y, z, w)
+    return a, b, c

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..jit import kernel
-from .hash import hash_to_color, hash_to_point
+from .hash import hash_to_color, hash_to_point, pcg_color, pcg_point
 
 F1, F2, SMOOTH_F1, DISTANCE_TO_EDGE, N_SPHERE_RADIUS = 0, 1, 2, 3, 4
 FEATURES = {"F1": F1, "F2": F2, "SMOOTH_F1": SMOOTH_F1, "DISTANCE_TO_EDGE": DISTANCE_TO_EDGE,
@@ -61,15 +61,23 @@ def _cell_offset(dims, idx, base, off):
 
 
 @kernel
-def _point(dims, randomness, cell, off, point):
-    """The cell's random point relative to the current cell: offset + hash * randomness."""
-    h = hash_to_point(dims, cell[0] + off[0], cell[1] + off[1], cell[2] + off[2], cell[3] + off[3])
+def _point(dims, pcg, randomness, cell, off, point):
+    """The cell's random point relative to the current cell: offset + hash * randomness. Blender
+    5.0 hashes integer cells with PCG in 2D to 4D (``pcg``); before, and in 1D, the float32 cell."""
+    if pcg and dims > 1:
+        h = pcg_point(dims, int(cell[0] + off[0]), int(cell[1] + off[1]), int(cell[2] + off[2]),
+                      int(cell[3] + off[3]))
+    else:
+        h = hash_to_point(dims, cell[0] + off[0], cell[1] + off[1], cell[2] + off[2], cell[3] + off[3])
     for k in range(dims):
         point[k] = off[k] + h[k] * randomness
 
 
 @kernel
-def _color(dims, cell, off):
+def _color(dims, pcg, cell, off):
+    if pcg and dims > 1:
+        return pcg_color(dims, int(cell[0] + off[0]), int(cell[1] + off[1]), int(cell[2] + off[2]),
+                         int(cell[3] + off[3]))
     return hash_to_color(dims, cell[0] + off[0], cell[1] + off[1], cell[2] + off[2], cell[3] + off[3])
 
 
@@ -81,7 +89,7 @@ def _split(dims, coord, cell, local):
 
 
 @kernel
-def _f1_f2(dims, metric, exponent, randomness, second, coord, work, color, position):
+def _f1_f2(dims, pcg, metric, exponent, randomness, second, coord, work, color, position):
     """F1 (or F2 when ``second``) of one octave: distance; colour and position written."""
     cell, local, off, point, off1, pos1, off2, pos2 = work[0], work[1], work[2], work[3], work[4], work[5], \
         work[6], work[7]
@@ -92,7 +100,7 @@ def _f1_f2(dims, metric, exponent, randomness, second, coord, work, color, posit
         off1[k] = off2[k] = pos1[k] = pos2[k] = 0.0
     for idx in range(3 ** dims):
         _cell_offset(dims, idx, 3, off)
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         d = _distance(dims, metric, exponent, point, local)
         if d < d1:
             d2 = d1
@@ -105,11 +113,11 @@ def _f1_f2(dims, metric, exponent, randomness, second, coord, work, color, posit
             for k in range(dims):
                 off2[k], pos2[k] = off[k], point[k]
     if second:
-        color[0], color[1], color[2] = _color(dims, cell, off2)
+        color[0], color[1], color[2] = _color(dims, pcg, cell, off2)
         for k in range(4):
             position[k] = pos2[k] + cell[k]
         return d2
-    color[0], color[1], color[2] = _color(dims, cell, off1)
+    color[0], color[1], color[2] = _color(dims, pcg, cell, off1)
     for k in range(4):
         position[k] = pos1[k] + cell[k]
     return d1
@@ -125,7 +133,7 @@ def _smoothstep01(x):
 
 
 @kernel
-def _smooth_f1(dims, metric, exponent, randomness, smoothness, coord, work, color, position):
+def _smooth_f1(dims, pcg, metric, exponent, randomness, smoothness, coord, work, color, position):
     cell, local, off, point, spos = work[0], work[1], work[2], work[3], work[4]
     _split(dims, coord, cell, local)
     sd = 0.0
@@ -135,13 +143,13 @@ def _smooth_f1(dims, metric, exponent, randomness, smoothness, coord, work, colo
     h = -1.0
     for idx in range(5 ** dims):
         _cell_offset(dims, idx, 5, off)
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         d = _distance(dims, metric, exponent, point, local)
         h = 1.0 if h == -1.0 else _smoothstep01(0.5 + 0.5 * (sd - d) / smoothness)
         corr = smoothness * h * (1.0 - h)
         sd = sd + h * (d - sd) - corr
         corr /= 1.0 + 3.0 * smoothness
-        c = _color(dims, cell, off)
+        c = _color(dims, pcg, cell, off)
         for k in range(3):
             color[k] = color[k] + h * (c[k] - color[k]) - corr
         for k in range(dims):
@@ -152,7 +160,7 @@ def _smooth_f1(dims, metric, exponent, randomness, smoothness, coord, work, colo
 
 
 @kernel
-def _distance_to_edge(dims, randomness, coord, work):
+def _distance_to_edge(dims, pcg, randomness, coord, work):
     cell, local, off, point, closest, perp = work[0], work[1], work[2], work[3], work[4], work[5]
     _split(dims, coord, cell, local)
     if dims == 1:
@@ -163,7 +171,7 @@ def _distance_to_edge(dims, randomness, coord, work):
     best = np.inf
     for idx in range(3 ** dims):
         _cell_offset(dims, idx, 3, off)
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         d = 0.0
         for k in range(dims):
             point[k] -= local[k]
@@ -175,7 +183,7 @@ def _distance_to_edge(dims, randomness, coord, work):
     best = np.inf
     for idx in range(3 ** dims):
         _cell_offset(dims, idx, 3, off)
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         p2 = 0.0
         for k in range(dims):
             point[k] -= local[k]
@@ -191,7 +199,7 @@ def _distance_to_edge(dims, randomness, coord, work):
 
 
 @kernel
-def _n_sphere_radius(dims, randomness, coord, work):
+def _n_sphere_radius(dims, pcg, randomness, coord, work):
     cell, local, off, point, closest, closest_off, other = work[0], work[1], work[2], work[3], work[4], \
         work[5], work[6]
     _split(dims, coord, cell, local)
@@ -200,7 +208,7 @@ def _n_sphere_radius(dims, randomness, coord, work):
         closest[k] = closest_off[k] = other[k] = 0.0
     for idx in range(3 ** dims):
         _cell_offset(dims, idx, 3, off)
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         d = _euclid(dims, point, local)
         if d < best:
             best = d
@@ -214,7 +222,7 @@ def _n_sphere_radius(dims, randomness, coord, work):
         _cell_offset(dims, idx, 3, off)
         for k in range(dims):
             off[k] += closest_off[k]
-        _point(dims, randomness, cell, off, point)
+        _point(dims, pcg, randomness, cell, off, point)
         d = _euclid(dims, closest, point)
         if d < best:
             best = d
@@ -240,7 +248,7 @@ def _max_distance(dims, metric, exponent, feature, randomness):
 
 
 @kernel
-def voronoi_texture(dims, feature, metric, normalize, vector, w_in, scale, detail, roughness, lacunarity,
+def voronoi_texture(dims, feature, metric, normalize, pcg, vector, w_in, scale, detail, roughness, lacunarity,
                     smoothness, exponent, randomness):
     """Cycles' svm_node_tex_voronoi over all points:
     (distance (N,), colour (N, 3), position (N, 3), w (N,), radius (N,))."""
@@ -272,7 +280,7 @@ def voronoi_texture(dims, feature, metric, normalize, vector, w_in, scale, detai
         lac = lacunarity[i]
         e = exponent[i]
         if feature == N_SPHERE_RADIUS:
-            radius[i] = _n_sphere_radius(dims, rnd, coord, work)
+            radius[i] = _n_sphere_radius(dims, pcg, rnd, coord, work)
             continue
         max_dist = _max_distance(dims, metric, e, feature, rnd)
         zero_input = det == 0.0 or rough == 0.0
@@ -284,7 +292,7 @@ def voronoi_texture(dims, feature, metric, normalize, vector, w_in, scale, detai
             for octave in range(int(math.ceil(det)) + 1):
                 for k in range(4):
                     scaled[k] = coord[k] * octave_scale
-                od = _distance_to_edge(dims, rnd, scaled, work)
+                od = _distance_to_edge(dims, pcg, rnd, scaled, work)
                 if zero_input:
                     dist = od
                     break
@@ -312,11 +320,11 @@ def voronoi_texture(dims, feature, metric, normalize, vector, w_in, scale, detai
             for k in range(4):
                 scaled[k] = coord[k] * octave_scale
             if feature == F2:
-                od = _f1_f2(dims, metric, e, rnd, True, scaled, work, oct_color, oct_pos)
+                od = _f1_f2(dims, pcg, metric, e, rnd, True, scaled, work, oct_color, oct_pos)
             elif feature == SMOOTH_F1 and smooth != 0.0:
-                od = _smooth_f1(dims, metric, e, rnd, smooth, scaled, work, oct_color, oct_pos)
+                od = _smooth_f1(dims, pcg, metric, e, rnd, smooth, scaled, work, oct_color, oct_pos)
             else:
-                od = _f1_f2(dims, metric, e, rnd, False, scaled, work, oct_color, oct_pos)
+                od = _f1_f2(dims, pcg, metric, e, rnd, False, scaled, work, oct_color, oct_pos)
             if zero_input:
                 max_amp = 1.0
                 dist = od
