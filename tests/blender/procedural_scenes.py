@@ -188,9 +188,46 @@ def parity(drt: np.ndarray, cycles0: np.ndarray, cycles1: np.ndarray) -> dict:
     return {"worst": worst, "cycles_seeds": own, "limit": 1.5 * own + 0.002, "ok": worst <= 1.5 * own + 0.002}
 
 
+def _diffuse(name, color_from):
+    """A Diffuse BSDF material whose colour ``color_from(tree)`` (an output socket) gives."""
+    mat = bpy.data.materials.new(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    tree.links.new(color_from(tree), bsdf.inputs["Color"])
+    out = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
+def _ground_color(tree):
+    """Voronoi cell colours darkened by a noise factor."""
+    vor = tree.nodes.new("ShaderNodeTexVoronoi")
+    vor.inputs["Scale"].default_value = 4.0
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 3.0
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    mix.blend_type = "MULTIPLY"
+    mix.inputs["Factor"].default_value = 1.0
+    tree.links.new(vor.outputs["Color"], mix.inputs["A"])
+    tree.links.new(noise.outputs["Fac"], mix.inputs["B"])
+    return mix.outputs["Result"]
+
+
+def _sphere_color(tree):
+    """Bricks whose first colour is a wave's."""
+    brick = tree.nodes.new("ShaderNodeTexBrick")
+    brick.inputs["Scale"].default_value = 3.0
+    wave = tree.nodes.new("ShaderNodeTexWave")
+    wave.inputs["Scale"].default_value = 2.0
+    tree.links.new(wave.outputs["Color"], brick.inputs["Color1"])
+    return brick.outputs["Color"]
+
+
 def lit_scene(width=48):
-    """A diffuse ground textured by Voronoi colour times a noise factor, with a Brick-driven
-    roughness on a glossy sphere, lit by a sun and a point light: textures under light."""
+    """Textures under light: a ground of Voronoi colours times noise and a sphere of bricks
+    and waves, both diffuse, lit by a sun and a point light (shadows on textured ground)."""
     scene = empty_scene(width, width)
     cam = scene.camera
     cam.location = (0.0, -6.0, 4.0)
@@ -199,37 +236,10 @@ def lit_scene(width=48):
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     bpy.ops.mesh.primitive_plane_add(size=8.0)
-    ground = bpy.context.active_object
-    mat = bpy.data.materials.new("Ground")
-    tree = mat.node_tree
-    bsdf = tree.nodes["Principled BSDF"]
-    bsdf.inputs["Roughness"].default_value = 1.0
-    vor = tree.nodes.new("ShaderNodeTexVoronoi")
-    vor.inputs["Scale"].default_value = 1.5
-    noise = tree.nodes.new("ShaderNodeTexNoise")
-    noise.inputs["Scale"].default_value = 1.0
-    mix = tree.nodes.new("ShaderNodeMix")
-    mix.data_type = "RGBA"
-    mix.blend_type = "MULTIPLY"
-    mix.inputs["Factor"].default_value = 1.0
-    tree.links.new(vor.outputs["Color"], mix.inputs["A"])
-    tree.links.new(noise.outputs["Fac"], mix.inputs["B"])
-    tree.links.new(mix.outputs["Result"], bsdf.inputs["Base Color"])
-    ground.data.materials.append(mat)
+    bpy.context.active_object.data.materials.append(_diffuse("Ground", _ground_color))
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(0.0, 0.0, 1.0), segments=48, ring_count=24)
-    sphere = bpy.context.active_object
     bpy.ops.object.shade_smooth()
-    smat = bpy.data.materials.new("Sphere")
-    stree = smat.node_tree
-    sbsdf = stree.nodes["Principled BSDF"]
-    sbsdf.inputs["Metallic"].default_value = 1.0
-    brick = stree.nodes.new("ShaderNodeTexBrick")
-    brick.inputs["Scale"].default_value = 3.0
-    wave = stree.nodes.new("ShaderNodeTexWave")
-    wave.inputs["Scale"].default_value = 2.0
-    stree.links.new(brick.outputs["Fac"], sbsdf.inputs["Roughness"])
-    stree.links.new(wave.outputs["Color"], sbsdf.inputs["Base Color"])
-    sphere.data.materials.append(smat)
+    bpy.context.active_object.data.materials.append(_diffuse("Sphere", _sphere_color))
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 3.0
     sun.rotation_euler = (0.6, 0.2, 0.8)
