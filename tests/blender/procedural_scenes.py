@@ -11,7 +11,7 @@ difference from Cycles (seed 0), and Cycles' own worst between its seeds 0 and 1
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import bpy
 import numpy as np
@@ -33,6 +33,7 @@ class Case:
     inputs: dict = field(default_factory=dict)
     w_from_x: bool = False  # 1D textures: W varies as the tile's x
     snap: bool = False  # coordinates snapped to a 0.25 grid (White Noise)
+    musgrave: tuple = ()  # (detail, dimension) of a Musgrave texture, linked as Blender 4.1 converts it
 
 
 def _noise(name, dims, kind, output="Fac", normalize=True, **inputs):
@@ -94,11 +95,46 @@ CASES = (
          {"Scale": 0.8, "Distortion": 1.7}),
     *(Case(f"White Noise {d}", "ShaderNodeTexWhiteNoise", "Color" if d != "2D" else "Value",
            {"noise_dimensions": d}, {"W": 0.25}, d == "1D", True) for d in ("1D", "2D", "3D", "4D")),
+    replace(_noise("Musgrave fBM 3D (converted)", "3D", "FBM", normalize=False), musgrave=(3.5, 1.2)),
+    replace(_noise("Musgrave multifractal 3D (converted)", "3D", "MULTIFRACTAL", normalize=False),
+            musgrave=(2.5, 0.8)),
     Case("Brick", "ShaderNodeTexBrick", "Color", {}, {"Scale": 1.5}),
     Case("Brick offset and squash, smooth mortar", "ShaderNodeTexBrick", "Fac",
          {"offset": 0.3, "offset_frequency": 3, "squash": 0.6, "squash_frequency": 2},
          {"Scale": 2.0, "Mortar Size": 0.05, "Mortar Smooth": 0.6, "Bias": 0.2}),
 )
+
+
+def _math(tree, operation, a, b, clamp=False):
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    node.use_clamp = clamp
+    for socket, value in zip(node.inputs, (a, b)):
+        if isinstance(value, float):
+            socket.default_value = value
+        else:
+            tree.links.new(value, socket)
+    return node.outputs[0]
+
+
+def _musgrave_converted(tree, tex, sockets, kind, detail, dimension):
+    """The nodes Blender (4.1 on, versioning_410.cc) puts around a Musgrave texture it turns into
+    a Noise texture, when the Musgrave's Detail and Dimension were linked: Detail - 1 capped at
+    14, Roughness = Lacunarity^-max(Dimension, -1e-5), the factor times clamp(Detail) (and, for
+    multifractal, plus clamp(1 - Detail)). Returns the socket that replaces the Musgrave's output."""
+    d = tree.nodes.new("ShaderNodeValue")
+    d.outputs[0].default_value = detail
+    r = tree.nodes.new("ShaderNodeValue")
+    r.outputs[0].default_value = dimension
+    tree.links.new(_math(tree, "MINIMUM", _math(tree, "SUBTRACT", d.outputs[0], 1.0), 14.0), sockets["Detail"])
+    exponent = _math(tree, "MULTIPLY", _math(tree, "MAXIMUM", r.outputs[0], -1e-5), -1.0)
+    tree.links.new(_math(tree, "POWER", float(sockets["Lacunarity"].default_value), exponent), sockets["Roughness"])
+    clamp = tree.nodes.new("ShaderNodeClamp")
+    tree.links.new(d.outputs[0], clamp.inputs["Value"])
+    out = _math(tree, "MULTIPLY", tex.outputs["Fac"], clamp.outputs[0])
+    if kind == "MULTIFRACTAL":
+        out = _math(tree, "ADD", out, _math(tree, "SUBTRACT", 1.0, d.outputs[0], clamp=True))
+    return out
 
 
 def _material(case: Case):
@@ -129,9 +165,12 @@ def _material(case: Case):
         tree.links.new(split.outputs["X"], sockets["W"])
     else:
         tree.links.new(vector, sockets["Vector"])
+    result = tex.outputs[case.output]
+    if case.musgrave:
+        result = _musgrave_converted(tree, tex, sockets, case.props["noise_type"], *case.musgrave)
     absolute = tree.nodes.new("ShaderNodeVectorMath")
     absolute.operation = "ABSOLUTE"
-    tree.links.new(tex.outputs[case.output], absolute.inputs[0])
+    tree.links.new(result, absolute.inputs[0])
     emission = tree.nodes.new("ShaderNodeEmission")
     tree.links.new(absolute.outputs["Vector"], emission.inputs["Color"])
     out = tree.nodes.new("ShaderNodeOutputMaterial")
