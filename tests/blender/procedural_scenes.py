@@ -98,10 +98,10 @@ CASES = (
     replace(_noise("Musgrave fBM 3D (converted)", "3D", "FBM", normalize=False), musgrave=(3.5, 1.2)),
     replace(_noise("Musgrave multifractal 3D (converted)", "3D", "MULTIFRACTAL", normalize=False),
             musgrave=(2.5, 0.8)),
-    Case("Brick", "ShaderNodeTexBrick", "Color", {}, {"Scale": 1.5}),
+    Case("Brick", "ShaderNodeTexBrick", "Color", {}, {"Scale": 0.6, "Mortar Size": 0.05}),
     Case("Brick offset and squash, smooth mortar", "ShaderNodeTexBrick", "Fac",
          {"offset": 0.3, "offset_frequency": 3, "squash": 0.6, "squash_frequency": 2},
-         {"Scale": 2.0, "Mortar Size": 0.05, "Mortar Smooth": 0.6, "Bias": 0.2}),
+         {"Scale": 0.8, "Mortar Size": 0.05, "Mortar Smooth": 0.6, "Bias": 0.2}),
 )
 
 
