@@ -1,7 +1,7 @@
 """Measure DRT's procedural textures against Cycles and write the figures into README.
 
-Renders tests/blender/procedural_scenes.py's grid (one tile per texture and mode) and lit
-scene with DRT (seed 0) and Cycles (seeds 0 and 1) at 64 samples, as the parity test does,
+Renders tests/blender/procedural_scenes.py's grid (one tile per texture and mode), lit
+scene and Box-projected image with DRT (seed 0) and Cycles (seeds 0 and 1) at 64 samples, as the parity test does,
 writes docs/texture_parity.json, and replaces README's block between the markers below with
 a table of each case's worst 4x4-block difference from Cycles beside Cycles' own between its
 two seeds. Run from the repository root: .venv/bin/python tools/texture_parity.py
@@ -25,6 +25,7 @@ import render_helpers as rh  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- texture parity: begin -->", "<!-- texture parity: end -->"
 JSON_PATH = ROOT / "docs" / "texture_parity.json"
+BOX_BLENDS = (0.0, 0.3)
 
 
 def _three(scene, out, name):
@@ -39,6 +40,9 @@ def measure() -> dict:
         lit = _three(ps.lit_scene(), out, "lit")
         cases["Lit scene (Voronoi x Noise ground, Brick and Wave sphere; sun and point light)"] = ps.parity(
             *(r.rgb for r in lit))
+        for blend in BOX_BLENDS:
+            box = _three(ps.box_scene(blend=blend), out, f"box-{blend}")
+            cases[f"Image Texture, Box projection, blend {blend}"] = ps.parity(*(r.rgb for r in box))
     return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "tile_px": ps.TILE, "cases": cases}
 
 

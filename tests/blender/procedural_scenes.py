@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import bpy
+import mathutils
 import numpy as np
 
 from export_helpers import empty_scene
@@ -287,4 +288,44 @@ def lit_scene(width=48):
     lamp.data.energy = 300.0
     lamp.location = (2.5, -2.0, 3.0)
     scene.collection.objects.link(lamp)
+    return scene
+
+
+def box_scene(width=48, blend=0.3):
+    """An emissive sphere, turned, seen from above at an angle, coloured by an 8x8 image of random
+    colours (Closest) in Box projection of its Object coordinates: the three faces and the
+    blended seams between them, which follow the object-space normal."""
+    scene = empty_scene(width, width)
+    cam = scene.camera
+    cam.location = (2.6, -3.4, 2.4)
+    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
+    world = bpy.data.worlds.new("World")
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=64, ring_count=32, rotation=(0.3, 0.2, 0.5))
+    bpy.ops.object.shade_smooth()
+    image = bpy.data.images.new("Texels", 8, 8, float_buffer=True)
+    texels = np.random.default_rng(11).uniform(0.05, 1.0, (8, 8, 4)).astype(np.float32)
+    texels[..., 3] = 1.0
+    image.pixels.foreach_set(texels.ravel())
+    image.pack()  # a generated image would be generated again (blank) for the render
+    mat = bpy.data.materials.new("Box")
+    tree = mat.node_tree
+    tree.nodes.clear()
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.5, 0.5, 0.5)
+    mapping.inputs["Scale"].default_value = (0.5, 0.5, 0.5)
+    tree.links.new(coords.outputs["Object"], mapping.inputs["Vector"])
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    tex.interpolation = "Closest"
+    tex.projection = "BOX"
+    tex.projection_blend = blend
+    tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(tex.outputs["Color"], emission.inputs["Color"])
+    out = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+    bpy.context.active_object.data.materials.append(mat)
     return scene

@@ -4,7 +4,8 @@ tile of one emissive grid (procedural_scenes.CASES), and one lit scene.
 A case passes when DRT's worst 4x4-block difference from Cycles (seed 0) is at most 1.5x
 Cycles' own worst between seeds 0 and 1, plus 0.002: what is left when both evaluate the
 same texture is pixel-sampling noise, largest at cell edges and discontinuities. A wrong
-hash, octave, seed or metric moves whole cells by far more.
+hash, octave, seed or metric moves whole cells by far more. Image Texture's Box projection
+is checked the same way on an emissive sphere.
 """
 from __future__ import annotations
 
@@ -44,4 +45,15 @@ def test_lit_scene_matches_cycles(drt, tmp_path):
                           for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
     figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
     rh.save_side_by_side("procedural-lit", drt_render.rgb, c0.rgb)
+    assert figures["ok"], figures
+
+
+@pytest.mark.parametrize("blend", [0.0, 0.3])  # as tools/texture_parity.BOX_BLENDS
+def test_image_box_projection_matches_cycles(drt, tmp_path, blend):
+    scene = ps.box_scene(blend=blend)
+    assert not [w for w in render_export(scene).warnings if "projection" in w]
+    drt_render, c0, c1 = (rh.render(scene, engine, ps.SAMPLES, seed, tmp_path, name="box")
+                          for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
+    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
+    rh.save_side_by_side(f"box-projection-{blend}", drt_render.rgb, c0.rgb)
     assert figures["ok"], figures

@@ -171,3 +171,19 @@ def test_brick_mortar_and_tint_by_hand():
     tint = 0.5 * nn / 1073741824.0
     assert fac[1] == 0.0
     np.testing.assert_allclose(color[1], [1 - tint, tint, 0.0], atol=1e-12)
+
+
+def test_box_weights_pick_a_face_and_blend_to_one():
+    from drt_engine.core.shadernodes import box_weights
+    faces = np.array([[0.9, 0.1, 0.2], [-0.1, -0.8, 0.3], [0.2, 0.1, -0.7]])
+    np.testing.assert_array_equal(box_weights(faces, 0.0), np.eye(3))
+    centre = np.full((1, 3), 1 / np.sqrt(3))
+    np.testing.assert_allclose(box_weights(centre, 0.5), [[1 / 3, 1 / 3, 1 / 3]])
+    normals = np.random.default_rng(4).normal(size=(500, 3))
+    for blend in (0.0, 0.2, 0.7, 1.0):
+        w = box_weights(normals, blend)
+        np.testing.assert_allclose(w.sum(axis=1), 1.0, atol=1e-12)
+        assert (w >= 0).all()
+    # between the x and y faces (z small), blend 1: x's weight is |x| / (|x| + |y|) stretched over [0, 1]
+    w = box_weights(np.array([[0.6, 0.4, 0.0]]), 1.0)
+    np.testing.assert_allclose(w, [[0.6, 0.4, 0.0]])

@@ -255,14 +255,15 @@ class Compiler:
     def _node_ShaderNodeTexImage(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection != "FLAT":
+        if node.projection not in ("FLAT", "BOX"):
             self.issues.add(f"'{node.name}' {node.projection.title()} projection (rendered as Flat)")
         interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
         if node.interpolation not in ("Linear", "Closest"):
             self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")
         vector = self._vector_or(node, "generated" if self.world else "uv")
         i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
-                             extension=node.extension)
+                             extension=node.extension, projection=node.projection,
+                             blend=float(node.projection_blend))
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeTexEnvironment(self, node, output):
