@@ -171,8 +171,7 @@ _INV_INT_MAX = 1.0 / 2147483648.0  # 1 / float32(0x7FFFFFFF), exactly 2^-31
 @kernel
 def _i32(x):
     """Wrap to a signed 32-bit integer, as C's int arithmetic does on every target Cycles runs on."""
-    x &= M32
-    return x - (1 << 32) if x >= (1 << 31) else x
+    return ((x + (1 << 31)) & M32) - (1 << 31)
 
 
 @kernel
