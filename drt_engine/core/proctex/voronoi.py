@@ -71,6 +71,7 @@ def _point(dims, pcg, randomness, cell, off, point):
         h = hash_to_point(dims, cell[0] + off[0], cell[1] + off[1], cell[2] + off[2], cell[3] + off[3])
     for k in range(dims):
         point[k] = off[k] + h[k] * randomness
+    return h
 
 
 @kernel
@@ -143,13 +144,14 @@ def _smooth_f1(dims, pcg, metric, exponent, randomness, smoothness, coord, work,
     h = -1.0
     for idx in range(5 ** dims):
         _cell_offset(dims, idx, 5, off)
-        _point(dims, pcg, randomness, cell, off, point)
+        r = _point(dims, pcg, randomness, cell, off, point)
         d = _distance(dims, metric, exponent, point, local)
         h = 1.0 if h == -1.0 else _smoothstep01(0.5 + 0.5 * (sd - d) / smoothness)
         corr = smoothness * h * (1.0 - h)
         sd = sd + h * (d - sd) - corr
         corr /= 1.0 + 3.0 * smoothness
-        c = _color(dims, pcg, cell, off)
+        # PCG in 3D and 4D colours a cell with its point's own hash
+        c = (r[0], r[1], r[2]) if pcg and dims >= 3 else _color(dims, pcg, cell, off)
         for k in range(3):
             color[k] = color[k] + h * (c[k] - color[k]) - corr
         for k in range(dims):
@@ -160,7 +162,8 @@ def _smooth_f1(dims, pcg, metric, exponent, randomness, smoothness, coord, work,
 
 
 @kernel
-def _distance_to_edge(dims, pcg, randomness, coord, work):
+def _distance_to_edge(dims, pcg, randomness, coord, work, vectors):
+    """``vectors`` (81, 4): scratch for the vectors to the neighbours' points, hashed once."""
     cell, local, off, point, closest, perp = work[0], work[1], work[2], work[3], work[4], work[5]
     _split(dims, coord, cell, local)
     if dims == 1:
@@ -174,26 +177,23 @@ def _distance_to_edge(dims, pcg, randomness, coord, work):
         _point(dims, pcg, randomness, cell, off, point)
         d = 0.0
         for k in range(dims):
-            point[k] -= local[k]
-            d += point[k] * point[k]
+            vectors[idx, k] = point[k] - local[k]
+            d += vectors[idx, k] * vectors[idx, k]
         if d < best:
             best = d
             for k in range(dims):
-                closest[k] = point[k]
+                closest[k] = vectors[idx, k]
     best = np.inf
     for idx in range(3 ** dims):
-        _cell_offset(dims, idx, 3, off)
-        _point(dims, pcg, randomness, cell, off, point)
         p2 = 0.0
         for k in range(dims):
-            point[k] -= local[k]
-            perp[k] = point[k] - closest[k]
+            perp[k] = vectors[idx, k] - closest[k]
             p2 += perp[k] * perp[k]
         if p2 > 0.0001:
             length = math.sqrt(p2)
             edge = 0.0
             for k in range(dims):
-                edge += (closest[k] + point[k]) / 2.0 * (perp[k] / length)
+                edge += (closest[k] + vectors[idx, k]) / 2.0 * (perp[k] / length)
             best = min(best, edge)
     return best
 
@@ -259,6 +259,7 @@ def voronoi_texture(dims, feature, metric, normalize, pcg, vector, w_in, scale, 
     w_out = np.zeros(n)
     radius = np.zeros(n)
     work = np.zeros((8, 4))
+    vectors = np.zeros((81, 4))
     coord = np.zeros(4)
     scaled = np.zeros(4)
     oct_color = np.zeros(3)
@@ -292,7 +293,7 @@ def voronoi_texture(dims, feature, metric, normalize, pcg, vector, w_in, scale, 
             for octave in range(int(math.ceil(det)) + 1):
                 for k in range(4):
                     scaled[k] = coord[k] * octave_scale
-                od = _distance_to_edge(dims, pcg, rnd, scaled, work)
+                od = _distance_to_edge(dims, pcg, rnd, scaled, work, vectors)
                 if zero_input:
                     dist = od
                     break
