@@ -187,3 +187,20 @@ def test_box_weights_pick_a_face_and_blend_to_one():
     # between the x and y faces (z small), blend 1: x's weight is |x| / (|x| + |y|) stretched over [0, 1]
     w = box_weights(np.array([[0.6, 0.4, 0.0]]), 1.0)
     np.testing.assert_allclose(w, [[0.6, 0.4, 0.0]])
+
+
+def test_shader_programs_evaluate_the_texture_ops():
+    """A program of coordinate -> Voronoi (as the export compiles a node) gives the kernel's values."""
+    from drt_engine.core.scene import Program
+    from drt_engine.core.shadernodes import DirectionContext, Evaluator
+    dirs = np.random.default_rng(8).normal(size=(50, 3))
+    program = Program()
+    coord = program.add("coord", name="generated")
+    consts = [program.add("const", value=v) for v in (0.0, 4.0, 1.5, 0.5, 2.0, 1.0, 1.0, 0.8)]
+    voronoi = program.add("voronoi", [(coord, 0)] + [(c, 0) for c in consts], dims=3, feature="F1",
+                          metric="EUCLIDEAN", normalize=True)
+    out = Evaluator(program, DirectionContext(dirs), [])((voronoi, 1))
+    expected = proctex.evaluate("voronoi", {"dims": 3, "feature": "F1", "metric": "EUCLIDEAN", "normalize": True},
+                                [dirs, *(np.full(50, v) for v in (0.0, 4.0, 1.5, 0.5, 2.0, 1.0, 1.0, 0.8))])[1]
+    np.testing.assert_array_equal(out, expected)
+    assert out.std() > 0.05
