@@ -7,6 +7,7 @@
 #                    bench/plots/), then ray throughput and memory; about 20 min on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
+#   make texture-parity  DRT vs Cycles per procedural texture and mode (tools/texture_parity.py: README table)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes .venv and wheels/
 #   make blender-env build (once, cached in BLENDER_ENV) a Debian 13 root with Blender 4.3.2; needs root
@@ -33,7 +34,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test extension scenes bench bench-throughput bench-farm clean distclean blender-env test-blender
+.PHONY: help venv render test extension scenes bench bench-throughput bench-farm texture-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -119,3 +120,6 @@ blender-env:
 # when DRT_BLENDER_ENV names the root, so `make test` leaves it out.
 test-blender: blender-env extension
 	DRT_BLENDER_ENV=$(BLENDER_ENV) $(PY) -m pytest tests/real_blender -q $(PYTEST_ARGS)
+
+texture-parity: $(STAMP)
+	$(PY) tools/texture_parity.py

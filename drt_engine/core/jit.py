@@ -65,7 +65,7 @@ def kernel(fn=None, **options):
 def _fingerprint() -> str:
     """What decides whether cached kernels can be loaded: DRT's core sources, Numba, Python."""
     h = hashlib.sha256(f"{numba.__version__} {sys.version_info[:2]} {sys.platform}".encode())
-    for source in sorted(Path(__file__).parent.glob("*.py")):
+    for source in sorted(Path(__file__).parent.rglob("*.py")):
         h.update(source.read_bytes())
     return h.hexdigest()[:16]
 

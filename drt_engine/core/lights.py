@@ -215,7 +215,9 @@ class Lights:
             best = np.maximum(best, self._emission_at(tris, np.tile(bary, (len(tris), 1))))
         return best
 
-    def _emission_at(self, prim, bary):
+    def _emission_at(self, prim, bary, normal=None):
+        """Emission of triangles ``prim`` at ``bary``, its texture seeing ``normal`` (the hits'
+        shading normals), or the triangles' geometric normals at light-sampled points."""
         g = self.geometry
         out = self.tri_emission[prim].copy()
         for m in self.textured:
@@ -223,17 +225,18 @@ class Lights:
             if len(sel):
                 p = g.world_vertices[g.triangles[prim[sel]]]
                 pos = np.einsum("ni,nij->nj", bary[sel], p)
-                ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, g.world_ng[prim[sel]])
+                n = g.world_ng[prim[sel]] if normal is None else normal[sel]
+                ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n)
                 out[sel] = self.shaders[m].emission_at(ctx)
         return out
 
-    def emission_seen(self, prim, u, v):
-        """Emitted radiance at hits (triangles ``prim``, barycentrics u, v)."""
+    def emission_seen(self, prim, u, v, normal=None):
+        """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``)."""
         if not len(self.tri_emission):
             return np.zeros((len(prim), 3))
         if not self.textured:
             return self.tri_emission[prim]
-        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1))
+        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal)
 
     def _local(self, i, points, dirs, time):
         """(light, points, directions, rotation) in the frame where light i stands still."""

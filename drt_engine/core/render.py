@@ -398,7 +398,8 @@ class Renderer:
             # emission seen (two-sided), weighted against light sampling of emissive triangles
             glowing = np.flatnonzero(self._glows[prim]) if len(self._glows) else np.zeros(0, np.int64)
             if len(glowing):
-                emission = self.lights.emission_seen(prim[glowing], hits.u[surf[glowing]], hits.v[surf[glowing]])
+                emission = self.lights.emission_seen(prim[glowing], hits.u[surf[glowing]], hits.v[surf[glowing]],
+                                                     ns[glowing])
                 weight = np.ones(len(glowing))
                 k = surf[glowing]
                 smooth = ~np.isinf(prev_pdf[k])

@@ -4,7 +4,7 @@ A ``Program`` (core.scene) is Blender's node graph compiled by the export into a
 of operations; this module evaluates the outputs a material asks for, vectorised over
 the hits. Each operation follows Cycles' SVM definition of its node (svm_math_util.h,
 svm_color_util.h, svm_checker.h, svm_ramp.h, svm_mapping_util.h, svm_normal_map.h,
-svm_bump.h). Scalars are (N,) arrays, colours and vectors (N, 3).
+svm_bump.h; the procedural textures in core.proctex). Scalars are (N,) arrays, colours and vectors (N, 3).
 
 Coordinates come from a context (``SurfaceContext`` for hits, ``DirectionContext`` for
 the world). A context can be shifted by a small world-space offset: that gives image
@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import microfacet as mf
+from . import proctex
 from .microfacet import orthonormal_basis
 from .scene import Program
 from .textures import Texture, equirect_uv
@@ -301,6 +302,8 @@ class Evaluator:
             rgba = self.ctx.attribute(p["name"])
             return rgba[:, :3], rgba[:, :3] @ LUMINANCE, rgba[:, 3]
         if op == "image":
+            if p.get("projection") == "BOX":
+                return self._image_box(p, node.inputs[0], x[0])
             return self._image(p, node.inputs[0], x[0])
         if op == "environment":
             tex = self.textures[p["image"]]
@@ -339,6 +342,8 @@ class Evaluator:
             return _ramp(x[0], p["positions"], p["colors"], p["interpolation"])
         if op == "checker":
             return _checker(x[0], x[1], x[2], x[3])
+        if op in proctex.OPS:
+            return proctex.evaluate(op, p, x)
         if op == "mapping":
             return (_mapping(p["type"], x[0], x[1], x[2], x[3]),)
         if op == "normal_map":
@@ -381,6 +386,32 @@ class Evaluator:
         rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
         return rgba[:, :3], rgba[:, 3]
 
+    def _image_box(self, p, vector_ref, co):
+        """Cycles' svm_node_tex_image_box: up to three planar lookups, one per axis of the
+        object-space normal, weighted by it with ``blend`` softening the seams."""
+        tex = self.textures[p["image"]]
+        normal = self.ctx.coord("normal")
+        weights = box_weights(normal, p.get("blend", 0.0))
+        footprint = None
+        if p.get("interpolation", "Linear") != "Closest":
+            shifted = self._footprint_evaluators()
+            if shifted is not None:
+                footprint = tuple(e(vector_ref) - co for e in shifted)
+        out = np.zeros((self.ctx.n, 4))
+        # per face: the two coordinates read, and which normal sign flips the first (no mirrored images)
+        faces = ((1, 2, normal[:, 0] < 0), (0, 2, normal[:, 1] > 0), (1, 0, normal[:, 2] > 0))
+        for axis, (u, v, flip) in enumerate(faces):
+            sel = np.flatnonzero(weights[:, axis] > 0)
+            if len(sel) == 0:
+                continue
+            sign = np.where(flip[sel], -1.0, 1.0)
+            uv = np.stack([np.where(flip[sel], 1.0 - co[sel, u], co[sel, u]), co[sel, v]], axis=1)
+            fp = None if footprint is None else tuple(
+                np.stack([d[sel, u] * sign, d[sel, v]], axis=1) for d in footprint)
+            rgba = tex.lookup(uv, fp, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+            out[sel] += weights[sel, axis, None] * rgba
+        return out[:, :3], out[:, 3]
+
     def _normal_map(self, p, strength, color):
         ctx = self.ctx
         n = ctx.normal
@@ -404,6 +435,39 @@ class Evaluator:
         grad = ((hx - h) / eps)[:, None] * t + ((hy - h) / eps)[:, None] * b
         out = _normalize(n - dist[:, None] * grad)
         return _normalize(strength * out + (1.0 - strength) * n)
+
+
+def box_weights(normal, blend):
+    """(N, 3) weights of the x, y and z projections of Box mapping (Cycles' seven zones of the
+    normal's barycentric triangle: one face, two blended, or all three in the middle)."""
+    a = np.abs(normal)
+    a = a / np.maximum(a.sum(axis=1, keepdims=True), _TINY)
+    x, y, z = a[:, 0], a[:, 1], a[:, 2]
+    limit = 0.5 * (1.0 + blend)
+    w = np.zeros_like(a)
+    with np.errstate(all="ignore"):
+        zones = [
+            (x > limit * (x + y)) & (x > limit * (x + z)),
+            (y > limit * (x + y)) & (y > limit * (y + z)),
+            (z > limit * (x + z)) & (z > limit * (y + z)),
+        ]
+        for axis, zone in enumerate(zones):
+            w[zone, axis] = 1.0
+        rest = ~(zones[0] | zones[1] | zones[2])
+        if blend <= 0.0:
+            w[rest, 0] = 1.0  # Cycles' fallback: no valid face, use x
+            return w
+        pairs = ((z < (1 - limit) * (y + x), 0, 1, x, y), (x < (1 - limit) * (y + z), 1, 2, y, z),
+                 (y < (1 - limit) * (x + z), 0, 2, x, z))
+        for cond, i, j, a_i, a_j in pairs:
+            sel = rest & cond
+            t = np.clip((a_i / (a_i + a_j) - 0.5 * (1.0 - blend)) / blend, 0.0, 1.0)
+            w[sel, i] = t[sel]
+            w[sel, j] = 1.0 - t[sel]
+            rest = rest & ~cond
+        three = ((2.0 - limit) * a + (limit - 1.0)) / (2.0 * limit - 1.0)
+        w[rest] = three[rest]
+    return w
 
 
 def _convert(kind, v):

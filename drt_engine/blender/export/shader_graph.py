@@ -10,6 +10,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from ...core import proctex
 from ...core import shadernodes as sn
 from ...core.scene import Program, TextureImage
 from ...core.textures import MAGENTA, openimageio_available
@@ -254,14 +255,15 @@ class Compiler:
     def _node_ShaderNodeTexImage(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection != "FLAT":
+        if node.projection not in ("FLAT", "BOX"):
             self.issues.add(f"'{node.name}' {node.projection.title()} projection (rendered as Flat)")
         interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
         if node.interpolation not in ("Linear", "Closest"):
             self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")
         vector = self._vector_or(node, "generated" if self.world else "uv")
         i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
-                             extension=node.extension)
+                             extension=node.extension, projection=node.projection,
+                             blend=float(node.projection_blend))
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeTexEnvironment(self, node, output):
@@ -372,6 +374,46 @@ class Compiler:
         args = (self._vector_or(node, "generated"), self._in(node, "Color1", "color"),
                 self._in(node, "Color2", "color"), self._in(node, "Scale", "float"))
         return self.op("checker", args), 0 if output.identifier == "Color" else 1
+
+    # -- procedural textures (core.proctex) ------------------------------------------
+    def _procedural(self, node, output, op, **params):
+        """A procedural texture node: its vector (Generated coordinates when unlinked, as in
+        Cycles), its other sockets in core.proctex's order, and the output's index."""
+        mapping = getattr(node, "texture_mapping", None)
+        if mapping is not None and (any(mapping.translation) or any(mapping.rotation)
+                                    or any(v != 1.0 for v in mapping.scale)):
+            self.issues.add(f"'{node.name}' texture mapping (ignored)")
+        kinds = {"Vector": "vector", "Color1": "color", "Color2": "color", "Mortar": "color"}
+        args = [self._vector_or(node, "generated")]
+        args += [self._in(node, name, kinds.get(name, "float")) for name in proctex.INPUTS[op][1:]]
+        return self.op(op, args, **params), proctex.OUTPUTS[op].index(output.identifier)
+
+    def _node_ShaderNodeTexNoise(self, node, output):
+        return self._procedural(node, output, "noise", dims=int(node.noise_dimensions[0]), type=node.noise_type,
+                                normalize=bool(node.normalize), color=output.identifier == "Color")
+
+    def _node_ShaderNodeTexVoronoi(self, node, output):
+        return self._procedural(node, output, "voronoi", dims=int(node.voronoi_dimensions[0]),
+                                feature=node.feature, metric=node.distance, normalize=bool(node.normalize),
+                                hash=proctex.HASH_PCG if bpy.app.version >= (5, 0, 0) else "lookup3")
+
+    def _node_ShaderNodeTexWave(self, node, output):
+        return self._procedural(node, output, "wave", type=node.wave_type, bands=node.bands_direction,
+                                rings=node.rings_direction, profile=node.wave_profile)
+
+    def _node_ShaderNodeTexGradient(self, node, output):
+        return self._procedural(node, output, "gradient", type=node.gradient_type)
+
+    def _node_ShaderNodeTexMagic(self, node, output):
+        return self._procedural(node, output, "magic", depth=int(node.turbulence_depth))
+
+    def _node_ShaderNodeTexWhiteNoise(self, node, output):
+        return self._procedural(node, output, "white_noise", dims=int(node.noise_dimensions[0]))
+
+    def _node_ShaderNodeTexBrick(self, node, output):
+        return self._procedural(node, output, "brick", offset=float(node.offset),
+                                offset_frequency=int(node.offset_frequency), squash=float(node.squash),
+                                squash_frequency=int(node.squash_frequency))
 
     def _node_ShaderNodeNormalMap(self, node, output):
         if node.space != "TANGENT":
