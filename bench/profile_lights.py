@@ -1,6 +1,7 @@
 """Where a render's time goes, for the light stages: cProfile of Renderer.render on each sample
 scene (160 px wide, 16 spp, one thread), printing the whole render time and the cumulative time
-spent in lights.py and environment.py (their outermost calls, so nested calls count once).
+spent in the light modules (their outermost calls, so nested calls count once). Times are CPU
+seconds of this process (the machine is shared: wall time measures the neighbours too).
 
 Usage: python bench/profile_lights.py [scene ...]
 """
@@ -21,6 +22,7 @@ from drt_engine.core.render import Renderer  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
 MODULES = ("core/lights.py", "core/environment.py")
+TOP = 6
 
 
 def module_time(stats: pstats.Stats, module: str) -> float:
@@ -41,16 +43,20 @@ def main(names):
         renderer = Renderer(data, settings(scene, samples=16, threads=1))
         renderer.render()  # warm: kernels compiled or loaded, tables built
         renderer = Renderer(data, settings(scene, samples=16, threads=1))
-        start = time.perf_counter()
+        start = time.process_time()
         renderer.render()
-        wall = time.perf_counter() - start
-        profile = cProfile.Profile()
+        cpu = time.process_time() - start
+        profile = cProfile.Profile(time.process_time)
         renderer = Renderer(data, settings(scene, samples=16, threads=1))
         profile.runcall(renderer.render)
         stats = pstats.Stats(profile)
         parts = ", ".join(f"{m.split('/')[-1]} {module_time(stats, m):.3f} s" for m in MODULES)
-        print(f"{name:15s} render {wall:.2f} s (profiled {stats.total_tt:.2f} s, "
+        print(f"{name:15s} render {cpu:.2f} s (profiled {stats.total_tt:.2f} s, "
               f"{stats.total_calls} calls); {parts}", flush=True)
+        ours = [(ct, f"{file.split('/')[-1]}:{fn}") for (file, _l, fn), (_c, _n, _t, ct, _) in stats.stats.items()
+                if file.endswith(MODULES)]
+        for ct, where in sorted(ours, reverse=True)[:TOP]:
+            print(f"    {ct:7.3f} s  {where}")
 
 
 if __name__ == "__main__":
