@@ -24,6 +24,7 @@ import numpy as np
 
 from .jit import kernel
 from .scene import Light
+from .shadernodes import LUMINANCE
 
 TINY = 1e-30
 INF = math.inf
@@ -49,7 +50,6 @@ COLUMNS = 33
 MIN_SOLID_ANGLE = 1e-5
 """Below this a rectangle's solid angle is sampled by area instead (the spherical-rectangle
 method loses precision; both strategies are exact there)."""
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
 def _unit(v):

@@ -139,7 +139,6 @@ class Lights:
         hittable = [i for i, light in enumerate(self.lights)
                     if light.kind == "AREA" or (light.kind in ("POINT", "SPOT") and light.radius > 0)]
         suns = [i for i, light in enumerate(self.lights) if light.kind == "SUN" and light.angle > 0]
-        self.hittable = np.array(hittable, np.int64)
         self._fixed_hittable = np.array([i for i in hittable if i not in self.motions], np.int64)
         self._fixed_suns = np.array([i for i in suns if i not in self.motions], np.int64)
         self._moving_hittable = [i for i in hittable if i in self.motions]
@@ -222,7 +221,7 @@ class Lights:
         """One light per point chosen by contribution; value and pdf are the whole slot's (the
         light's divided, and multiplied, by the expected number of picks of that light)."""
         wi, dist, value, pdf, pick, chosen = _sample_chosen_batch(self.table, self.light_slots, pos, u, u_light)
-        if time is not None:  # moving lights picked: sampled again in their own frames
+        if time is not None and self.motions:  # moving lights picked: sampled again in their own frames
             for i in np.intersect1d(pick, list(self.motions)):
                 idx = np.flatnonzero(pick == i)
                 ls = self._sample_light(i, pos[idx], u[idx], time[idx])
@@ -230,12 +229,6 @@ class Lights:
                 value[idx] = ls.value / chosen[idx, None]
                 pdf[idx] = ls.pdf * chosen[idx]
         return LightSample(wi, dist, value, pdf)
-
-    def pick_factor(self, light_index: int, origins: np.ndarray) -> np.ndarray | float:
-        """Expected number of samples light sampling spends on ``light_index`` from origins."""
-        if not self.selecting:
-            return 1.0
-        return _pick_batch(self.table, light_index, origins) * self.light_slots
 
     def _sample_emissive(self, pos, u, u_pick):
         g = self.geometry
@@ -282,10 +275,18 @@ class Lights:
         return best_t, best, radiance
 
     def pdf(self, light_index, origins, dirs, t, time=None):
-        """Solid-angle density with which light sampling picks dirs from origins."""
-        table, o, d, _ = self._frame(light_index, origins, dirs, time)
-        return _pdf_batch(table, self.table, light_index, self.light_slots if self.selecting else 0,
-                          o, d, np.asarray(t, np.float64), origins)
+        """Solid-angle density with which light sampling picks dirs from origins, toward the
+        light ``light_index`` (one index, or one per ray: the light each ray hit)."""
+        ids = np.ascontiguousarray(np.broadcast_to(np.asarray(light_index, np.int64), (len(origins),)))
+        t = np.asarray(t, np.float64)
+        slots = self.light_slots if self.selecting else 0
+        pdf = _pdf_batch(self.table, self.table, ids, slots, origins, dirs, t, origins)
+        if time is not None and self.motions:  # moving lights: again in their own frames
+            for i in np.intersect1d(ids, list(self.motions)):
+                k = np.flatnonzero(ids == i)
+                table, o, d, _ = self._frame(i, origins[k], dirs[k], time[k])
+                pdf[k] = _pdf_batch(table, self.table, ids[k], slots, o, d, t[k], origins[k])
+        return pdf
 
     def suns_seen(self, origins, dirs, time=None):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs."""
@@ -495,19 +496,12 @@ def _sample_chosen_batch(table, slots, pos, u, u_light):
 
 
 @kernel
-def _pick_batch(table, i, origins):
-    out = np.empty(len(origins))
-    for j in range(len(origins)):
-        out[j] = pick_probability(table, i, origins[j, 0], origins[j, 1], origins[j, 2])
-    return out
-
-
-@kernel
-def _pdf_batch(shape_table, table, i, slots, o, d, t, origins):
-    """Light i's density in its own frame (o, d), times its chance of being picked at the
-    world origins when lights are chosen (slots > 0)."""
+def _pdf_batch(shape_table, table, ids, slots, o, d, t, origins):
+    """Each ray's light's density in its own frame (o, d), times its chance of being picked
+    at the world origins when lights are chosen (slots > 0)."""
     out = np.empty(len(o))
     for j in range(len(o)):
+        i = ids[j]
         out[j] = light_pdf(shape_table, i, o[j, 0], o[j, 1], o[j, 2], d[j, 0], d[j, 1], d[j, 2], t[j])
         if slots > 0:
             out[j] *= pick_probability(table, i, origins[j, 0], origins[j, 1], origins[j, 2]) * slots

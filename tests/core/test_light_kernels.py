@@ -57,7 +57,7 @@ def test_sampled_direction_hits_the_light_with_the_sampled_radiance_and_pdf(name
     assert (hit == 0).all()
     assert np.allclose(t, dist[lit], rtol=1e-6)
     assert np.allclose(radiance / pdf[lit, None], value[lit], rtol=1e-6)
-    assert np.allclose(_pdf_batch(table, table, 0, 0, o, d, t, o), pdf[lit], rtol=1e-6)
+    assert np.allclose(_pdf_batch(table, table, hit, 0, o, d, t, o), pdf[lit], rtol=1e-6)
 
 
 def test_delta_lights_have_infinite_pdf_and_inverse_square_value():
@@ -130,3 +130,43 @@ def test_emissive_triangle_samples_have_the_pdf_of_pdf_emissive():
     pdf = lights.pdf_emissive(hits.prim, ls.wi, ls.dist)
     assert np.allclose(pdf, ls.pdf, rtol=1e-5)
     assert np.allclose(ls.value * ls.pdf[:, None], [2.0, 1.0, 0.5], rtol=1e-9)
+
+
+def _rotation_z(angle, at):
+    m = translation(*at)
+    c, s = np.cos(angle), np.sin(angle)
+    m[:2, :2] = [[c, -s], [s, c]]
+    return m
+
+
+@pytest.mark.parametrize("kind", ["AREA", "SPOT"])
+def test_a_moving_light_at_a_time_is_the_still_light_where_it_is_then(kind):
+    """Sampled, hit and weighted in its own frame: at mid-shutter, directions sampled toward a
+    light moving from one pose to another (a quarter turn and a shift) meet the still light
+    at the middle pose at the sampled distance, with the sampled radiance and pdf."""
+    def light(matrix, matrices=None):
+        if kind == "AREA":
+            return Light("AREA", matrix, radiance=np.full(3, 2.0), size_x=0.8, size_y=0.3, matrices=matrices)
+        return Light("SPOT", matrix, intensity=np.full(3, 5.0), radius=0.2, spot_size=2.0, matrices=matrices)
+
+    start, end = _rotation_z(0.0, (-0.4, 0, 1)), _rotation_z(np.pi / 2, (0.4, 0, 1))
+    mats = [Material("white", [Closure("DIFFUSE", color=(0.5,) * 3)])]
+    moving, still = [Renderer(SceneData(top_camera(), [plane()], [Instance(0, np.eye(4))], mats, [lt]),
+                              RenderSettings(samples=1, threads=1)).lights
+                     for lt in (light(start, np.stack([start, end])), light(_rotation_z(np.pi / 4, (0, 0, 1))))]
+    assert moving.moving and not still.moving
+    n = 3000
+    pos = np.column_stack([RNG.uniform(-1, 1, n), RNG.uniform(-1, 1, n), np.zeros(n)])
+    time = np.full(n, 0.5)
+    ls = moving.sample(0, pos, np.tile([0, 0, 1.0], (n, 1)), RNG.random((n, 2)), None, None, time)
+    lit = np.flatnonzero(ls.value.max(axis=1) > 0)
+    assert len(lit) > n // 2
+    o, d, inf = pos[lit], ls.wi[lit], np.full(len(lit), np.inf)
+    t_moving, hit_moving, le_moving = moving.intersect(o, d, inf, time[lit])
+    t_still, hit_still, le_still = still.intersect(o, d, inf)
+    assert (hit_moving == 0).all() and (hit_still == 0).all()
+    assert np.allclose(t_moving, ls.dist[lit], rtol=1e-6) and np.allclose(t_still, ls.dist[lit], rtol=1e-6)
+    assert np.allclose(le_moving / ls.pdf[lit, None], ls.value[lit], rtol=1e-6)
+    assert np.allclose(le_still, le_moving, rtol=1e-6)
+    assert np.allclose(moving.pdf(0, o, d, t_moving, time[lit]), ls.pdf[lit], rtol=1e-6)
+    assert np.allclose(still.pdf(0, o, d, t_still), ls.pdf[lit], rtol=1e-6)
