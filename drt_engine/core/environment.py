@@ -82,7 +82,7 @@ class Environment:
         return _pdf_batch(self.cell, self.cell_area, np.asarray(dirs, np.float64))
 
 
-@kernel
+@kernel(inline="always")
 def direction_at(u, v):
     """Scalar form of ``textures.equirect_direction``: the unit direction at (u, v)."""
     phi = (0.5 - u) * 2 * math.pi
@@ -91,7 +91,7 @@ def direction_at(u, v):
     return c * math.cos(phi), c * math.sin(phi), math.sin(elevation)
 
 
-@kernel
+@kernel(inline="always")
 def map_direction(row_cdf, col_cdf, u0, u1):
     """The direction the table gives the 2D sample u: a row by the marginal CDF, a column by
     that row's conditional CDF, then uniform within the cell (in u, v)."""
@@ -106,7 +106,7 @@ def map_direction(row_cdf, col_cdf, u0, u1):
     return direction_at((col + fu) / w, (row + fv) / h)
 
 
-@kernel
+@kernel(inline="always")
 def map_pdf(cell, cell_area, dx, dy, dz):
     """Solid-angle density of ``map_direction`` at direction d: the cell's probability over its
     solid angle (cell_area in (phi, theta) times sin theta); the cell from the scalar form of

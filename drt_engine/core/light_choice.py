@@ -16,7 +16,7 @@ FLOOR = 1e-12
 """Smallest weight relative to the largest at a point (keeps every light's probability > 0)."""
 
 
-@kernel
+@kernel(inline="always")
 def selection_weight(table, j, px, py, pz):
     if table[j, KIND] == SUN:
         return table[j, SEL_POWER]
@@ -25,7 +25,7 @@ def selection_weight(table, j, px, py, pz):
     return table[j, SEL_POWER] / d2
 
 
-@kernel
+@kernel(inline="always")
 def _floor_and_total(table, px, py, pz):
     largest = 0.0
     for j in range(table.shape[0]):
@@ -37,14 +37,14 @@ def _floor_and_total(table, px, py, pz):
     return floor, total
 
 
-@kernel
+@kernel(inline="always")
 def pick_probability(table, i, px, py, pz):
     """Chance that one slot picks light i at p."""
     floor, total = _floor_and_total(table, px, py, pz)
     return max(selection_weight(table, i, px, py, pz), floor) / total
 
 
-@kernel
+@kernel(inline="always")
 def pick_light(table, px, py, pz, u):
     """(light index, its probability) for the sample u in [0, 1): inverting the cumulative sum."""
     floor, total = _floor_and_total(table, px, py, pz)

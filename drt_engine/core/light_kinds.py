@@ -14,7 +14,9 @@ kind answers the same three questions for one shading point or ray:
 Kinds: point and spot (radius, soft falloff, cone and blend), sun (angle), rectangle
 (spherical-rectangle sampling, Urena et al. 2013), disk and ellipse (area sampling), all area
 shapes with Cycles' spread. Scalars in, scalars out: the batch loops in lights.py and a later
-fused stage kernel call these.
+fused stage kernel call these. They are inlined into their callers (``inline="always"``): a
+call from one compiled function to another is not inlined by LLVM across Numba's libraries,
+and measured 3x the arithmetic of a delta point light's sample (41 against 13 ns a sample).
 """
 from __future__ import annotations
 
@@ -111,7 +113,7 @@ def _spread_terms(spread: float):
 
 
 # -- small vector helpers ---------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def basis(nx, ny, nz):
     """Two unit vectors completing a unit vector to a right-handed frame (Duff et al. 2017)."""
     s = 1.0 if nz >= 0 else -1.0
@@ -120,7 +122,7 @@ def basis(nx, ny, nz):
     return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
 
 
-@kernel
+@kernel(inline="always")
 def concentric_disk(u0, u1):
     """Shirley's concentric map of the unit square onto the unit disk."""
     a = 2.0 * u0 - 1.0
@@ -134,7 +136,7 @@ def concentric_disk(u0, u1):
     return r * math.cos(phi), r * math.sin(phi)
 
 
-@kernel
+@kernel(inline="always")
 def spread_factor(table, i, cos_l):
     mode = table[i, SPREAD_MODE]
     if mode == 0.0:
@@ -146,7 +148,7 @@ def spread_factor(table, i, cos_l):
     return max((table[i, SPREAD_TAN] - tan_a) * table[i, SPREAD_NORM], 0.0)
 
 
-@kernel
+@kernel(inline="always")
 def spot_factor(table, i, wx, wy, wz):
     """Cycles' spot cone along the emitted direction w: smoothstep over the blend, no cosine."""
     cos_a = wx * table[i, DX] + wy * table[i, DY] + wz * table[i, DZ]
@@ -161,7 +163,7 @@ def spot_factor(table, i, wx, wy, wz):
 
 
 # -- point and spot ---------------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def sample_point(table, i, px, py, pz, u0, u1):
     """Point or spot light: a delta (radius 0), Cycles' soft-falloff disk facing the point,
     or a sphere sampled uniformly over the cone it subtends."""
@@ -205,7 +207,7 @@ def sample_point(table, i, px, py, pz, u0, u1):
     return wx, wy, wz, dist, table[i, ER] * scale, table[i, EG] * scale, table[i, EB] * scale, pdf
 
 
-@kernel
+@kernel(inline="always")
 def pdf_point(table, i, ox, oy, oz, dx, dy, dz, t):
     cx, cy, cz = table[i, PX] - ox, table[i, PY] - oy, table[i, PZ] - oz
     d2 = cx * cx + cy * cy + cz * cz
@@ -217,7 +219,7 @@ def pdf_point(table, i, ox, oy, oz, dx, dy, dz, t):
     return 1.0 / (2.0 * math.pi * max(1.0 - cos_max, TINY))
 
 
-@kernel
+@kernel(inline="always")
 def hit_point(table, i, ox, oy, oz, dx, dy, dz):
     """A sphere, or with soft falloff the disk facing the ray origin that sampling uses."""
     cx, cy, cz = table[i, PX] - ox, table[i, PY] - oy, table[i, PZ] - oz
@@ -245,7 +247,7 @@ def hit_point(table, i, ox, oy, oz, dx, dy, dz):
 
 
 # -- sun ----------------------------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def sample_sun(table, i, u0, u1):
     """A delta direction (angle 0) or uniform over the cone of the sun's disk."""
     ax, ay, az = -table[i, DX], -table[i, DY], -table[i, DZ]
@@ -262,7 +264,7 @@ def sample_sun(table, i, u0, u1):
             table[i, ER] * scale, table[i, EG] * scale, table[i, EB] * scale, 1.0 / solid)
 
 
-@kernel
+@kernel(inline="always")
 def sun_seen(table, i, dx, dy, dz):
     """Radiance of a sun disk (angle > 0) seen along d, and the density of sampling d (0, 0
     outside the disk or for a delta sun)."""
@@ -273,7 +275,7 @@ def sun_seen(table, i, dx, dy, dz):
 
 
 # -- area shapes --------------------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def spherical_rectangle(table, i, ox, oy, oz):
     """The rectangle of light i seen from o, in its local frame (Urena et al. 2013):
     (x0, y0, x1, y1, z0, flip, b0, b1, k, solid angle). z0 >= 0 is the distance to the plane,
@@ -303,12 +305,12 @@ def spherical_rectangle(table, i, ox, oy, oz):
     return x0, y0, x1, y1, z0, flip, c0, c2, k, g0 + g1 - k
 
 
-@kernel
+@kernel(inline="always")
 def rectangle_usable(z0, solid):
     return solid > MIN_SOLID_ANGLE and abs(z0) > 0 and math.isfinite(solid)
 
 
-@kernel
+@kernel(inline="always")
 def sample_spherical_rectangle(x0, y0, x1, y1, z0, b0, b1, k, solid, u0, u1):
     """Local (x, y) on the rectangle for the 2D sample u, uniform in solid angle."""
     au = u0 * solid + k
@@ -327,7 +329,7 @@ def sample_spherical_rectangle(x0, y0, x1, y1, z0, b0, b1, k, solid, u0, u1):
     return xu, min(max(yv, y0), y1)
 
 
-@kernel
+@kernel(inline="always")
 def sample_area(table, i, px, py, pz, u0, u1):
     """Rectangles by solid angle (by area where it is too small), disks and ellipses by area."""
     sx, sy = table[i, SIZE_X], table[i, SIZE_Y]
@@ -363,7 +365,7 @@ def sample_area(table, i, px, py, pz, u0, u1):
     return wx, wy, wz, dist, table[i, ER] * scale, table[i, EG] * scale, table[i, EB] * scale, pdf
 
 
-@kernel
+@kernel(inline="always")
 def pdf_area(table, i, ox, oy, oz, dx, dy, dz, t):
     if table[i, KIND] == RECT:
         _, _, _, _, z0, _, _, _, _, solid = spherical_rectangle(table, i, ox, oy, oz)
@@ -373,7 +375,7 @@ def pdf_area(table, i, ox, oy, oz, dx, dy, dz, t):
     return t * t / (max(cos_l, TINY) * table[i, AREA])
 
 
-@kernel
+@kernel(inline="always")
 def hit_area(table, i, ox, oy, oz, dx, dy, dz):
     """The one-sided rectangle, disk or ellipse, seen from its emitting side."""
     ezx, ezy, ezz = table[i, EZX], table[i, EZY], table[i, EZZ]
@@ -393,7 +395,7 @@ def hit_area(table, i, ox, oy, oz, dx, dy, dz):
 
 
 # -- one contract for every kind ------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def sample_light(table, i, px, py, pz, u0, u1):
     """(wx, wy, wz, dist, value r, g, b, pdf): value is radiance over pdf (pdf inf: delta)."""
     kind = table[i, KIND]
@@ -404,7 +406,7 @@ def sample_light(table, i, px, py, pz, u0, u1):
     return sample_point(table, i, px, py, pz, u0, u1)
 
 
-@kernel
+@kernel(inline="always")
 def light_pdf(table, i, ox, oy, oz, dx, dy, dz, t):
     """Solid-angle density of ``sample_light`` picking d from o, the light's body at distance t."""
     kind = table[i, KIND]
@@ -415,7 +417,7 @@ def light_pdf(table, i, ox, oy, oz, dx, dy, dz, t):
     return pdf_point(table, i, ox, oy, oz, dx, dy, dz, t)
 
 
-@kernel
+@kernel(inline="always")
 def hit_light(table, i, ox, oy, oz, dx, dy, dz):
     """(t, radiance r, g, b) where the ray meets light i's body; t = inf when it misses."""
     kind = table[i, KIND]

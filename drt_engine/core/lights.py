@@ -326,13 +326,13 @@ class Lights:
 
 
 # -- emissive triangles ------------------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def pick_triangle(emissive, cdf, u):
     """An emissive triangle chosen by power (``cdf`` over the ``emissive`` triangles)."""
     return emissive[min(np.searchsorted(cdf, u, side="right"), len(emissive) - 1)]
 
 
-@kernel
+@kernel(inline="always")
 def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
     """A point uniform on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in
     solid angle including the chance ``prob[i]`` of picking the triangle, two-sided."""
@@ -383,7 +383,7 @@ def _pdf_emissive_batch(ng, area, prob, prim, dirs, t):
 
 
 # -- the world ------------------------------------------------------------------------------------
-@kernel
+@kernel(inline="always")
 def cosine_direction(nx, ny, nz, u0, u1):
     """A cosine-weighted direction about n (concentric disk lifted to the hemisphere)."""
     a, b = concentric_disk(u0, u1)
@@ -392,7 +392,7 @@ def cosine_direction(nx, ny, nz, u0, u1):
     return a * t0 + b * b0 + z * nx, a * t1 + b * b1 + z * ny, a * t2 + b * b2 + z * nz, z
 
 
-@kernel
+@kernel(inline="always")
 def world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area):
     """Density of world sampling: the map's share of its table density, the rest cosine."""
     cosine = max(nx * dx + ny * dy + nz * dz, 0.0) / math.pi
@@ -401,7 +401,7 @@ def world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area):
     return share * map_pdf(cell, cell_area, dx, dy, dz) + (1.0 - share) * cosine
 
 
-@kernel
+@kernel(inline="always")
 def sample_world_direction(nx, ny, nz, u0, u1, share, row_cdf, col_cdf, cell, cell_area):
     """(dx, dy, dz, pdf): from the map with probability ``share`` (the first sample coordinate
     split), else cosine-weighted about n."""
