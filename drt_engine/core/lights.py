@@ -234,7 +234,7 @@ class Lights:
         g = self.geometry
         wi, dist, value, pdf, pick, bary, q, cos_l = _sample_emissive_batch(
             g.world_vertices, g.triangles, g.world_ng, g.area, self.emissive, self.emissive_cdf,
-            self.emissive_prob, self.tri_emission, pos, u, u_pick)
+            self.emissive_prob, self.tri_emission, pos, u, np.ascontiguousarray(u_pick))
         if self.textured:  # emission from the shader program at the sampled points
             k = np.flatnonzero(self._textured_tri[pick] & (cos_l > 0))
             if len(k):
@@ -277,7 +277,8 @@ class Lights:
     def pdf(self, light_index, origins, dirs, t, time=None):
         """Solid-angle density with which light sampling picks dirs from origins, toward the
         light ``light_index`` (one index, or one per ray: the light each ray hit)."""
-        ids = np.ascontiguousarray(np.broadcast_to(np.asarray(light_index, np.int64), (len(origins),)))
+        ids = (np.full(len(origins), light_index, np.int64) if np.ndim(light_index) == 0
+               else np.ascontiguousarray(light_index, np.int64))
         t = np.asarray(t, np.float64)
         slots = self.light_slots if self.selecting else 0
         pdf = _pdf_batch(self.table, self.table, ids, slots, origins, dirs, t, origins)
