@@ -12,11 +12,14 @@ exact direction, so the table only shapes the density (any table is unbiased).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from .jit import kernel
 from .scene import World
 from .shadernodes import LUMINANCE, DirectionContext, Evaluator
-from .textures import Texture, equirect_direction, equirect_uv
+from .textures import Texture, equirect_direction
 
 MAX_WIDTH = 1024
 MIN_WIDTH = 64
@@ -45,13 +48,13 @@ class Environment:
             weight = np.broadcast_to(sin_t, (h, w)).copy()
             total = weight.sum()
         cell = (1.0 - UNIFORM_SHARE) * weight / total + UNIFORM_SHARE * sin_t / (sin_t.sum() * w)
-        self.cell = cell  # probability of each cell
+        self.cell = np.ascontiguousarray(cell)  # probability of each cell
         rows = cell.sum(axis=1)
         self.row_cdf = np.concatenate([[0.0], np.cumsum(rows)])
         self.row_cdf /= self.row_cdf[-1]
         cond = cell / np.maximum(rows[:, None], 1e-300)
         self.col_cdf = np.concatenate([np.zeros((h, 1)), np.cumsum(cond, axis=1)], axis=1)
-        self.col_cdf /= self.col_cdf[:, -1:]
+        self.col_cdf = np.ascontiguousarray(self.col_cdf / self.col_cdf[:, -1:])
         self.cell_area = (2 * np.pi / w) * (np.pi / h)  # in (phi, theta)
 
     def _cell_luminance(self, w, h, rows_per_chunk=64):
@@ -73,33 +76,66 @@ class Environment:
 
     def sample(self, u: np.ndarray):
         """Directions and their solid-angle densities for 2D samples u (N, 2)."""
-        row = np.clip(np.searchsorted(self.row_cdf, u[:, 0], side="right") - 1, 0, self.h - 1)
-        lo, hi = self.row_cdf[row], self.row_cdf[row + 1]
-        fv = np.clip((u[:, 0] - lo) / np.maximum(hi - lo, 1e-300), 0.0, 1.0)
-        col = np.clip(self._column(row, u[:, 1]), 0, self.w - 1)
-        clo = self.col_cdf[row, col]
-        chi = self.col_cdf[row, col + 1]
-        fu = np.clip((u[:, 1] - clo) / np.maximum(chi - clo, 1e-300), 0.0, 1.0)
-        uv = np.stack([(col + fu) / self.w, (row + fv) / self.h], axis=1)
-        dirs = equirect_direction(uv)
-        return dirs, self.pdf(dirs)
-
-    def _column(self, row: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Largest k with col_cdf[row, k] <= u, by bisection (rows are non-decreasing from 0):
-        the count of entries <= u, less one, without an (N, W) comparison per wave."""
-        lo = np.zeros(len(u), np.int64)
-        hi = np.full(len(u), self.w, np.int64)
-        while (lo < hi).any():
-            mid = (lo + hi + 1) >> 1
-            up = u >= self.col_cdf[row, mid]
-            lo = np.where(up, mid, lo)
-            hi = np.where(up, hi, mid - 1)
-        return lo
+        return _sample_batch(self.row_cdf, self.col_cdf, self.cell, self.cell_area, np.asarray(u, np.float64))
 
     def pdf(self, dirs: np.ndarray) -> np.ndarray:
-        uv = equirect_uv(dirs)
-        col = np.clip((uv[:, 0] * self.w).astype(np.int64), 0, self.w - 1)
-        row = np.clip((uv[:, 1] * self.h).astype(np.int64), 0, self.h - 1)
-        sin_t = np.maximum(np.hypot(dirs[:, 0], dirs[:, 1]) / np.maximum(np.linalg.norm(dirs, axis=1), 1e-300),
-                           1e-12)
-        return self.cell[row, col] / (self.cell_area * sin_t)
+        return _pdf_batch(self.cell, self.cell_area, np.asarray(dirs, np.float64))
+
+
+@kernel(inline="always")
+def direction_at(u, v):
+    """Scalar form of ``textures.equirect_direction``: the unit direction at (u, v)."""
+    phi = (0.5 - u) * 2 * math.pi
+    elevation = (v - 0.5) * math.pi
+    c = math.cos(elevation)
+    return c * math.cos(phi), c * math.sin(phi), math.sin(elevation)
+
+
+@kernel(inline="always")
+def map_direction(row_cdf, col_cdf, u0, u1):
+    """The direction the table gives the 2D sample u: a row by the marginal CDF, a column by
+    that row's conditional CDF, then uniform within the cell (in u, v)."""
+    h = len(row_cdf) - 1
+    w = col_cdf.shape[1] - 1
+    row = min(max(np.searchsorted(row_cdf, u0, side="right") - 1, 0), h - 1)
+    lo, hi = row_cdf[row], row_cdf[row + 1]
+    fv = min(max((u0 - lo) / max(hi - lo, 1e-300), 0.0), 1.0)
+    col = min(max(np.searchsorted(col_cdf[row], u1, side="right") - 1, 0), w - 1)
+    clo, chi = col_cdf[row, col], col_cdf[row, col + 1]
+    fu = min(max((u1 - clo) / max(chi - clo, 1e-300), 0.0), 1.0)
+    return direction_at((col + fu) / w, (row + fv) / h)
+
+
+@kernel(inline="always")
+def map_pdf(cell, cell_area, dx, dy, dz):
+    """Solid-angle density of ``map_direction`` at direction d: the cell's probability over its
+    solid angle (cell_area in (phi, theta) times sin theta); the cell from the scalar form of
+    ``textures.equirect_uv``."""
+    h, w = cell.shape
+    horizontal = math.sqrt(dx * dx + dy * dy)
+    u = -math.atan2(dy, dx) / (2 * math.pi) + 0.5
+    v = math.atan2(dz, horizontal) / math.pi + 0.5
+    col = min(max(int(u * w), 0), w - 1)
+    row = min(max(int(v * h), 0), h - 1)
+    sin_t = max(horizontal / max(math.sqrt(dx * dx + dy * dy + dz * dz), 1e-300), 1e-12)
+    return cell[row, col] / (cell_area * sin_t)
+
+
+@kernel
+def _sample_batch(row_cdf, col_cdf, cell, cell_area, u):
+    n = len(u)
+    dirs = np.empty((n, 3))
+    pdf = np.empty(n)
+    for j in range(n):
+        dx, dy, dz = map_direction(row_cdf, col_cdf, u[j, 0], u[j, 1])
+        dirs[j, 0], dirs[j, 1], dirs[j, 2] = dx, dy, dz
+        pdf[j] = map_pdf(cell, cell_area, dx, dy, dz)
+    return dirs, pdf
+
+
+@kernel
+def _pdf_batch(cell, cell_area, dirs):
+    pdf = np.empty(len(dirs))
+    for j in range(len(dirs)):
+        pdf[j] = map_pdf(cell, cell_area, dirs[j, 0], dirs[j, 1], dirs[j, 2])
+    return pdf

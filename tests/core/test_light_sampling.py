@@ -2,35 +2,50 @@
 import numpy as np
 import pytest
 
-from drt_engine.core.lights import _SphericalRectangle
+from drt_engine.core.light_kinds import light_table, spherical_rectangle
+from drt_engine.core.lights import _sample_batch
+from drt_engine.core.scene import Light
 
 RNG = np.random.default_rng(3)
-EX, EY, EZ = np.eye(3)
 
 
-def rectangle(origins, sx=2.0, sy=1.0, c=(0.3, -0.2, 1.0)):
-    return _SphericalRectangle(np.array(c, float), EX, EY, EZ, sx, sy, origins)
+def rectangle(sx=2.0, sy=1.0, c=(0.3, -0.2, 1.0)):
+    """A light table of one rectangle in the plane z = c_z, facing down (toward the origin)."""
+    m = np.eye(4)
+    m[:3, 3] = c
+    return light_table([Light("AREA", m, radiance=np.ones(3), size_x=sx, size_y=sy)])
+
+
+def solid_angle(table, origin):
+    return spherical_rectangle(table, 0, *origin)[9]
+
+
+def sample(table, origins, u):
+    """Points the light kernel samples on the rectangle, and their densities."""
+    wi, dist, _, pdf = _sample_batch(table, 0, origins, u)
+    return origins + wi * dist[:, None], pdf
 
 
 def test_solid_angle_of_a_square_on_axis():
     a, d = 0.5, 2.0
-    rect = rectangle(np.zeros((1, 3)), 2 * a, 2 * a, c=(0, 0, d))
-    assert rect.solid_angle[0] == pytest.approx(4 * np.arcsin(a * a / (a * a + d * d)), rel=1e-10)
+    table = rectangle(2 * a, 2 * a, c=(0, 0, d))
+    assert solid_angle(table, (0.0, 0.0, 0.0)) == pytest.approx(4 * np.arcsin(a * a / (a * a + d * d)), rel=1e-10)
 
 
 def test_samples_lie_on_the_rectangle_and_are_uniform_in_solid_angle():
     n = 200_000
     origin = np.array([[0.1, 0.2, 0.0]])
-    rect = rectangle(np.repeat(origin, n, 0))
-    q = rect.sample(RNG.random((n, 2)), np.arange(n))
+    table = rectangle()
+    q, pdf = sample(table, np.repeat(origin, n, 0), RNG.random((n, 2)))
     c = np.array([0.3, -0.2, 1.0])
+    total = solid_angle(table, origin[0])
+    assert np.allclose(pdf, 1.0 / total, rtol=1e-12)  # the density is the one of uniform solid angle
     assert np.allclose(q[:, 2], 1.0)
     assert (np.abs(q[:, 0] - c[0]) <= 1.0 + 1e-9).all() and (np.abs(q[:, 1] - c[1]) <= 0.5 + 1e-9).all()
     # the share of samples in the left half is that half's share of the solid angle
-    left = rectangle(origin, 1.0, 1.0, c=(c[0] - 0.5, c[1], c[2])).solid_angle[0]
-    total = rect.solid_angle[0]
+    left = solid_angle(rectangle(1.0, 1.0, c=(c[0] - 0.5, c[1], c[2])), origin[0])
     assert np.mean(q[:, 0] < c[0]) == pytest.approx(left / total, abs=0.005)
-    right = rectangle(origin, 1.0, 1.0, c=(c[0] + 0.5, c[1], c[2])).solid_angle[0]
+    right = solid_angle(rectangle(1.0, 1.0, c=(c[0] + 0.5, c[1], c[2])), origin[0])
     assert left + right == pytest.approx(total, rel=1e-9)
 
 
@@ -38,11 +53,10 @@ def test_solid_angle_sampling_is_less_noisy_than_area_sampling_near_a_large_ligh
     """Irradiance under a 4x4 light 0.3 above: per-sample variance of both estimators."""
     n = 20_000
     o = np.zeros((n, 3))
-    rect = _SphericalRectangle(np.array([0, 0, 0.3]), EX, EY, EZ, 4.0, 4.0, o)
     u = RNG.random((n, 2))
-    q = rect.sample(u, np.arange(n))
+    q, pdf = sample(rectangle(4.0, 4.0, c=(0, 0, 0.3)), o, u)
     wi = q / np.linalg.norm(q, axis=1, keepdims=True)
-    solid = wi[:, 2] * rect.solid_angle  # cos(theta) / pdf
+    solid = wi[:, 2] / pdf  # cos(theta) / pdf
     qa = np.stack([(u[:, 0] - 0.5) * 4, (u[:, 1] - 0.5) * 4, np.full(n, 0.3)], 1)
     d2 = (qa * qa).sum(1)
     area = (0.3 / np.sqrt(d2)) ** 2 / d2 * 16.0  # cos_i cos_l A / d²
