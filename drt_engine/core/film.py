@@ -109,8 +109,9 @@ class Film:
         self.lo = np.full((self.n, 3), np.inf) if track_range else None
         self.hi = np.full((self.n, 3), -np.inf) if track_range else None
 
-    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray):
-        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4).
+    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray, replicate=None):
+        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4);
+        ``replicate`` the samples' replicate (else ``self.replicate``; None: split by id).
 
         Sums run over the pixel range the wave touches (a wave of a large image covers a
         band of it), so the cost follows the wave, not the image.
@@ -126,7 +127,8 @@ class Film:
             v = values[name]
             for c in range(v.shape[1]):
                 total[span, c] += np.bincount(local, weights=v[:, c], minlength=m)
-        a = sample_is_class_a(sample) if self.replicate is None else np.full(len(pixel), self.replicate == 1)
+        replicate = self.replicate if replicate is None else replicate
+        a = sample_is_class_a(sample) if replicate is None else np.full(len(pixel), replicate == 1)
         la = local[a]
         self.count_a[span] += np.bincount(la, minlength=m)
         rgb = values["Combined"][a, :3]
