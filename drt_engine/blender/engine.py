@@ -14,12 +14,15 @@ import weakref
 import bpy
 import numpy as np
 
-from ..core import report
+from ..core import jit, report
 from ..core.errors import DRTError, RenderCancelled
 from .properties import enabled_passes, pass_layout, settings_from_scene
 
 DISPLAY_INTERVAL = 1.0
 """Seconds between refreshes of the image on screen while rendering."""
+
+COMPILING = "Compiling DRT kernels (first run only)"
+"""Status while the first render after an install compiles the kernels (later ones load them)."""
 
 PREVIEW_SAMPLES = 16
 PREVIEW_MAX_DEPTH = 4
@@ -160,7 +163,11 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         settings = settings_from_scene(scene, view_layer)
         if self.is_preview:
             settings = preview_settings(settings)
-        self.update_stats("", "Preparing the render")
+        if jit.first_run():
+            self.update_stats("", COMPILING)
+            print(f"DRT: {COMPILING}", flush=True)  # the console, and the CLI's output
+        else:
+            self.update_stats("", "Preparing the render")
         renderer = Renderer(scene_data, settings)
         if self.test_break():
             return
@@ -254,7 +261,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                    tuple(map(tuple, region_data.window_matrix)))
             if key != self._view_key:
                 camera = viewport_camera(region, region_data)
-                self._viewport.start(dataclasses.replace(self._view_scene, camera=camera), self._view_settings)
+                self._viewport.start(self._view_scene, camera, self._view_settings)
                 self._view_key = key
         if self._viewport is None:
             return

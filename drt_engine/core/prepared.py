@@ -16,7 +16,7 @@ from .errors import SceneError
 from .lights import Lights
 from .scene import SceneData
 from .shading import MaterialShading, SurfaceAttributes, load_textures
-from .validate import validate_scene
+from .validate import validate_content
 
 
 def geometry_center(scene: SceneData) -> np.ndarray:
@@ -53,7 +53,7 @@ class PreparedScene:
     """The camera-independent parts of a render of ``scene`` (see the module's docstring)."""
 
     def __init__(self, scene: SceneData):
-        validate_scene(scene)
+        validate_content(scene)
         self.scene = scene
         self.geometry = Geometry(scene, geometry_center(scene))
         for mesh in scene.meshes:

@@ -24,7 +24,7 @@ from .records import Samples
 from .sampling import Sampler
 from .scene import SceneData
 from .settings import RenderSettings
-from .validate import validate_scene
+from .validate import validate_camera
 
 __all__ = ["WAVE", "ProgressUpdate", "RenderResult", "Renderer", "PreparedScene"]
 
@@ -50,7 +50,7 @@ class Renderer:
     def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None):
         if scene.camera is None:
             raise SceneError("the scene has no camera")
-        validate_scene(scene)
+        validate_camera(scene.camera)
         if prepared is None:
             prepared = PreparedScene(scene)
         elif not prepared.serves(scene):

@@ -1,0 +1,58 @@
+"""A prepared scene serves renders with other cameras exactly as a scene prepared for each."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drt_engine.core import dims as D
+from drt_engine.core.prepared import PreparedScene, geometry_center
+from drt_engine.core.render import Renderer
+from drt_engine.core.scene import Camera, Light
+from drt_engine.core.settings import PASSES, RenderSettings
+from scenes import look_at, translation
+from test_determinism import scene
+
+
+def camera(eye):
+    return Camera(look_at(eye, (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (24, 24))
+
+
+def test_another_camera_on_a_prepared_scene_gives_the_image_of_a_fresh_render():
+    base = scene()
+    prepared = PreparedScene(base)
+    s = RenderSettings(samples=4, seed=2, threads=1, passes=PASSES)
+    for eye in ((0, -5, 2), (3, -4, 1.5), (-2, -3, 4)):
+        moved = dataclasses.replace(base, camera=camera(eye))
+        reused = Renderer(moved, s, prepared).render().passes
+        fresh = Renderer(moved, s).render().passes
+        for name in fresh:
+            assert np.array_equal(reused[name], fresh[name]), (eye, name)
+    assert Renderer(base, s, prepared).geometry is prepared.geometry
+
+
+def test_a_prepared_scene_refuses_another_scene():
+    with pytest.raises(ValueError):
+        Renderer(scene(), RenderSettings(samples=1), PreparedScene(scene()))
+
+
+def test_the_geometry_centre_follows_the_bulk_of_the_triangles_not_a_far_object():
+    base = scene()
+    far = dataclasses.replace(base.instances[1], matrices=translation(1e6, 0, 0)[None])
+    moved = dataclasses.replace(base, instances=[base.instances[0], far, base.instances[2]])
+    centre = geometry_center(moved)
+    assert np.abs(centre).max() < 1.0  # the floor and the other sphere outweigh the far one
+
+
+def test_adding_a_light_leaves_every_other_strategy_dimension_and_the_path_dimensions():
+    base = scene()
+    extra = Light("POINT", translation(0, 0, 3), intensity=np.full(3, 5.0), name="Extra")
+    one = D.LightDims(D.strategy_keys(PreparedScene(base).lights), 8)
+    more = dataclasses.replace(base, lights=[extra] + base.lights)
+    two = D.LightDims(D.strategy_keys(PreparedScene(more).lights), 8)
+    assert one.keys == two.keys[1:] and len(one.keys) == 2  # the area light and the world
+    for depth in range(9):
+        for k in range(len(one.keys)):
+            assert one.point(depth, k) == two.point(depth, k + 1) and one.choice(depth, k) == two.choice(depth, k + 1)
+        used = {two.point(depth, k) + i for k in range(3) for i in range(4)}
+        assert D.lobe(depth) < min(used) and len(used) == 12
+    assert D.lobe(8) + 2 < min(D.LightDims(["a"], 8).point(d, 0) for d in range(9))
