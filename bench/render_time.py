@@ -1,9 +1,9 @@
 """Render time of the sample scenes, whole and per module, for before/after comparisons of a change.
 
 ``python bench/render_time.py [--width 160] [--samples 16] [--threads 1] [--scenes ...] [--top 12]``:
-for each scene, the time to prepare the scene (export excluded), the render's wall time (best of
-``--repeat``) and, from one cProfile run of the render, the cumulative time of each core module's
-functions and the number of Python function calls.
+for each scene, the time to prepare the scene (core.prepared; export excluded), the render's
+wall time (best of ``--repeat``, reusing the prepared scene) and, from one cProfile run of the
+render, each core module's own time and the number of Python function calls.
 """
 from __future__ import annotations
 
@@ -18,9 +18,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "bench")]
 
 import drt_engine  # noqa: E402
+from drt_engine.core.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
-
 
 def by_module(stats: pstats.Stats) -> dict[str, float]:
     """Own (tottime) seconds per drt_engine.core module, the rest lumped as 'other'."""
@@ -45,11 +45,11 @@ def main(argv=None):
         scene, data = load(name, args.width)
         s = settings(scene, samples=args.samples, threads=args.threads, seed=7)
         start = time.perf_counter()
-        Renderer(data, s)
+        prepared = PreparedScene(data)
         prepare = time.perf_counter() - start
-        best = min(Renderer(data, s).render().stats["elapsed"] for _ in range(args.repeat))
+        best = min(Renderer(data, s, prepared).render().stats["elapsed"] for _ in range(args.repeat))
         profiler = cProfile.Profile()
-        renderer = Renderer(data, s)
+        renderer = Renderer(data, s, prepared)
         profiler.enable()
         renderer.render()
         profiler.disable()
