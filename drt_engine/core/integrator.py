@@ -163,7 +163,7 @@ class Integrator:
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
         self._count("camera", n)
         state = PathState(np.arange(n), cam.origins, cam.directions, cam.tmax, np.ones((n, 3)), np.full(n, np.inf),
-                          np.zeros((n, 3)), np.ones(n, bool), time)
+                          np.zeros((n, 3)), np.zeros((n, 3)), np.ones(n, bool), time)
         return state, cam
 
     # -- what rays see ----------------------------------------------------------------
@@ -204,7 +204,7 @@ class Integrator:
             smooth = np.flatnonzero(~np.isinf(rays.prev_pdf))
             if len(smooth) and lights.world is not None:
                 weight[smooth] = _power(rays.prev_pdf[smooth],
-                                        lights.pdf_world(rays.prev_normal[smooth], rays.dirs[smooth]))
+                                        lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
             out.radiance[rays.path] += rays.throughput * world * weight[:, None]
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
@@ -337,7 +337,8 @@ class Integrator:
         emissive = lights.light_slots if len(lights.emissive) else -1
         for k in range(lights.strategies):
             u_pick = u.choice[emissive] if emissive >= 0 else None
-            ls = lights.sample(k, hits.pos, hits.ng, u.point[k], u_pick, u.choice[k] if lights.selecting else None,
+            # the world is sampled around the shading normal, the one the BSDF's cosine follows
+            ls = lights.sample(k, hits.pos, hits.ns, u.point[k], u_pick, u.choice[k] if lights.selecting else None,
                                time)
             ok = mf.max3(ls.value) > 0
             if not ok.any():
@@ -395,8 +396,8 @@ class Integrator:
         self._count("transparent", passthrough.sum())
         n = len(sel)
         return PathState(hits.path[sel], origin, wi, np.full(n, np.inf), new_thr[sel],
-                         np.where(bs.delta[sel], np.inf, bs.pdf[sel]), hits.ng[sel], hits.straight[sel] & passthrough,
-                         hits.time[sel])
+                         np.where(bs.delta[sel], np.inf, bs.pdf[sel]), hits.ng[sel], hits.ns[sel],
+                         hits.straight[sel] & passthrough, hits.time[sel])
 
 
 TERMINATOR_CUTOFF = 0.1

@@ -47,8 +47,11 @@ class PathState:
     """Live paths of a wave at one depth, one row per path.
 
     ``path`` is the row of the camera sample in the wave; ``prev_pdf`` the solid-angle pdf of
-    the direction that brought the ray here (inf: camera ray or delta lobe); ``straight``
-    whether the camera sees through to here only through transparent surfaces."""
+    the direction that brought the ray here (inf: camera ray or delta lobe); ``prev_normal``
+    and ``prev_shading`` the geometric and shading normals of the surface it left (facing
+    where it came from; the first decides which world visibility applies, the second is the
+    one the world's light sampling is cosine-weighted around); ``straight`` whether the
+    camera sees through to here only through transparent surfaces."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -57,6 +60,7 @@ class PathState:
     throughput: np.ndarray
     prev_pdf: np.ndarray
     prev_normal: np.ndarray
+    prev_shading: np.ndarray
     straight: np.ndarray
     time: np.ndarray  # shutter time of each ray (zeros when nothing moves)
 
