@@ -50,11 +50,12 @@ class Renderer:
     def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None):
         if scene.camera is None:
             raise SceneError("the scene has no camera")
-        validate_camera(scene.camera)
         if prepared is None:
             prepared = PreparedScene(scene)
         elif not prepared.serves(scene):
             raise ValueError("the prepared scene was made for another scene")
+        else:
+            validate_camera(scene.camera)
         self.prepared = prepared
         self.scene, self.settings, self.camera = scene, settings, scene.camera
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)

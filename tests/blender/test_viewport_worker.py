@@ -9,6 +9,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
 from drt_engine.blender.viewport import ViewportRender  # noqa: E402
+from drt_engine.core.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
 from drt_engine.core.scene import Camera  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
@@ -32,7 +33,8 @@ def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
         viewport.start(base, camera, settings)
         images.append(finish(viewport))
         prepared.append(viewport._prepared[1])
-        expected = Renderer(dataclasses.replace(base, camera=camera), settings).render().passes["Combined"]
+        moved = dataclasses.replace(base, camera=camera)  # prepared anew around the first view's centre
+        expected = Renderer(moved, settings, PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes["Combined"]
         assert np.array_equal(images[-1], expected.astype(np.float32))
     assert prepared[0] is prepared[1]
     assert not np.array_equal(images[0], images[1])
