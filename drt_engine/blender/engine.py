@@ -52,6 +52,31 @@ engine's settings, stats and error log back to write ``<OUT stem>.drt.json``.
 """
 
 
+persistent: dict[str, tuple[str, object]] = {}
+"""With Blender's Persistent Data on (Render Properties > Performance, as for Cycles): per view
+layer, the content key (core.prepared.content_key) and prepared scene of its last final render,
+so the next frame reuses the Embree scenes, lights and materials when only the camera changed."""
+
+
+def prepared_for(scene_data, layer: str, keep: bool):
+    """(scene data, prepared scene or None) for a final render: the kept prepared scene when the
+    content is the same, else None (the Renderer prepares it), kept for the next frame if ``keep``."""
+    from ..core.prepared import PreparedScene, content_key
+
+    if not keep:
+        persistent.pop(layer, None)
+        return scene_data, None
+    key = content_key(scene_data)
+    kept = persistent.get(layer)
+    if key is not None and kept is not None and kept[0] == key:
+        return kept[1].adopt(scene_data), kept[1]
+    persistent.pop(layer, None)  # free the old one before building the next
+    prepared = PreparedScene(scene_data)
+    if key is not None:
+        persistent[layer] = (key, prepared)
+    return scene_data, prepared
+
+
 def write_passes(result, passes: dict) -> None:
     """Copy the core's (h, w, C) arrays, rows bottom-to-top like Blender's, into a render result."""
     layer_passes = result.layers[0].passes
@@ -168,7 +193,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             print(f"DRT: {COMPILING}", flush=True)  # the console, and the CLI's output
         else:
             self.update_stats("", "Preparing the render")
-        renderer = Renderer(scene_data, settings)
+        keep = not self.is_preview and scene.render.use_persistent_data
+        scene_data, prepared = prepared_for(scene_data, view_layer.name, keep)
+        renderer = Renderer(scene_data, settings, prepared)
         if self.test_break():
             return
 

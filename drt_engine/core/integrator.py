@@ -73,15 +73,16 @@ class WaveOutput:
 
 
 class Integrator:
-    """Traces waves of one camera over a prepared scene (core.prepared) with one settings."""
+    """Traces waves of one scene's camera over its prepared scene (core.prepared) with one settings."""
 
-    def __init__(self, prepared, camera, settings, plan):
+    def __init__(self, prepared, scene, settings, plan):
         self.prepared = prepared
         self.geometry, self.lights = prepared.geometry, prepared.lights
-        self.camera, self.settings, self.plan = camera, settings, plan
+        self.camera, self.settings, self.plan = scene.camera, settings, plan
+        self.film_transparent = scene.film_transparent
         self.timed = plan.time
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
-        self.pixel_spread = camera_rays.pixel_spread(camera)
+        self.pixel_spread = camera_rays.pixel_spread(self.camera)
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
@@ -182,7 +183,7 @@ class Integrator:
             contrib = contrib.copy()
             contrib[smooth] *= _power(rays.prev_pdf[smooth], pl)[:, None]
         out.radiance[rays.path] += rays.throughput * contrib
-        if self.prepared.scene.film_transparent:
+        if self.film_transparent:
             direct = rays.straight
             out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
 
@@ -195,7 +196,7 @@ class Integrator:
         world = lights.world_radiance(rays.dirs, st, rays.prev_normal)
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
-        if self.prepared.scene.film_transparent:
+        if self.film_transparent:
             out.alpha[rays.path[st]] -= rays.throughput[st].mean(axis=1)
             keep = np.flatnonzero(~st)
             rays, world = rays.take(keep), world[keep]

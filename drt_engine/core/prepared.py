@@ -14,6 +14,9 @@ a jump across 1e7 m, which deserves a scene prepared for it).
 """
 from __future__ import annotations
 
+import hashlib
+from dataclasses import fields, is_dataclass, replace
+
 import numpy as np
 
 from . import microfacet as mf
@@ -55,5 +58,49 @@ class PreparedScene:
     def serves(self, scene: SceneData) -> bool:
         """Whether ``scene`` is this prepared scene's with at most another camera."""
         mine = self.scene
-        return all(getattr(scene, name) is getattr(mine, name)
-                   for name in ("meshes", "instances", "materials", "lights", "world"))
+        return all(getattr(scene, name) is getattr(mine, name) for name in _PREPARED_FIELDS)
+
+    def adopt(self, scene: SceneData) -> SceneData:
+        """``scene`` (equal to this one's but for the camera, see ``content_key``) on this one's
+        parts, so a Renderer can use this prepared scene for it."""
+        return replace(scene, **{name: getattr(self.scene, name) for name in _PREPARED_FIELDS})
+
+
+_PREPARED_FIELDS = ("meshes", "instances", "materials", "lights", "world", "images")
+
+
+def content_key(scene: SceneData) -> str | None:
+    """A digest of everything a prepared scene is made from (not the camera, the film's
+    transparency or the warnings): two scenes with one key can share a prepared scene, as the
+    frames of an animation where only the camera moves do. None when the scene holds a value
+    the digest does not know how to read (then nothing is shared)."""
+    digest = hashlib.blake2b(digest_size=20)
+    try:
+        for name in _PREPARED_FIELDS:
+            _feed(digest, getattr(scene, name))
+    except TypeError:
+        return None
+    return digest.hexdigest()
+
+
+def _feed(digest, value) -> None:
+    if isinstance(value, np.ndarray):
+        digest.update(f"a{value.dtype.str}{value.shape}".encode())
+        digest.update(np.ascontiguousarray(value).tobytes())
+    elif is_dataclass(value):
+        digest.update(f"d{type(value).__name__}".encode())
+        for f in fields(value):
+            _feed(digest, getattr(value, f.name))
+    elif isinstance(value, (list, tuple)):
+        digest.update(f"l{len(value)}".encode())
+        for item in value:
+            _feed(digest, item)
+    elif isinstance(value, dict):
+        digest.update(f"m{len(value)}".encode())
+        for key in sorted(value, key=repr):
+            _feed(digest, key)
+            _feed(digest, value[key])
+    elif value is None or isinstance(value, (str, int, float, bool, np.generic)):
+        digest.update(f"v{type(value).__name__}{value!r};".encode())
+    else:
+        raise TypeError(f"no digest for {type(value).__name__}")

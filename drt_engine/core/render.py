@@ -63,7 +63,7 @@ class Renderer:
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
         self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
         self.timed = self.plan.time
-        self.integrator = Integrator(prepared, self.camera, settings, self.plan)
+        self.integrator = Integrator(prepared, scene, settings, self.plan)
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast)

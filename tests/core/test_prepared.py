@@ -1,4 +1,5 @@
 """A prepared scene serves renders with other cameras exactly as a scene prepared for each."""
+import copy
 import dataclasses
 
 import numpy as np
@@ -52,3 +53,30 @@ def test_adding_a_light_leaves_every_other_strategy_dimension_and_the_path_dimen
         used = {two.point(depth, k) + i for k in range(3) for i in range(4)}
         assert D.lobe(depth) < min(used) and len(used) == 12
     assert D.lobe(8) + 2 < min(D.LightDims(["a"], 8).point(d, 0) for d in range(9))
+
+
+def test_the_content_key_ignores_the_camera_and_sees_any_other_change():
+    from drt_engine.core.prepared import content_key
+
+    base = scene()
+    key = content_key(base)
+    assert key == content_key(copy.deepcopy(base)) == content_key(dataclasses.replace(base, camera=camera((1, -4, 2))))
+    moved = copy.deepcopy(base)
+    moved.meshes[1].vertices[0, 0] += 1e-6
+    recoloured = copy.deepcopy(base)
+    recoloured.materials[2].closures[0].color = np.array([0.9, 0.7, 0.31])
+    dimmer = copy.deepcopy(base)
+    dimmer.lights[0].radiance = np.full(3, 9.0)
+    keys = {content_key(s) for s in (moved, recoloured, dimmer)}
+    assert key not in keys and len(keys) == 3
+
+
+def test_an_adopted_scene_renders_on_the_prepared_parts():
+    base = scene()
+    prepared = PreparedScene(base)
+    later = copy.deepcopy(dataclasses.replace(base, camera=camera((1, -4, 2))))  # the next frame's export
+    adopted = prepared.adopt(later)
+    assert prepared.serves(adopted) and adopted.camera is later.camera
+    s = RenderSettings(samples=2, threads=1)
+    fresh = Renderer(later, s, PreparedScene(later, center=prepared.geometry.center)).render().passes["Combined"]
+    assert np.array_equal(Renderer(adopted, s, prepared).render().passes["Combined"], fresh)
