@@ -2,8 +2,8 @@
 
 Radiance does not change with scale when every length scales and light powers scale by s²
 (area lights keep their radiance, point lights' intensity goes with s²). The tracer
-re-centres geometry (on the bulk of its triangles, core.prepared) in float64 before handing
-float32 to Embree and rebuilds hit points in float64, so position does not matter either. With the same seed
+re-centres geometry on the camera in float64 before handing float32 to Embree and
+rebuilds hit points in float64, so position does not matter either. With the same seed
 every render draws the same random numbers: images may differ only where float error
 moves a silhouette across a sample.
 """
