@@ -23,7 +23,7 @@ from drt_engine.core.render import Renderer  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
 def by_module(stats: pstats.Stats) -> dict[str, float]:
-    """Own (tottime) seconds per drt_engine.core module, the rest lumped as 'other'."""
+    """Own (tottime) CPU seconds per drt_engine.core module, the rest lumped as 'other'."""
     out: dict[str, float] = {}
     for (path, _, _), (_, _, tottime, _, _) in stats.stats.items():
         name = Path(path).stem if "drt_engine/core" in path else "other (numpy, embree, ...)"
@@ -56,7 +56,7 @@ def main(argv=None):
         prepare = time.perf_counter() - start
         runs = [timed(Renderer(data, s, prepared).render) for _ in range(args.repeat)]
         best, cpu = min(runs)
-        profiler = cProfile.Profile()
+        profiler = cProfile.Profile(time.process_time)  # CPU seconds: a busy machine disturbs them less
         renderer = Renderer(data, s, prepared)
         profiler.enable()
         renderer.render()
@@ -67,7 +67,7 @@ def main(argv=None):
         print(f"{name} {w}x{h} {args.samples} spp threads={args.threads}: prepare {prepare:.2f} s, "
               f"render {best:.2f} s wall, {cpu:.2f} s CPU (best of {args.repeat}), {calls} Python calls (profiled run)")
         for module, seconds in sorted(by_module(stats).items(), key=lambda kv: -kv[1])[:args.top]:
-            print(f"    {module:28s} {seconds:6.2f} s own time")
+            print(f"    {module:28s} {seconds:6.2f} s own CPU time")
 
 
 if __name__ == "__main__":
