@@ -124,7 +124,7 @@ class Integrator:
                 # arrays are views, and per path nothing changes (groups keep their order)
                 rows = rows[np.argsort(self.geometry.material[hits.prim[rows]], kind="stable")]
             surf = self._surface(state, hits, rows, ray_times)
-            self._emission_seen(surf, state.take(rows), hits, out)
+            self._emission_seen(surf, state, hits, out)
             if depth == 0:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
@@ -229,7 +229,7 @@ class Integrator:
                            self.geometry.offset_scale(prim, pos), state.throughput[rows], state.straight[rows],
                            state.time[rows], ns)
 
-    def _emission_seen(self, surf: SurfaceHits, rays: PathState, hits, out: WaveOutput):
+    def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
         glows = self.prepared.glows
         glowing = np.flatnonzero(glows[surf.prim]) if len(glows) else np.zeros(0, np.int64)
@@ -239,10 +239,10 @@ class Integrator:
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit])
         weight = np.ones(len(glowing))
-        prev_pdf = rays.prev_pdf[glowing]
+        prev_pdf = state.prev_pdf[hit]
         smooth = np.flatnonzero(~np.isinf(prev_pdf))
         if len(smooth):
-            pl = self.lights.pdf_emissive(prim[smooth], rays.dirs[glowing[smooth]], hits.t[hit[smooth]])
+            pl = self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]], hits.t[hit[smooth]])
             weight[smooth] = _power(prev_pdf[smooth], pl)
         e = surf.throughput[glowing] * emission * weight[:, None]
         out.radiance[surf.path[glowing]] += e
