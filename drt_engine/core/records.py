@@ -10,20 +10,14 @@ import numpy as np
 
 
 def _take(record, rows):
-    out = {}
-    for f in fields(record):
-        value = getattr(record, f.name)
-        out[f.name] = value if value is None or np.isscalar(value) else value[rows]
-    return type(record)(**out)
+    """The record's rows ``rows`` (an index array, a mask or a slice), field by field."""
+    return type(record)(**{f.name: getattr(record, f.name)[rows] for f in fields(record)})
 
 
 def _concat(records: list):
-    first = records[0]
-    out = {}
-    for f in fields(first):
-        value = getattr(first, f.name)
-        out[f.name] = None if value is None else np.concatenate([getattr(r, f.name) for r in records])
-    return type(first)(**out)
+    """One record of the rows of ``records`` (of one type), in order."""
+    return type(records[0])(**{f.name: np.concatenate([getattr(r, f.name) for r in records])
+                               for f in fields(records[0])})
 
 
 @dataclass
