@@ -14,13 +14,16 @@ import weakref
 import bpy
 import numpy as np
 
-from ..core import report
+from ..core import jit, report
 from ..core.errors import DRTError, RenderCancelled
 from . import part_files
 from .properties import enabled_passes, pass_layout, settings_from_scene
 
 DISPLAY_INTERVAL = 1.0
 """Seconds between refreshes of the image on screen while rendering."""
+
+COMPILING = "Compiling DRT kernels (first run only)"
+"""Status while the first render after an install compiles the kernels (later ones load them)."""
 
 PREVIEW_SAMPLES = 16
 PREVIEW_MAX_DEPTH = 4
@@ -48,6 +51,31 @@ last_reports: dict[str, dict] = {}
 The CLI runs Blender's render operator in its own process; this is how it gets the
 engine's settings, stats and error log back to write ``<OUT stem>.drt.json``.
 """
+
+
+persistent: dict[str, tuple[str, object]] = {}
+"""With Blender's Persistent Data on (Render Properties > Performance, as for Cycles): per view
+layer, the content key (core.prepared.content_key) and prepared scene of its last final render,
+so the next frame reuses the Embree scenes, lights and materials when only the camera changed."""
+
+
+def prepared_for(scene_data, layer: str, keep: bool):
+    """(scene data, prepared scene or None) for a final render: the kept prepared scene when the
+    content is the same, else None (the Renderer prepares it), kept for the next frame if ``keep``."""
+    from ..core.prepared import PreparedScene, content_key
+
+    if not keep:
+        persistent.pop(layer, None)
+        return scene_data, None
+    key = content_key(scene_data)
+    kept = persistent.get(layer)
+    if key is not None and kept is not None and kept[0] == key:
+        return kept[1].adopt(scene_data), kept[1]
+    persistent.pop(layer, None)  # free the old one before building the next
+    prepared = PreparedScene(scene_data)
+    if key is not None:
+        persistent[layer] = (key, prepared)
+    return scene_data, prepared
 
 
 def write_passes(result, passes: dict) -> None:
@@ -163,8 +191,14 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         settings = settings_from_scene(scene, view_layer)
         if self.is_preview:
             settings = preview_settings(settings)
-        self.update_stats("", "Preparing the render")
-        renderer = Renderer(scene_data, settings)
+        if jit.first_run():
+            self.update_stats("", COMPILING)
+            print(f"DRT: {COMPILING}", flush=True)  # the console, and the CLI's output
+        else:
+            self.update_stats("", "Preparing the render")
+        keep = not self.is_preview and scene.render.use_persistent_data
+        scene_data, prepared = prepared_for(scene_data, view_layer.name, keep)
+        renderer = Renderer(scene_data, settings, prepared)
         if self.test_break():
             return
 
@@ -259,7 +293,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                    tuple(map(tuple, region_data.window_matrix)))
             if key != self._view_key:
                 camera = viewport_camera(region, region_data)
-                self._viewport.start(dataclasses.replace(self._view_scene, camera=camera), self._view_settings)
+                self._viewport.start(self._view_scene, camera, self._view_settings)
                 self._view_key = key
         if self._viewport is None:
             return

@@ -2,15 +2,17 @@
 
 Blender calls the engine's ``view_update`` and ``view_draw`` on its main thread, which
 must never wait for the tracer. The scene is exported there (reading Blender data is
-only safe on the main thread), then a worker thread builds the ``Renderer`` and traces,
-publishing the image after every round of samples; ``view_draw`` only uploads the
-newest image and draws it. A new scene or a new view stops the running worker (it
-notices at its next progress call) and starts another one. The worker never holds the
+only safe on the main thread), then a worker thread prepares it (core.prepared: Embree
+scenes, lights, materials) and traces, publishing the image after every round of samples;
+``view_draw`` only uploads the newest image and draws it. A new scene or a new view stops
+the running worker (it notices at its next progress call) and starts another one; a new
+view of the same scene (orbit, zoom) reuses its prepared scene, only a new scene prepares again. The worker never holds the
 engine: it asks for redraws through a weak reference, so Blender can free the engine
 whenever it wants, and a ``weakref.finalize`` on the engine stops the worker first.
 """
 from __future__ import annotations
 
+import dataclasses
 import threading
 import traceback
 import weakref
@@ -39,13 +41,15 @@ class ViewportRender:
         """(h, w, 4) float32 RGBA, rows bottom-to-top, or None before the first round."""
         self.version = 0
         self.status = ""
+        self._prepared = None  # (SceneData, PreparedScene) of the newest scene prepared
+        self._prepare_lock = threading.Lock()
 
-    def start(self, scene_data, settings) -> None:
-        """Stop the running worker (without waiting for it) and render ``scene_data``."""
+    def start(self, scene_data, camera, settings) -> None:
+        """Stop the running worker (without waiting for it) and render ``scene_data`` seen by ``camera``."""
         self._stop.set()
         stop = threading.Event()
         self._stop = stop
-        self._thread = threading.Thread(target=self._run, args=(scene_data, settings, stop),
+        self._thread = threading.Thread(target=self._run, args=(scene_data, camera, settings, stop),
                                         name="DRT viewport", daemon=True)
         self._thread.start()
 
@@ -68,12 +72,25 @@ class ViewportRender:
             self.status = status
         self._redraw()
 
-    def _run(self, scene_data, settings, stop: threading.Event) -> None:
+    def prepared(self, scene_data):
+        """The prepared scene of ``scene_data``: the one made for it before, else a new one
+        (under a lock: a stale worker and a new one never prepare the same scene twice)."""
+        from ..core.prepared import PreparedScene
+
+        with self._prepare_lock:
+            if self._prepared is None or self._prepared[0] is not scene_data:
+                self._prepared = (scene_data, PreparedScene(scene_data))
+            return self._prepared[1]
+
+    def _run(self, scene_data, camera, settings, stop: threading.Event) -> None:
         from ..core.render import Renderer
         from .engine import done_line, stats_line
 
         try:
-            renderer = Renderer(scene_data, settings)
+            prepared = self.prepared(scene_data)
+            if stop.is_set():
+                return
+            renderer = Renderer(dataclasses.replace(scene_data, camera=camera), settings, prepared)
             if stop.is_set():  # the view changed while the scene was being prepared
                 return
 

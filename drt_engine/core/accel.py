@@ -28,6 +28,7 @@ from .motion import Motion, inverse3
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
+_EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates hit points are rebuilt in
 _CHUNK = 1 << 16  # rays per Embree call: bounds its output buffers
 _FAR = np.float32(3.0e38)
 DEFORM_BUCKETS = 8
@@ -194,7 +195,9 @@ class Geometry:
         self.world_ng = self._mid_world_normals(n_world / np.maximum(world_len, 1e-300)[:, None])
         self.ns = self._shading_normals(normals)
         rel = self.world_vertices[self.triangles] - self.center
-        self.tri_scale = np.abs(rel).max(axis=(1, 2)) if len(rel) else np.zeros(0)
+        # the offset also clears the float64 rounding of world positions far from the origin
+        world = np.abs(self.world_vertices[self.triangles]).max(axis=(1, 2)) * _EPS_ABS if len(rel) else 0.0
+        self.tri_scale = np.maximum(np.abs(rel).max(axis=(1, 2)), world) if len(rel) else np.zeros(0)
         for part in self.parts:
             self._build(part)
 

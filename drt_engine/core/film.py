@@ -105,12 +105,12 @@ class Film:
                      for name in passes if name not in ("Sample Count", "Noise")}
         self.count_a = np.zeros(self.n)
         self.sum_a = np.zeros((self.n, 3))
-        self.replicate: int | None = None  # replicate of the samples being added; None: split by id
         self.lo = np.full((self.n, 3), np.inf) if track_range else None
         self.hi = np.full((self.n, 3), -np.inf) if track_range else None
 
-    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray):
-        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4).
+    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray, replicate=None):
+        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4);
+        ``replicate`` the samples' replicate (0 or 1), or None to split them by id.
 
         Sums run over the pixel range the wave touches (a wave of a large image covers a
         band of it), so the cost follows the wave, not the image.
@@ -126,7 +126,7 @@ class Film:
             v = values[name]
             for c in range(v.shape[1]):
                 total[span, c] += np.bincount(local, weights=v[:, c], minlength=m)
-        a = sample_is_class_a(sample) if self.replicate is None else np.full(len(pixel), self.replicate == 1)
+        a = sample_is_class_a(sample) if replicate is None else np.full(len(pixel), replicate == 1)
         la = local[a]
         self.count_a[span] += np.bincount(la, minlength=m)
         rgb = values["Combined"][a, :3]

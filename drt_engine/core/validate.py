@@ -25,12 +25,20 @@ def _finite(value) -> bool:
 
 def validate_scene(scene: SceneData) -> None:
     """Raise SceneError naming the first non-finite camera, light, world or material value."""
-    cam = scene.camera
+    validate_camera(scene.camera)
+    validate_content(scene)
+
+
+def validate_camera(cam) -> None:
     if not _finite(cam.matrices):
         raise SceneError("The camera has a location or rotation that is not a finite number")
     for name in ("frame", "clip_start", "clip_end", "aperture_radius", "focus_distance", "aperture_ratio"):
         if not _finite(getattr(cam, name)):
             raise SceneError(f"The camera's {name.replace('_', ' ')} is not a finite number")
+
+
+def validate_content(scene: SceneData) -> None:
+    """The scene's lights, world and materials (what a prepared scene holds, whatever the camera)."""
     for light in scene.lights:
         matrices = light.matrix if light.matrices is None else light.matrices
         if not _finite(matrices):

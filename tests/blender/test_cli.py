@@ -5,6 +5,7 @@ one line on stderr (Blender's own chatter goes to stdout).
 """
 import hashlib
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -17,10 +18,10 @@ ROOT = Path(__file__).resolve().parents[2]
 STRENGTH = 0.5
 
 
-def run_cli(*args, timeout=120):
+def run_cli(*args, timeout=120, env=None):
     return subprocess.run(
         [sys.executable, "-m", "drt_engine", *map(str, args)],
-        cwd=ROOT, capture_output=True, text=True, timeout=timeout,
+        cwd=ROOT, capture_output=True, text=True, timeout=timeout, env=env,
     )
 
 
@@ -84,6 +85,17 @@ def test_render_to_png_through_the_view_transform(bl, blend, tmp_path):
     assert rgb.shape == (12, 16, 3)
     srgb = 1.055 * STRENGTH ** (1 / 2.4) - 0.055  # Standard view: the sRGB curve, 0.5 -> 0.735
     np.testing.assert_allclose(rgb, srgb, atol=2 / 255)
+
+
+def test_the_first_render_of_an_install_says_it_compiles_the_kernels(blend, tmp_path):
+    """With an empty kernel cache the output names the wait once; the next render loads the cache."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "kernels"))
+    message = "DRT: Compiling DRT kernels (first run only)"
+    first = run_cli("render", blend, "-o", tmp_path / "a.png", env=env)
+    assert first.returncode == 0 and first.stderr == "", first.stdout[-2000:] + first.stderr
+    assert first.stdout.count(message) == 1
+    second = run_cli("render", blend, "-o", tmp_path / "b.png", env=env)
+    assert second.returncode == 0 and message not in second.stdout
 
 
 def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):

@@ -39,6 +39,32 @@ def test_render_operator_gives_the_emitted_radiance(bl, tmp_path):
     np.testing.assert_allclose(combined[..., 3], 1.0, rtol=1e-5)
 
 
+def test_persistent_data_reuses_the_prepared_scene_while_only_the_camera_moves(bl, tmp_path):
+    """Frames of an animation whose camera alone moves share one prepared scene (Persistent
+    Data on, as in Cycles); a changed material prepares anew; Persistent Data off keeps nothing."""
+    scene = bl.emission_scene(strength=STRENGTH)
+    scene.render.use_persistent_data = True
+    camera = scene.camera
+    for frame, x in ((1, 0.0), (2, 0.1)):
+        camera.location = (x, 0.0, bl.camera_height)
+        camera.keyframe_insert("location", frame=frame)
+    prepared = []
+    for frame in (1, 2):
+        scene.frame_set(frame)
+        combined = bl.pass_pixels(bl.render_exr(scene, tmp_path / f"f{frame}.exr"), LAYER, "Combined")
+        np.testing.assert_allclose(combined[..., :3], STRENGTH, rtol=1e-4)
+        prepared.append(engine_module.persistent[LAYER][1])
+    assert prepared[0] is prepared[1]
+    emitter = bpy.data.objects["Emitter"].active_material
+    emitter.node_tree.nodes["Emission"].inputs["Strength"].default_value = 3.0
+    combined = bl.pass_pixels(bl.render_exr(scene, tmp_path / "brighter.exr"), LAYER, "Combined")
+    np.testing.assert_allclose(combined[..., :3], 3.0, rtol=1e-4)
+    assert engine_module.persistent[LAYER][1] is not prepared[0]
+    scene.render.use_persistent_data = False
+    bl.render_exr(scene, tmp_path / "off.exr")
+    assert LAYER not in engine_module.persistent
+
+
 def test_enabled_passes_are_written_and_disabled_ones_are_not(bl, tmp_path):
     scene = bl.emission_scene(strength=STRENGTH)
     view_layer = scene.view_layers[LAYER]

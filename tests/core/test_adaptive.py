@@ -200,10 +200,8 @@ def test_film_error_of_independent_halves_is_unbiased():
     n = 16
     pixel = np.repeat(np.arange(2000), n)
     values = rng.normal(1.0, 0.2, (len(pixel), 4))
-    film.replicate = 0
-    film.add(pixel[::2], {"Combined": values[::2]}, np.zeros(len(pixel) // 2, np.uint32))
-    film.replicate = 1
-    film.add(pixel[1::2], {"Combined": values[1::2]}, np.zeros(len(pixel) // 2, np.uint32))
+    film.add(pixel[::2], {"Combined": values[::2]}, np.zeros(len(pixel) // 2, np.uint32), replicate=0)
+    film.add(pixel[1::2], {"Combined": values[1::2]}, np.zeros(len(pixel) // 2, np.uint32), replicate=1)
     assert film.variance().mean() == pytest.approx(0.04 / n, rel=0.08)
 
 

@@ -69,3 +69,26 @@ def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
     for name in images[0]:
         assert np.array_equal(images[0][name], images[1][name]), name
         assert np.isfinite(images[0][name]).all(), name
+
+
+def test_two_renders_at_once_in_one_process_match_renders_alone():
+    """Two renderers in two Python threads (a viewport render during F12), each with two
+    threads of its own: neither crashes nor waits on the other, and each image is the one it
+    gives alone."""
+    import threading
+
+    alone = [render(2, seed=seed) for seed in (0, 1)]
+    together = [None, None]
+
+    def run(i):
+        together[i] = render(2, seed=i)
+
+    workers = [threading.Thread(target=run, args=(i,)) for i in (0, 1)]
+    for t in workers:
+        t.start()
+    for t in workers:
+        t.join(timeout=300)
+    assert not any(t.is_alive() for t in workers), "a render did not finish: deadlock"
+    for a, b in zip(alone, together):
+        for name in a:
+            assert np.array_equal(a[name], b[name]), name

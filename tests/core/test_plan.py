@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 
 from drt_engine.core import bsdf
-from drt_engine.core.render import Renderer, _Dims
+from drt_engine.core import dims as D
+from drt_engine.core.records import Samples
+from drt_engine.core.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
 from scenes import look_at, plane, top_camera, translation, uv_sphere
@@ -98,9 +100,9 @@ class Recording:
 
 def dims_drawn(scene):
     r = Renderer(scene, RenderSettings(samples=2, threads=1))
-    r.sampler = Recording(r.sampler)
-    r._trace(np.arange(16), np.zeros(16, np.int64), 0, 0, 4)
-    return r, r.sampler.dims
+    sampler = Recording(r.sampler)
+    r.integrator.trace(Samples(np.arange(16), np.arange(16, dtype=np.uint32), np.zeros(16, np.int64)), sampler)
+    return r, sampler.dims
 
 
 def test_no_lens_dimension_at_aperture_zero():
@@ -108,19 +110,19 @@ def test_no_lens_dimension_at_aperture_zero():
     blurred = Camera(look_at((0, -3, 2), (0, 0, 0))[None], (-0.3, 0.3, -0.3, 0.3), (4, 4), aperture_radius=0.1,
                      focus_distance=3.0)
     r, dims = dims_drawn(floor_scene(lights=[point(0, 0, 3)], camera=sharp))
-    assert not r.plan.lens and _Dims.LENS not in dims and _Dims.LENS + 1 not in dims
+    assert not r.plan.lens and D.LENS not in dims and D.LENS + 1 not in dims
     r, dims = dims_drawn(floor_scene(lights=[point(0, 0, 3)], camera=blurred))
-    assert r.plan.lens and _Dims.LENS in dims
+    assert r.plan.lens and D.LENS in dims
 
 
 def test_no_time_dimension_when_nothing_moves():
     r, dims = dims_drawn(floor_scene((DIFFUSE, DIFFUSE), [point(0, 0, 3)], ball=np.eye(4)))
-    assert not r.plan.time and _Dims.TIME not in dims and r.plan.moving == []
+    assert not r.plan.time and D.TIME not in dims and r.plan.moving == []
     moving = np.stack([translation(-0.3, 0, 0), translation(0.3, 0, 0)])
     scene = floor_scene((DIFFUSE, DIFFUSE), [point(0, 0, 3)], ball=moving)
     scene.instances[1].name = "Ball"
     r, dims = dims_drawn(scene)
-    assert r.plan.time and _Dims.TIME in dims and r.plan.moving == ["Ball"]
+    assert r.plan.time and D.TIME in dims and r.plan.moving == ["Ball"]
 
 
 @pytest.mark.parametrize("name", ["DiffCol", "GlossCol"])

@@ -1,18 +1,18 @@
 """Waves: bounded in size, every requested (pixel, sample) exactly once, sample-major order."""
 import numpy as np
 
-from drt_engine.core import render
+from drt_engine.core import driver
 
 
 def test_waves_are_bounded_complete_and_sample_major(monkeypatch):
-    monkeypatch.setattr(render, "WAVE", 7)
+    monkeypatch.setattr(driver, "WAVE", 7)
     rng = np.random.default_rng(3)
     for _ in range(40):
         n = int(rng.integers(0, 30))
         pix = np.sort(rng.choice(100, n, replace=False)).astype(np.int64)
         base = rng.integers(0, 5, n).astype(np.int64)
         need = rng.integers(1, 6, n).astype(np.int64)
-        waves = list(render._waves(pix, base, need))
+        waves = list(driver._waves(pix, base, need))
         assert all(0 < len(p) <= 7 for p, _ in waves)
         assert all(len(p) == 7 for p, _ in waves[:-1])  # only the last wave is short
         p = np.concatenate([w[0] for w in waves]) if waves else np.zeros(0, np.int64)

@@ -1,0 +1,125 @@
+"""Named records of arrays that flow between the integrator's stages (pbrt-v4's work items,
+Mitsuba 3's loop state): one field per quantity, one row per ray, instead of long positional
+argument lists and tuples. A stage takes records and returns new ones; ``take`` gathers rows
+(a slice gives views, so a material's hits cost nothing to cut out)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+
+def _take(record, rows):
+    """The record's rows ``rows`` (an index array, a mask or a slice), field by field."""
+    return type(record)(**{f.name: getattr(record, f.name)[rows] for f in fields(record)})
+
+
+def _concat(records: list):
+    """One record of the rows of ``records`` (of one type), in order."""
+    return type(records[0])(**{f.name: np.concatenate([getattr(r, f.name) for r in records])
+                               for f in fields(records[0])})
+
+
+@dataclass
+class Samples:
+    """Which camera samples a wave traces: ``index`` the film pixel (window), ``pixel`` the
+    pixel's id in the whole image (seeds its numbers whatever the window), ``sample`` the
+    sample id in the sampler's sequence."""
+
+    index: np.ndarray
+    pixel: np.ndarray
+    sample: np.ndarray
+
+    def __len__(self):
+        return len(self.index)
+
+    take = _take
+
+
+@dataclass
+class PathState:
+    """Live paths of a wave at one depth, one row per path.
+
+    ``path`` is the row of the camera sample in the wave; ``prev_pdf`` the solid-angle pdf of
+    the direction that brought the ray here (inf: camera ray or delta lobe); ``prev_normal``
+    and ``prev_shading`` the geometric and shading normals of the surface it left (facing
+    where it came from; the first decides which world visibility applies, the second is the
+    one the world's light sampling is cosine-weighted around); ``straight`` whether the
+    camera sees through to here only through transparent surfaces."""
+
+    path: np.ndarray
+    origins: np.ndarray
+    dirs: np.ndarray
+    tmax: np.ndarray
+    throughput: np.ndarray
+    prev_pdf: np.ndarray
+    prev_normal: np.ndarray
+    prev_shading: np.ndarray
+    straight: np.ndarray
+    time: np.ndarray  # shutter time of each ray (zeros when nothing moves)
+
+    def __len__(self):
+        return len(self.path)
+
+    take = _take
+    concat = staticmethod(_concat)
+
+
+@dataclass
+class SurfaceHits:
+    """Rays that hit a surface, in shading order: the frame faces the incoming ray
+    (``inside``: it came from the back), ``wo_l`` is the outgoing direction in that frame,
+    ``scale`` the offset that clears the surface, ``row`` the hit's row in its depth's
+    intersection results, ``normal`` the mesh's shading normal as interpolated (the Normal pass)."""
+
+    path: np.ndarray
+    row: np.ndarray
+    prim: np.ndarray
+    mat: np.ndarray
+    pos: np.ndarray
+    ng: np.ndarray
+    ns: np.ndarray
+    tangent: np.ndarray
+    bitangent: np.ndarray
+    wo: np.ndarray
+    wo_l: np.ndarray
+    inside: np.ndarray
+    scale: np.ndarray
+    throughput: np.ndarray
+    straight: np.ndarray
+    time: np.ndarray
+    normal: np.ndarray
+
+    def __len__(self):
+        return len(self.path)
+
+    take = _take
+
+
+@dataclass
+class BsdfSample:
+    """A direction sampled from a hit's lobes: local and world direction, the throughput
+    it leaves, its pdf (inf for a delta lobe) and whether it passed straight through."""
+
+    wi_l: np.ndarray
+    weight: np.ndarray
+    pdf: np.ndarray
+    delta: np.ndarray
+    valid: np.ndarray
+    passthrough: np.ndarray
+
+
+@dataclass
+class ShadowRays:
+    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked."""
+
+    path: np.ndarray
+    origins: np.ndarray
+    dirs: np.ndarray
+    tmax: np.ndarray
+    contrib: np.ndarray
+
+    def __len__(self):
+        return len(self.path)
+
+    concat = staticmethod(_concat)

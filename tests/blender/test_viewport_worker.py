@@ -1,0 +1,44 @@
+"""The viewport's worker: a new view of the same scene reuses its prepared scene, a new scene
+prepares again, and each view renders what a render of that camera gives."""
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
+
+from drt_engine.blender.viewport import ViewportRender  # noqa: E402
+from drt_engine.core.prepared import PreparedScene  # noqa: E402
+from drt_engine.core.render import Renderer  # noqa: E402
+from drt_engine.core.scene import Camera  # noqa: E402
+from drt_engine.core.settings import RenderSettings  # noqa: E402
+from scenes import look_at  # noqa: E402
+from test_determinism import scene  # noqa: E402
+
+
+def finish(viewport):
+    viewport._thread.join(timeout=120)
+    assert not viewport._thread.is_alive()
+    return viewport.latest()[1]
+
+
+def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
+    viewport = ViewportRender(lambda: None)
+    base = scene()
+    settings = RenderSettings(samples=2, threads=1)
+    images, prepared = [], []
+    for eye in ((0, -5, 2), (3, -4, 1.5)):
+        camera = Camera(look_at(eye, (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (24, 24))
+        viewport.start(base, camera, settings)
+        images.append(finish(viewport))
+        prepared.append(viewport._prepared[1])
+        moved = dataclasses.replace(base, camera=camera)  # prepared anew around the first view's centre
+        expected = Renderer(moved, settings, PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes["Combined"]
+        assert np.array_equal(images[-1], expected.astype(np.float32))
+    assert prepared[0] is prepared[1]
+    assert not np.array_equal(images[0], images[1])
+    other = scene()
+    viewport.start(other, other.camera, settings)
+    finish(viewport)
+    assert viewport._prepared[1] is not prepared[0]
