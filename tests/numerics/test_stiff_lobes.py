@@ -32,7 +32,9 @@ def brightness(kind, roughness, angle, samples=16, determinism=False):
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("angle", ANGLES)
 def test_finite_and_continuous_across_the_delta_threshold(kind, angle):
-    values = {r: brightness(kind, r, angle) for r in ROUGHNESS}
+    # 256 samples: at roughness 1 the plane converges to 1.095, 0.4% under the bound, and 16
+    # samples spread its mean by about 0.008 from seed to seed (3 to 5 of 16 seeds over the bound)
+    values = {r: brightness(kind, r, angle, samples=256) for r in ROUGHNESS}
     assert all(np.isfinite(v) and v >= 0 for v in values.values()), values
     below, above = values[0.0099], values[0.01]
     assert abs(below - above) <= 0.012 * above, values
