@@ -169,7 +169,7 @@ class Renderer:
         n_pix = w * h
         cap = self.sampler.samples
         threshold = adaptive.effective_threshold(s.adaptive_threshold, cap)
-        first = adaptive.first_test(adaptive.min_samples(threshold, s.adaptive_min_samples))
+        first = adaptive.first_test(adaptive.min_samples(s.adaptive_min_samples, cap))
         points = adaptive.checkpoints(cap, first if s.use_adaptive_sampling else cap)
         replicas = adaptive.replicate_samplers(s.sampling_pattern, cap, s.seed)
         main_sampler = self.sampler

@@ -139,7 +139,8 @@ def plot_loglog(path, curves, title: str, xlabel: str = "time (s)", ylabel: str 
     import OpenImageIO as oiio
 
     width, height = size
-    left, right, top, bottom = 70, 150, 30, 45
+    longest = max((len(label) for label, _ in curves), default=0)
+    left, right, top, bottom = 70, max(150, 36 + 7 * longest), 30, 45  # the legend's longest label fits
     buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 3, "float"))
     oiio.ImageBufAlgo.fill(buf, (1.0, 1.0, 1.0))
     points = [p for _, pts in curves for p in pts if p[0] > 0 and p[1] > 0]

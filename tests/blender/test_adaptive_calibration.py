@@ -1,9 +1,10 @@
 """The estimated error of a render tracks its true error, on every sample scene.
 
-At every logged step, the estimated RMSE of the image (``adaptive.image_error``, from
-the film's two independent replicates) is within a factor of 1.5 of the true RMSE
-against a reference of 1024 samples with another seed, less the reference's own
-estimated variance. Both are pooled over four seeds: at 32 pixels wide the error of
+At every logged step, the estimated RMSE and relMSE of the image (``adaptive.image_error``,
+from the film's two independent replicates) are each within a factor of 1.5 of the true ones
+against a reference of 1024 samples with another seed, less the reference's own estimated
+variance. Both are pooled over four seeds (RMSE as the root of the mean square, relMSE as
+the mean): at 32 pixels wide the error of
 glossy_spheres sits in the handful of pixels that hold the gold sphere's highlight, so
 one render's true error is itself a sum of a few squares (one seed alone ranged from
 0.5 to 1.9 times its estimate). Adaptive renders are compared step by step (the k-th
@@ -45,9 +46,10 @@ def scene(request, drt):
     return request.param, data, base, truth
 
 
-def pooled_steps(scene, **settings) -> list[tuple[int, float, float]]:
-    """(most samples a pixel holds, least over the seeds; estimated RMSE; true RMSE), mean squares
-    over the seeds, at every step (the k-th logged of each render) all seeds logged."""
+def pooled_steps(scene, **settings) -> list[tuple]:
+    """(most samples a pixel holds, least over the seeds; estimated RMSE; true RMSE; estimated relMSE;
+    true relMSE), means of the squared errors over the seeds, at every step (the k-th logged of each
+    render) all seeds logged."""
     _, data, base, truth = scene
     per_seed = []
     for seed in SEEDS:
@@ -55,21 +57,23 @@ def pooled_steps(scene, **settings) -> list[tuple[int, float, float]]:
 
         def progress(update):
             if update.entry is not None:
-                rmse, _ = true_error(update.passes()["Combined"][..., :3], *truth)
-                steps[len(steps)] = (update.entry["spp_max"], update.entry["rmse"] ** 2, rmse ** 2)
+                rmse, relmse = true_error(update.passes()["Combined"][..., :3], *truth)
+                e = update.entry
+                steps[len(steps)] = (e["spp_max"], e["rmse"] ** 2, rmse ** 2, e["relmse"], relmse)
             return True
 
         Renderer(data, RenderSettings(samples=CAP, seed=seed, **base, **settings)).render(progress=progress)
         per_seed.append(steps)
     common = sorted(set.intersection(*(set(s) for s in per_seed)))
-    return [(min(s[k][0] for s in per_seed), *(np.sqrt(np.mean([s[k][c] for s in per_seed])) for c in (1, 2)))
-            for k in common]
+    return [(min(s[k][0] for s in per_seed), *(np.sqrt(np.mean([s[k][c] for s in per_seed])) for c in (1, 2)),
+             *(np.mean([s[k][c] for s in per_seed]) for c in (3, 4))) for k in common]
 
 
 def assert_tracks(name, steps):
-    for spp, estimated, true in steps:
-        assert np.isfinite(estimated), (name, spp)
-        assert 1 / FACTOR < estimated / true < FACTOR, (name, spp, estimated, true)
+    for spp, *errors in steps:
+        for kind, estimated, true in (("RMSE", *errors[:2]), ("relMSE", *errors[2:])):
+            assert np.isfinite(estimated), (name, kind, spp)
+            assert 1 / FACTOR < estimated / true < FACTOR, (name, kind, spp, estimated, true)
 
 
 def test_estimated_error_tracks_the_true_error(scene):
