@@ -4,10 +4,10 @@ Both renderers get the same chances. For each scene (WIDTH px wide by default):
 - references: DRT's (SOBOL, many samples, another seed) and Cycles' (the mean of two seeds);
   every error below is the true relMSE against the renderer's own reference, less the
   reference's own estimated variance;
-- plain sampling on one sample-count grid (GRID_COUNTS) for both: DRT GRID and JITTERED one
-  render per count (their patterns depend on it), DRT SOBOL one progressive render read where
-  its samples per pixel reach a count of the grid (what a render capped there returns), Cycles
-  one render per count;
+- plain sampling on one sample-count grid (GRID_COUNTS) for both: DRT SOBOL one progressive
+  render read where its samples per pixel reach a count of the grid (what a render capped there
+  returns), Cycles one render per count; DRT GRID and JITTERED one render per count of PATTERN_COUNTS (their
+  patterns depend on the count);
 - adaptive sampling the same way for both: one render per noise threshold (THRESHOLDS) and per
   Min Samples (MIN_SAMPLES, 0 = each renderer's automatic rule), sample cap ``--cap``; the curve
   is the lower envelope of all those renders ("SOBOL+NOISE", "Cycles adaptive"), and the
@@ -59,8 +59,10 @@ WIDTH = 256
 LEVELS = (1e-2, 3e-3, 1e-3)
 GRID_COUNTS = (4, 8, 16, 32, 64, 128, 256)
 """Samples per pixel of the plain-sampling points, the same for DRT and Cycles."""
-THRESHOLDS = (0.04, 0.02, 0.01, 0.005, 0.0025)
-MIN_SAMPLES = (0, 4, 16, 64)
+PATTERN_COUNTS = (4, 16, 64)
+"""Sample counts of DRT's GRID and JITTERED renders (one render each: kept few at 256 px)."""
+THRESHOLDS = (0.02, 0.01, 0.005, 0.0025)
+MIN_SAMPLES = (0, 4, 16)
 """Min Samples searched for both renderers' adaptive sampling; 0 = the renderer's automatic rule."""
 CURVES = ("GRID", "JITTERED", "SOBOL", "SOBOL+NOISE", "SOBOL+NOISE auto min", "SOBOL+CONTRAST", "Cycles",
           "Cycles adaptive", "Cycles adaptive auto min")
@@ -153,7 +155,7 @@ def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
     counts = [n for n in GRID_COUNTS if n <= cap]
     for pattern in ("GRID", "JITTERED"):
         pts = []
-        for n in counts:
+        for n in PATTERN_COUNTS:
             res, _, cpu = drt_run(data, drt_settings(scene, samples=n, sampling_pattern=pattern))
             _, rel = true_error(res.passes["Combined"][..., :3], *reference)
             pts.append((cpu, rel, res.stats.get("relmse"), res.stats["samples_mean"], n))
@@ -237,7 +239,8 @@ def machine() -> str:
 def settings_text(width, ref_samples, cap) -> str:
     return (f"Scenes at width {width} px; references {ref_samples} spp (DRT: SOBOL, another seed; Cycles: "
             f"two seeds), each renderer against its own, less the reference's variance; sample cap {cap}; "
-            f"plain sampling at {', '.join(map(str, GRID_COUNTS))} spp for both; adaptive sampling one render "
+            f"plain sampling at {', '.join(map(str, GRID_COUNTS))} spp for both (DRT GRID and JITTERED at "
+            f"{', '.join(map(str, PATTERN_COUNTS))}); adaptive sampling one render "
             f"per noise threshold ({', '.join(f'{t:g}' for t in THRESHOLDS)}) and Min Samples "
             f"({', '.join('auto' if m == 0 else str(m) for m in MIN_SAMPLES)}) for both, the curve the "
             "lower envelope of them all (\"auto min\": automatic Min Samples only). One run per setting for "
