@@ -195,18 +195,32 @@ def main(argv=None):
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--scenes", nargs="*", default=("cornell_box", "glossy_spheres", "dof_row", "motion_blur"))
     parser.add_argument("--min-samples", type=int, default=0, help="adaptive Min Samples (0: automatic, the default)")
-    parser.add_argument("--publish", action="store_true")
+    parser.add_argument("--publish", action="store_true", help="also write README.md's block and bench/adaptive_<what>.json")
+    parser.add_argument("--publish-only", action="store_true", help="publish the last run's results without rendering")
     args = parser.parse_args(argv)
-    rows = gain(args) if args.what == "gain" else calibration(args)
-    OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / f"adaptive_{args.what}.json").write_text(json.dumps({"args": vars(args), "rows": rows}, indent=1))
+    saved = OUT / f"adaptive_{args.what}.json"
+    if args.publish_only:
+        found = json.loads(saved.read_text())
+        args, rows = argparse.Namespace(**found["args"]), found["rows"]
+        args.publish = True
+    else:
+        rows = gain(args) if args.what == "gain" else calibration(args)
+        OUT.mkdir(parents=True, exist_ok=True)
+        saved.write_text(json.dumps({"args": vars(args), "rows": rows,
+                                     "made": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}, indent=1))
     text = gain_table(rows) if args.what == "gain" else calibration_table(rows)
     print(text)
     if args.publish:
-        (ROOT / "bench" / f"adaptive_{args.what}.json").write_text((OUT / f"adaptive_{args.what}.json").read_text())
-        cmd = f"`python bench/adaptive_study.py {args.what} --width {args.width} --seeds {args.seeds}`"
-        write_block(f"adaptive-{args.what}", f"Measured by {cmd} on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
-                f"{args.width} px wide, {args.seeds} seeds, references {REFERENCE_SAMPLES} spp.\n\n{text}")
+        (ROOT / "bench" / f"adaptive_{args.what}.json").write_text(saved.read_text())
+        made = json.loads(saved.read_text()).get("made") or time.strftime(
+            "%Y-%m-%d %H:%M UTC", time.gmtime(saved.stat().st_mtime))
+        if args.what == "gain":
+            setup = (f"the sample scenes at {args.width} px wide, the soft-shadow scene at {args.soft_width} px "
+                     f"under a {args.time_limit:g} s limit")
+        else:
+            setup = f"{args.width} px wide, uniform and adaptive renders to {args.cap} spp, target-error stops"
+        write_block(f"adaptive-{args.what}", f"Measured by `python bench/adaptive_study.py {args.what}` on {made}: "
+                    f"{setup}, {args.seeds} seeds pooled, references {REFERENCE_SAMPLES} spp.\n\n{text}")
 
 
 if __name__ == "__main__":
