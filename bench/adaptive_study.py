@@ -197,6 +197,8 @@ def main(argv=None):
     parser.add_argument("--min-samples", type=int, default=0, help="adaptive Min Samples (0: automatic, the default)")
     parser.add_argument("--publish", action="store_true", help="also write README.md's block and bench/adaptive_<what>.json")
     parser.add_argument("--publish-only", action="store_true", help="publish the last run's results without rendering")
+    parser.add_argument("--append", action="store_true", help="add this run's rows to the last run's saved results "
+                        "(scenes run one process each)")
     args = parser.parse_args(argv)
     saved = OUT / f"adaptive_{args.what}.json"
     if args.publish_only:
@@ -205,6 +207,8 @@ def main(argv=None):
         args.publish = True
     else:
         rows = gain(args) if args.what == "gain" else calibration(args)
+        if args.append:
+            rows = json.loads(saved.read_text())["rows"] + rows
         OUT.mkdir(parents=True, exist_ok=True)
         saved.write_text(json.dumps({"args": vars(args), "rows": rows,
                                      "made": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}, indent=1))
