@@ -5,16 +5,28 @@ it shows whether adaptive sampling moves samples there with its default settings
 """
 from __future__ import annotations
 
+import importlib.util
 import sys
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "core")]
+sys.path.insert(0, str(ROOT))
 
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData  # noqa: E402
-from scenes import look_at, plane, translation, uv_sphere  # noqa: E402  (the core tests' scene helpers)
+
+
+def _core_test_scenes():
+    """tests/core/scenes.py (the core tests' scene helpers), loaded by path: bench/scenes.py has its name."""
+    spec = importlib.util.spec_from_file_location("core_test_scenes", ROOT / "tests" / "core" / "scenes.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_helpers = _core_test_scenes()
+look_at, plane, translation, uv_sphere = _helpers.look_at, _helpers.plane, _helpers.translation, _helpers.uv_sphere
 
 
 def cube(center, half, material):
