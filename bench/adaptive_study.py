@@ -83,8 +83,6 @@ def log_interp(points, t):
 
 
 def sample_scenes(width, names):
-    import bpy  # noqa: F401  (the sample scenes need Blender to load)
-
     import drt_engine
     from scenes import load, settings
 
