@@ -176,10 +176,12 @@ def calibration_table(rows) -> str:
             ratios = [r["ratio"] for r in rows if r["scene"] == scene and r["run"] == run]
             if ratios:
                 lines.append(f"| {scene} | {run} | {min(ratios):.2f}-{max(ratios):.2f} | {len(ratios)} |")
-    lines += ["", "| scene | target relMSE | true relMSE at the stop | true / target | mean spp |", "|---|---|---|---|---|"]
+    lines += ["", "| scene | target relMSE | true relMSE at the stop | true / target | mean spp | stopped by |",
+              "|---|---|---|---|---|---|"]
     for r in rows:
         if r["run"] == "target":
-            lines.append(f"| {r['scene']} | {r['target']:g} | {r['true']:.2e} | {r['ratio']:.2f} | {r['spp_mean']:.0f} |")
+            lines.append(f"| {r['scene']} | {r['target']:g} | {r['true']:.2e} | {r['ratio']:.2f} | {r['spp_mean']:.0f} "
+                         f"| {', '.join(r['stopped_by'])} |")
     return "\n".join(lines)
 
 
