@@ -95,19 +95,21 @@ def sample_scenes(width, names):
         yield name, data, base, scene.drt.samples
 
 
-def gain_row(name, data, base, samples, seeds, time_limit=0.0, min_samples=0):
+def gain_row(name, data, base, samples, seeds, time_limit=0.0, min_samples=0, threshold=None):
     truth = reference(name, data, base)
     uniform, adaptive = [], []
     for seed in seeds:
         common = dict(base, samples=samples, seed=seed, time_limit=time_limit)
         uniform.append(steps(data, RenderSettings(**common), truth))
-        adaptive.append(steps(data, RenderSettings(**common, use_adaptive_sampling=True, adaptive_min_samples=min_samples),
-                                    truth))
+        chosen = {} if threshold is None else {"adaptive_threshold": threshold}
+        adaptive.append(steps(data, RenderSettings(**common, use_adaptive_sampling=True, adaptive_min_samples=min_samples,
+                                                   **chosen), truth))
     # uniform's error at the CPU time adaptive took, seed by seed: the same time when both run to the
     # limit, and a fair one when adaptive sampling ends sooner (every pixel under the threshold)
     u = float(np.mean([log_interp([(p[0], p[3]) for p in su], sa[-1][0]) for su, sa in zip(uniform, adaptive)]))
     a = float(np.mean([s[-1][3] for s in adaptive]))
-    row = {"scene": name, "samples": samples, "time_limit": time_limit, "seeds": len(seeds),
+    row = {"scene": name if threshold is None else f"{name}, threshold {threshold:g}", "samples": samples,
+           "time_limit": time_limit, "seeds": len(seeds),
            "uniform_relmse": u, "adaptive_relmse": a, "gain": u / a,
            "adaptive_cpu": float(np.mean([s[-1][0] for s in adaptive])),
            "adaptive_spp_mean": float(np.mean([s[-1][1] for s in adaptive])),
@@ -123,8 +125,9 @@ def gain(args):
     from soft_shadow import soft_shadow_scene
 
     data, base = soft_shadow_scene(args.soft_width)
-    rows.append(gain_row("soft_shadow", data, base, 4096, range(args.seeds), time_limit=args.time_limit,
-                         min_samples=args.min_samples))
+    for threshold in args.soft_thresholds:  # None: the default threshold
+        rows.append(gain_row("soft_shadow", data, base, 4096, range(args.seeds), time_limit=args.time_limit,
+                             min_samples=args.min_samples, threshold=threshold))
     return rows
 
 
@@ -195,6 +198,8 @@ def main(argv=None):
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--scenes", nargs="*", default=("cornell_box", "glossy_spheres", "dof_row", "motion_blur"))
     parser.add_argument("--min-samples", type=int, default=0, help="adaptive Min Samples (0: automatic, the default)")
+    parser.add_argument("--soft-thresholds", type=float, nargs="*", default=[None],
+                        help="noise thresholds of the soft-shadow rows (default: the default threshold only)")
     parser.add_argument("--publish", action="store_true", help="also write README.md's block and bench/adaptive_<what>.json")
     parser.add_argument("--publish-only", action="store_true", help="publish the last run's results without rendering")
     parser.add_argument("--append", action="store_true", help="add this run's rows to the last run's saved results "
