@@ -12,6 +12,7 @@ import sys
 import time
 from pathlib import Path
 
+from .cli_progress import ProgressDisplay
 from .core import merge, parts, report
 from .core.errors import DRTError
 from .core.settings import ADAPTIVE_MODES
@@ -290,10 +291,14 @@ def _render(args) -> str:
 
     engine.last_reports.clear()
     start = time.perf_counter()
+    engine.progress_listener = ProgressDisplay(sys.stdout, scene.drt.time_limit, scene.drt.target_error)
     try:
         bpy.ops.render.render(write_still=False, scene=scene.name)
     except RuntimeError as error:
         raise CLIError(f"render failed: {_blender_message(error)}") from None
+    finally:
+        engine.progress_listener.close()
+        engine.progress_listener = None
     elapsed = time.perf_counter() - start
     if not engine.last_reports:
         raise CLIError("the render produced no image")

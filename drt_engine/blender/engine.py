@@ -52,6 +52,9 @@ The CLI runs Blender's render operator in its own process; this is how it gets t
 engine's settings, stats and error log back to write ``<OUT stem>.drt.json``.
 """
 
+progress_listener = None
+"""Called with every core ProgressUpdate of a final render when set: the CLI's live progress line."""
+
 
 persistent: dict[str, tuple[str, object]] = {}
 """With Blender's Persistent Data on (Render Properties > Performance, as for Cycles): per view
@@ -238,6 +241,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
         def progress(update) -> bool:
             nonlocal last_display
+            if progress_listener is not None and not self.is_preview:
+                progress_listener(update)
             self.update_progress(min(max(update.fraction, 0.0), 1.0))
             self.update_stats("", stats_line(update.samples_done, update.samples_total, update.error,
                                              update.elapsed))

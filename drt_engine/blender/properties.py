@@ -175,8 +175,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     adaptive_min_samples: IntProperty(
         name="Min Samples",
-        description="Samples every pixel takes before the first test; 0 chooses it from the "
-        "threshold as Cycles does",
+        description="Samples every pixel takes before the first test; 0 chooses it for DRT's "
+        "sharing of samples: min(16, samples / 8), at least 4",
         default=0,
         min=0,
     )

@@ -114,7 +114,8 @@ def write_json(path, report: dict) -> None:
 
 
 PLOT_COLORS = ((0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.84, 0.15, 0.16),
-               (0.58, 0.4, 0.74), (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.5, 0.5, 0.5))
+               (0.58, 0.4, 0.74), (0.55, 0.34, 0.29), (0.89, 0.47, 0.76), (0.5, 0.5, 0.5), (0.74, 0.74, 0.13),
+               (0.09, 0.75, 0.81))
 
 
 def error_curve(log: list[dict], key: str = "relmse") -> list[tuple[float, float]]:
@@ -139,7 +140,8 @@ def plot_loglog(path, curves, title: str, xlabel: str = "time (s)", ylabel: str 
     import OpenImageIO as oiio
 
     width, height = size
-    left, right, top, bottom = 70, 150, 30, 45
+    longest = max((len(label) for label, _ in curves), default=0)
+    left, right, top, bottom = 70, max(150, 36 + 7 * longest), 30, 45  # the legend's longest label fits
     buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 3, "float"))
     oiio.ImageBufAlgo.fill(buf, (1.0, 1.0, 1.0))
     points = [p for _, pts in curves for p in pts if p[0] > 0 and p[1] > 0]

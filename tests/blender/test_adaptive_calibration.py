@@ -1,9 +1,11 @@
 """The estimated error of a render tracks its true error, on every sample scene.
 
-At every logged step, the estimated RMSE of the image (``adaptive.image_error``, from
-the film's two independent replicates) is within a factor of 1.5 of the true RMSE
-against a reference of 1024 samples with another seed, less the reference's own
-estimated variance. Both are pooled over four seeds: at 32 pixels wide the error of
+At every logged step, the estimated RMSE and relMSE of the image (``adaptive.image_error``,
+from the film's two independent replicates) are each within a factor of 1.5 of the true ones
+against a reference of 1024 samples with another seed, less the reference's own estimated
+variance (the relMSE from RELMSE_FROM samples up, and while adapting from 0.55: see
+ADAPTED_RELMSE_LOW). Both are pooled over four seeds (RMSE as the root of the mean square, relMSE as
+the mean): at 32 pixels wide the error of
 glossy_spheres sits in the handful of pixels that hold the gold sphere's highlight, so
 one render's true error is itself a sum of a few squares (one seed alone ranged from
 0.5 to 1.9 times its estimate). Adaptive renders are compared step by step (the k-th
@@ -25,7 +27,17 @@ REFERENCE_SAMPLES = 1024
 CAP = 64
 SEEDS = range(4)
 FACTOR = 1.5
+ADAPTED_RELMSE_LOW = 0.55
+"""While adapting, the relMSE estimate reads low, down to 0.62-0.67 of the true relMSE (cornell_box,
+motion_blur): pixels stop when their one-degree-of-freedom estimate happens to be low, and keep
+that low estimate while their error stays; the sparse pixels of dark corners and edges weigh most
+in the relMSE. This bound catches anything worse; the RMSE keeps FACTOR."""
 MIN_SAMPLES = 8
+RELMSE_FROM = 16
+"""The relMSE is checked from this many samples in the busiest pixel up. At 8 samples and 32 px,
+glossy_spheres' relMSE sits in the few pixels of the gold sphere's highlight, which most renders
+miss entirely (pooled over the four seeds: true 0.108, estimated 0.047); no estimate from the
+samples can see a highlight they missed. At 64 px the same step reads 0.89 (bench/adaptive_study.py)."""
 
 
 @pytest.fixture(scope="module", params=SCENES)
@@ -45,9 +57,10 @@ def scene(request, drt):
     return request.param, data, base, truth
 
 
-def pooled_steps(scene, **settings) -> list[tuple[int, float, float]]:
-    """(most samples a pixel holds, least over the seeds; estimated RMSE; true RMSE), mean squares
-    over the seeds, at every step (the k-th logged of each render) all seeds logged."""
+def pooled_steps(scene, **settings) -> list[tuple]:
+    """(most samples a pixel holds, least over the seeds; estimated RMSE; true RMSE; estimated relMSE;
+    true relMSE), means of the squared errors over the seeds, at every step (the k-th logged of each
+    render) all seeds logged."""
     _, data, base, truth = scene
     per_seed = []
     for seed in SEEDS:
@@ -55,21 +68,26 @@ def pooled_steps(scene, **settings) -> list[tuple[int, float, float]]:
 
         def progress(update):
             if update.entry is not None:
-                rmse, _ = true_error(update.passes()["Combined"][..., :3], *truth)
-                steps[len(steps)] = (update.entry["spp_max"], update.entry["rmse"] ** 2, rmse ** 2)
+                rmse, relmse = true_error(update.passes()["Combined"][..., :3], *truth)
+                e = update.entry
+                steps[len(steps)] = (e["spp_max"], e["rmse"] ** 2, rmse ** 2, e["relmse"], relmse)
             return True
 
         Renderer(data, RenderSettings(samples=CAP, seed=seed, **base, **settings)).render(progress=progress)
         per_seed.append(steps)
     common = sorted(set.intersection(*(set(s) for s in per_seed)))
-    return [(min(s[k][0] for s in per_seed), *(np.sqrt(np.mean([s[k][c] for s in per_seed])) for c in (1, 2)))
-            for k in common]
+    return [(min(s[k][0] for s in per_seed), *(np.sqrt(np.mean([s[k][c] for s in per_seed])) for c in (1, 2)),
+             *(np.mean([s[k][c] for s in per_seed]) for c in (3, 4))) for k in common]
 
 
-def assert_tracks(name, steps):
-    for spp, estimated, true in steps:
-        assert np.isfinite(estimated), (name, spp)
-        assert 1 / FACTOR < estimated / true < FACTOR, (name, spp, estimated, true)
+def assert_tracks(name, steps, relmse_low=1 / FACTOR):
+    for spp, *errors in steps:
+        checks = [("RMSE", *errors[:2], 1 / FACTOR)]
+        if spp >= RELMSE_FROM:
+            checks.append(("relMSE", *errors[2:], relmse_low))
+        for kind, estimated, true, low in checks:
+            assert np.isfinite(estimated), (name, kind, spp)
+            assert low < estimated / true < FACTOR, (name, kind, spp, estimated, true)
 
 
 def test_estimated_error_tracks_the_true_error(scene):
@@ -84,4 +102,4 @@ def test_estimated_error_tracks_the_true_error_while_adapting(scene, mode):
                          adaptive_min_samples=MIN_SAMPLES)
     after = [step for step in steps if step[0] >= first_test(MIN_SAMPLES)]
     assert after[0][0] == first_test(MIN_SAMPLES) and len(after) >= 2
-    assert_tracks(f"{scene[0]} {mode}", after)
+    assert_tracks(f"{scene[0]} {mode}", after, ADAPTED_RELMSE_LOW)

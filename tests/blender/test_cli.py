@@ -6,6 +6,7 @@ one line on stderr (Blender's own chatter goes to stdout).
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -123,6 +124,10 @@ def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
     plot = bl.read_channels(tmp_path / "out.error.png")
     assert plot["R"].shape == (420, 640)
     assert plot["R"].min() < 0.5  # axes and curves drawn on the white page
+    # not a terminal: the live progress comes as plain lines, the first as the render starts
+    progress = [line for line in result.stdout.splitlines() if line.startswith("DRT: Sample ")]
+    assert progress and "\r" not in result.stdout
+    assert re.fullmatch(r"DRT: Sample \d+/32 \| est\. error \S+ \| [\d.]+ s( \| ~\d+ s left to the .+)?", progress[0])
 
 
 @pytest.mark.parametrize("option, value", [("--time-limit", "-1"), ("--target-error", "abc"),

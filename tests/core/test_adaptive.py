@@ -65,14 +65,16 @@ def assert_consistent(result):
 
 # -- Cycles' semantics -----------------------------------------------------------------
 
-def test_automatic_threshold_and_min_samples_are_cycles():
-    # scene/integrator.cpp: threshold 0 -> max(0.001, 1 / samples); min 0 -> max(4, ceil(16 / threshold^0.3))
+def test_automatic_threshold_is_cycles_and_min_samples_leave_the_allocation_room():
+    # scene/integrator.cpp: threshold 0 -> max(0.001, 1 / samples)
     assert adaptive.effective_threshold(0.0, 256) == pytest.approx(1 / 256)
     assert adaptive.effective_threshold(0.0, 4096) == pytest.approx(0.001)
     assert adaptive.effective_threshold(0.02, 256) == 0.02
-    assert adaptive.min_samples(0.01, 0) == 64  # ceil(16 / 0.01^0.3) = ceil(63.7)
-    assert adaptive.min_samples(1 / 256, 0) == 85  # ceil(16 * 256^0.3) = ceil(84.4)
-    assert adaptive.min_samples(0.01, 24) == 24
+    # min 0 -> min(16, cap / 8), at least 4 (Cycles: max(4, ceil(16 / threshold^0.3)), 64 at 0.01)
+    assert adaptive.min_samples(0, 64) == 8
+    assert adaptive.min_samples(0, 4096) == 16
+    assert adaptive.min_samples(0, 16) == 4
+    assert adaptive.min_samples(24, 64) == 24 and adaptive.min_samples(2, 64) == 4
     # the first test comes right after the minimum (Cycles: at the next multiple of 16 after it)
     assert adaptive.first_test(64) == 64 and adaptive.first_test(8) == 8 and adaptive.first_test(85) == 85
 
@@ -89,8 +91,8 @@ def test_rounds_hold_enough_samples_but_keep_the_first_test_and_the_cap():
 def test_threshold_zero_is_automatic_in_a_render():
     result = render(samples=128, use_adaptive_sampling=True, adaptive_threshold=0.0)
     assert result.stats["adaptive_threshold"] == pytest.approx(1 / 128)
-    assert result.stats["adaptive_first_test"] == adaptive.first_test(adaptive.min_samples(1 / 128, 0)) == 69  # ceil(16 * 128^0.3)
-    assert result.passes["Sample Count"].min() >= 69
+    assert result.stats["adaptive_first_test"] == adaptive.first_test(adaptive.min_samples(0, 128)) == 16
+    assert result.passes["Sample Count"].min() >= 16
 
 
 # -- noise-adaptive ---------------------------------------------------------------------
