@@ -9,6 +9,10 @@ Directions are in the local shading frame with ``wo`` always in the upper hemisp
 (the caller flips the frame to the side the ray arrived from; glass inverts its IOR).
 The diffuse lobe is evaluated for light sampling only: as in Cook's distribution ray
 tracing (and Cycles with diffuse bounces 0) no rays continue from it.
+
+Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
+sampling, pdf, lobe choice, pass colours) is ``lobe_kernels``, compiled, over the flat
+arrays ``MaterialShader`` packs the lobes into.
 """
 from __future__ import annotations
 
@@ -355,8 +359,9 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
     return lp, lt, hp
 
 
-def _floats(a, n=None):
-    return np.ascontiguousarray(a, np.float64) if n is None else np.ascontiguousarray(np.broadcast_to(a, n), np.float64)
+def _floats(a):
+    """``a`` as the kernels take it (one compiled version per layout: keep to C-contiguous)."""
+    return np.ascontiguousarray(a, np.float64)
 
 
 def _bools(a):
@@ -452,7 +457,7 @@ class MaterialShader:
         f_nd = np.empty((n, 3))
         pdf = np.empty(n)
         lk.evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
-                         _bools(above), _bools(np.broadcast_to(inside, (n,))), _floats(sel), f_diff, f_nd, pdf)
+                         _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
         return f_diff, f_nd, pdf
 
     # -- sampling -------------------------------------------------------------------
@@ -473,7 +478,7 @@ class MaterialShader:
         valid = np.empty(n, bool)
         passthrough = np.empty(n, bool)
         lk.sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
-                       _floats(u2), _bools(np.broadcast_to(inside, (n,))), wi, weight, pdf, delta, valid, passthrough,
+                       _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
                        len(self.sampled))
         return wi, weight, pdf, delta, valid, passthrough
 
