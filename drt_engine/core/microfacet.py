@@ -69,7 +69,7 @@ def normalize(v, tiny: float = _TINY):
     return v / np.maximum(norm(v)[..., None], tiny)
 
 
-@kernel(inline="always")
+@kernel
 def ggx_d(cos_h, alpha):
     """GGX normal distribution D(h) for one microfacet normal (zero below the surface)."""
     if not cos_h > 0.0:
@@ -79,32 +79,32 @@ def ggx_d(cos_h, alpha):
     return a2 / (np.pi * max((c2 * (a2 - 1.0) + 1.0) ** 2, _TINY))
 
 
-@kernel(inline="always")
+@kernel
 def ggx_lambda(cos_t, alpha):
     c2 = min(max(cos_t * cos_t, _TINY), 1.0)
     tan2 = (1.0 - c2) / c2
     return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
 
 
-@kernel(inline="always")
+@kernel
 def ggx_g1(cos_t, alpha):
     return 1.0 / (1.0 + ggx_lambda(cos_t, alpha))
 
 
-@kernel(inline="always")
+@kernel
 def ggx_g2(cos_o, cos_i, alpha):
     """Height-correlated masking-shadowing."""
     return 1.0 / (1.0 + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha))
 
 
-@kernel(inline="always")
+@kernel
 def unit(x, y, z):
     """(x, y, z) scaled to unit length; lengths under 1e-30 count as 1e-30."""
     length = max(np.sqrt(x * x + y * y + z * z), _TINY)
     return x / length, y / length, z / length
 
 
-@kernel(inline="always")
+@kernel
 def sample_visible_normal(wx, wy, wz, alpha, u0, u1):
     """Heitz 2018: a microfacet normal from the distribution of normals visible from w."""
     if wz < 0.0:
@@ -130,14 +130,14 @@ def sample_visible_normal(wx, wy, wz, alpha, u0, u1):
     return unit(alpha * nx, alpha * ny, max(nz, 1e-12))
 
 
-@kernel(inline="always")
+@kernel
 def visible_normal_pdf(wx, wy, wz, hx, hy, hz, alpha):
     """Density of ``sample_visible_normal`` (per solid angle of h); w may be below."""
     cos_o = abs(wz)
     return ggx_g1(cos_o, alpha) * abs(wx * hx + wy * hy + wz * hz) * ggx_d(hz, alpha) / max(cos_o, _TINY)
 
 
-@kernel(inline="always")
+@kernel
 def fresnel_dielectric1(cos_i, eta):
     """Exact unpolarised Fresnel reflectance; eta = n_inside / n_outside, cos_i < 0 from inside."""
     if cos_i < 0.0:
@@ -181,7 +181,7 @@ F82_M = (1.0 / 7.0) * (1.0 - 1.0 / 7.0) ** 6
 """The F82 correction's c (1 - c)^6 at c = 1/7."""
 
 
-@kernel(inline="always")
+@kernel
 def f82_parts(cos_i, f82):
     """Metal Fresnel (Schlick with the F82-tint correction, Hoffman 2019, as Cycles) of one colour
     channel, before clipping, as f0 A + B: returns (A, B). Affine in f0, so its albedo tables
@@ -193,14 +193,14 @@ def f82_parts(cos_i, f82):
     return 1.0 - schlick - (1.0 - F82_K) * bump, schlick - F82_K * bump
 
 
-@kernel(inline="always")
+@kernel
 def fresnel_f82(cos_i, f0, f82):
     """Metal Fresnel of one colour channel: clip(f0 A + B) (see ``f82_parts``)."""
     a, b = f82_parts(cos_i, f82)
     return min(max(f0 * a + b, 0.0), 1.0)
 
 
-@kernel(inline="always")
+@kernel
 def refract(wx, wy, wz, hx, hy, hz, eta):
     """Refract w about h; eta = n_(refracted side) / n_(w side). Returns (x, y, z, valid)."""
     c = wx * hx + wy * hy + wz * hz
