@@ -1,7 +1,8 @@
-"""GGX microfacet terms, Fresnel, and their sampling, vectorised in a local frame.
+"""GGX microfacet terms, Fresnel, and their sampling in a local frame; vector helpers.
 
-Local frame: z is the (shading) normal. All functions take arrays of shape (N, 3) for
-directions and scalar material parameters (one material is shaded at a time).
+Local frame: z is the (shading) normal. The microfacet terms are scalar kernels (one
+direction's components and numbers in, a few numbers out) that the lobe kernels of
+``lobe_kernels`` call per ray; the vector helpers take arrays of shape (N, 3).
 Alpha below ``DELTA_ALPHA`` is treated as a perfect mirror or smooth interface: the
 microfacet normal is the macro normal, but the lobe keeps the albedo of GGX at its own
 alpha (masking matters within a fraction of a degree of grazing, where alpha·tanθ is no
@@ -15,8 +16,12 @@ import functools
 
 import numpy as np
 
+from .jit import kernel
+
 DELTA_ALPHA = 1e-4
-MU_TABLE = np.unique(np.concatenate([np.geomspace(1e-5, 1.0 / 64, 12), np.linspace(1.0 / 64, 1.0, 32)]))
+MU_GRAZING, MU_SPLIT, MU_GEOMETRIC, MU_LINEAR = 1e-5, 1.0 / 64, 12, 32
+MU_TABLE = np.unique(np.concatenate([np.geomspace(MU_GRAZING, MU_SPLIT, MU_GEOMETRIC),
+                                     np.linspace(MU_SPLIT, 1.0, MU_LINEAR)]))
 """Cosines the albedo tables are computed at: geometric steps toward the horizon, linear above."""
 _TINY = 1e-30
 
@@ -64,64 +69,101 @@ def normalize(v, tiny: float = _TINY):
     return v / np.maximum(norm(v)[..., None], tiny)
 
 
-def ggx_d(cos_h: np.ndarray, alpha: float) -> np.ndarray:
+@kernel
+def ggx_d(cos_h, alpha):
+    """GGX normal distribution D(h) for one microfacet normal (zero below the surface)."""
+    if not cos_h > 0.0:
+        return 0.0
     a2 = alpha * alpha
     c2 = cos_h * cos_h
-    return np.where(cos_h > 0, a2 / (np.pi * np.maximum((c2 * (a2 - 1.0) + 1.0) ** 2, _TINY)), 0.0)
+    return a2 / (np.pi * max((c2 * (a2 - 1.0) + 1.0) ** 2, _TINY))
 
 
-def ggx_lambda(cos_t: np.ndarray, alpha: float) -> np.ndarray:
-    c2 = np.clip(cos_t * cos_t, _TINY, 1.0)
+@kernel
+def ggx_lambda(cos_t, alpha):
+    c2 = min(max(cos_t * cos_t, _TINY), 1.0)
     tan2 = (1.0 - c2) / c2
     return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
 
 
+@kernel
 def ggx_g1(cos_t, alpha):
     return 1.0 / (1.0 + ggx_lambda(cos_t, alpha))
 
 
+@kernel
 def ggx_g2(cos_o, cos_i, alpha):
     """Height-correlated masking-shadowing."""
     return 1.0 / (1.0 + ggx_lambda(cos_o, alpha) + ggx_lambda(cos_i, alpha))
 
 
-def sample_visible_normal(wo: np.ndarray, alpha: float, u: np.ndarray) -> np.ndarray:
-    """Heitz 2018: sample a microfacet normal from the distribution of visible normals."""
-    flip = wo[:, 2] < 0
-    w = np.where(flip[:, None], -wo, wo)
-    vh = normalize(np.stack([alpha * w[:, 0], alpha * w[:, 1], w[:, 2]], axis=1))
-    lensq = vh[:, 0] ** 2 + vh[:, 1] ** 2
-    inv = 1.0 / np.sqrt(np.maximum(lensq, _TINY))
-    t1 = np.where((lensq > 0)[:, None], np.stack([-vh[:, 1] * inv, vh[:, 0] * inv, np.zeros_like(inv)], 1),
-                  np.array([1.0, 0.0, 0.0]))
-    t2 = np.cross(vh, t1)
-    r = np.sqrt(u[:, 0])
-    phi = 2.0 * np.pi * u[:, 1]
+@kernel
+def unit(x, y, z):
+    """(x, y, z) scaled to unit length; lengths under 1e-30 count as 1e-30."""
+    length = max(np.sqrt(x * x + y * y + z * z), _TINY)
+    return x / length, y / length, z / length
+
+
+@kernel
+def sample_visible_normal(wx, wy, wz, alpha, u0, u1):
+    """Heitz 2018: a microfacet normal from the distribution of normals visible from w."""
+    if wz < 0.0:
+        wx, wy, wz = -wx, -wy, -wz
+    vx, vy, vz = unit(alpha * wx, alpha * wy, wz)
+    lensq = vx * vx + vy * vy
+    if lensq > 0.0:
+        inv = 1.0 / np.sqrt(max(lensq, _TINY))
+        t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
+    else:
+        t1x, t1y, t1z = 1.0, 0.0, 0.0
+    t2x, t2y, t2z = vy * t1z - vz * t1y, vz * t1x - vx * t1z, vx * t1y - vy * t1x
+    r = np.sqrt(u0)
+    phi = 2.0 * np.pi * u1
     p1 = r * np.cos(phi)
     p2 = r * np.sin(phi)
-    s = 0.5 * (1.0 + vh[:, 2])
-    p2 = (1.0 - s) * np.sqrt(np.maximum(1.0 - p1 * p1, 0.0)) + s * p2
-    nh = p1[:, None] * t1 + p2[:, None] * t2 + np.sqrt(np.maximum(1.0 - p1 * p1 - p2 * p2, 0.0))[:, None] * vh
-    return normalize(np.stack([alpha * nh[:, 0], alpha * nh[:, 1], np.maximum(nh[:, 2], 1e-12)], axis=1))
+    s = 0.5 * (1.0 + vz)
+    p2 = (1.0 - s) * np.sqrt(max(1.0 - p1 * p1, 0.0)) + s * p2
+    p3 = np.sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0))
+    nx = p1 * t1x + p2 * t2x + p3 * vx
+    ny = p1 * t1y + p2 * t2y + p3 * vy
+    nz = p1 * t1z + p2 * t2z + p3 * vz
+    return unit(alpha * nx, alpha * ny, max(nz, 1e-12))
 
 
-def visible_normal_pdf(wo, h, alpha):
-    """Density of ``sample_visible_normal`` (per solid angle of h); wo may be below."""
-    cos_o = np.abs(wo[:, 2])
-    return ggx_g1(cos_o, alpha) * np.abs(dot(wo, h)) * ggx_d(h[:, 2], alpha) / np.maximum(cos_o, _TINY)
+@kernel
+def visible_normal_pdf(wx, wy, wz, hx, hy, hz, alpha):
+    """Density of ``sample_visible_normal`` (per solid angle of h); w may be below."""
+    cos_o = abs(wz)
+    return ggx_g1(cos_o, alpha) * abs(wx * hx + wy * hy + wz * hz) * ggx_d(hz, alpha) / max(cos_o, _TINY)
 
 
-def fresnel_dielectric(cos_i: np.ndarray, eta: float | np.ndarray) -> np.ndarray:
+@kernel
+def fresnel_dielectric1(cos_i, eta):
     """Exact unpolarised Fresnel reflectance; eta = n_inside / n_outside, cos_i < 0 from inside."""
-    eta = np.where(cos_i < 0, 1.0 / eta, eta)
-    c = np.abs(cos_i)
+    if cos_i < 0.0:
+        eta = 1.0 / eta
+    c = abs(cos_i)
     g2 = eta * eta - 1.0 + c * c
-    tir = g2 <= 0
-    g = np.sqrt(np.maximum(g2, 0.0))
-    a = (g - c) / np.maximum(g + c, _TINY)
-    b = (c * (g + c) - 1.0) / np.maximum(c * (g - c) + 1.0, _TINY)
-    f = 0.5 * a * a * (1.0 + b * b)
-    return np.where(tir, 1.0, np.clip(f, 0.0, 1.0))
+    if g2 <= 0.0:
+        return 1.0
+    g = np.sqrt(g2)
+    a = (g - c) / max(g + c, _TINY)
+    b = (c * (g + c) - 1.0) / max(c * (g - c) + 1.0, _TINY)
+    return min(max(0.5 * a * a * (1.0 + b * b), 0.0), 1.0)
+
+
+@kernel
+def _fresnel_dielectric_rows(cos_i, eta, out):
+    for i in range(len(cos_i)):
+        out[i] = fresnel_dielectric1(cos_i[i], eta[i])
+
+
+def fresnel_dielectric(cos_i: np.ndarray, eta) -> np.ndarray:
+    """``fresnel_dielectric1`` over an array of cosines (eta: one number or one per cosine)."""
+    cos_i = np.ascontiguousarray(cos_i, np.float64)
+    out = np.empty(len(cos_i))
+    _fresnel_dielectric_rows(cos_i, np.ascontiguousarray(np.broadcast_to(eta, cos_i.shape), np.float64), out)
+    return out
 
 
 def f0_from_ior(ior):
@@ -139,27 +181,33 @@ F82_M = (1.0 / 7.0) * (1.0 - 1.0 / 7.0) ** 6
 """The F82 correction's c (1 - c)^6 at c = 1/7."""
 
 
-def fresnel_f82(cos_i: np.ndarray, f0: np.ndarray, f82: np.ndarray) -> np.ndarray:
-    """Metal Fresnel: Schlick with the F82-tint correction (Hoffman 2019), as Cycles."""
-    c = np.clip(cos_i, 0.0, 1.0)[:, None]
-    schlick = f0 + (1.0 - f0) * (1.0 - c) ** 5
-    schlick_mu = f0 + (1.0 - f0) * F82_K
-    b = schlick_mu * (1.0 - f82) / F82_M
-    return np.clip(schlick - b * c * (1.0 - c) ** 6, 0.0, 1.0)
+@kernel
+def f82_parts(cos_i, f82):
+    """Metal Fresnel (Schlick with the F82-tint correction, Hoffman 2019, as Cycles) of one colour
+    channel, before clipping, as f0 A + B: returns (A, B). Affine in f0, so its albedo tables
+    split in two that a per-hit colour f0 combines."""
+    c = min(max(cos_i, 0.0), 1.0)
+    scale = (1.0 - f82) / F82_M
+    schlick = (1.0 - c) ** 5
+    bump = scale * c * (1.0 - c) ** 6
+    return 1.0 - schlick - (1.0 - F82_K) * bump, schlick - F82_K * bump
 
 
-def reflect(wo, h):
-    return 2.0 * dot(wo, h)[:, None] * h - wo
+@kernel
+def fresnel_f82(cos_i, f0, f82):
+    """Metal Fresnel of one colour channel: clip(f0 A + B) (see ``f82_parts``)."""
+    a, b = f82_parts(cos_i, f82)
+    return min(max(f0 * a + b, 0.0), 1.0)
 
 
-def refract(wo, h, eta):
-    """Refract wo about h; eta = n_(wi side) / n_(wo side). Returns (wi, valid)."""
-    eta = np.broadcast_to(eta, (len(wo),))
-    c = dot(wo, h)
+@kernel
+def refract(wx, wy, wz, hx, hy, hz, eta):
+    """Refract w about h; eta = n_(refracted side) / n_(w side). Returns (x, y, z, valid)."""
+    c = wx * hx + wy * hy + wz * hz
     k = 1.0 - (1.0 - c * c) / (eta * eta)
-    valid = k > 0
-    wi = -wo / eta[:, None] + (c / eta - np.sign(c) * np.sqrt(np.maximum(k, 0.0)))[:, None] * h
-    return normalize(wi), valid
+    s = c / eta - np.sign(c) * np.sqrt(max(k, 0.0))
+    x, y, z = unit(-wx / eta + s * hx, -wy / eta + s * hy, -wz / eta + s * hz)
+    return x, y, z, k > 0.0
 
 
 def cosine_hemisphere(u: np.ndarray) -> np.ndarray:
@@ -181,6 +229,22 @@ def concentric_disk(u: np.ndarray) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
 
 
+@kernel
+def _albedo_samples(mu, u, alpha, cos_oh, weight):
+    """For each view cosine and sample point: cos(wo, h) of a sampled visible normal h and
+    the masking weight G2/G1 of its mirror direction (0 below the horizon)."""
+    m = len(u)
+    for k in range(len(mu)):
+        wx, wz = np.sqrt(1.0 - mu[k] * mu[k]), mu[k]
+        for j in range(m):
+            hx, hy, hz = sample_visible_normal(wx, 0.0, wz, alpha, u[j, 0], u[j, 1])
+            c = wx * hx + wz * hz
+            i = k * m + j
+            cos_oh[i] = c
+            wiz = 2.0 * c * hz - wz
+            weight[i] = ggx_g2(wz, wiz, alpha) / ggx_g1(wz, alpha) if wiz > 0.0 else 0.0
+
+
 def directional_albedo(alpha: float, fresnel, n_samples: int = 4096) -> tuple[np.ndarray, np.ndarray]:
     """Albedo E(mu) of a GGX reflection lobe with the given Fresnel(cos_h) -> (N,) or (N,3).
 
@@ -193,14 +257,11 @@ def directional_albedo(alpha: float, fresnel, n_samples: int = 4096) -> tuple[np
 
     g = Sampler("SOBOL", n_samples, seed=0x5AB1E).get2d(np.zeros(n_samples, np.int64), np.arange(n_samples), 0)
     m = len(g)
-    wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=1)
-    wo_r = np.repeat(wo, m, axis=0)
-    u = np.tile(g, (n_mu, 1))
-    h = sample_visible_normal(wo_r, alpha, u)  # also below DELTA_ALPHA: sampling stays exact there
-    wi = reflect(wo_r, h)
-    ok = wi[:, 2] > 0
-    weight = np.where(ok, ggx_g2(wo_r[:, 2], wi[:, 2], alpha) / ggx_g1(wo_r[:, 2], alpha), 0.0)
-    f = np.asarray(fresnel(dot(wo_r, h)))
+    cos_oh = np.empty(n_mu * m)
+    weight = np.empty(n_mu * m)
+    # also below DELTA_ALPHA: sampling stays exact there
+    _albedo_samples(mu, np.ascontiguousarray(g, np.float64), float(alpha), cos_oh, weight)
+    f = np.asarray(fresnel(cos_oh))
     if f.ndim == 2:
         e = (f * weight[:, None]).reshape(n_mu, m, -1).mean(axis=1)
     else:
@@ -212,11 +273,3 @@ def directional_albedo(alpha: float, fresnel, n_samples: int = 4096) -> tuple[np
 def white_albedo(alpha: float) -> tuple[np.ndarray, np.ndarray]:
     """Single-scatter albedo of GGX with F = 1, shared by every lobe of that roughness."""
     return directional_albedo(alpha, lambda c: np.ones_like(c))
-
-
-def lookup(mu_table: np.ndarray, values: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """Linear interpolation of a per-material albedo table at cosines ``mu``."""
-    mu = np.clip(mu, 0.0, 1.0)
-    if values.ndim == 1:
-        return np.interp(mu, mu_table, values)
-    return np.stack([np.interp(mu, mu_table, values[:, k]) for k in range(values.shape[1])], axis=1)
