@@ -6,19 +6,29 @@ serially: the renderer splits a wave into one piece per thread itself (pieces in
 pool, Embree calls between them), so no Numba threading layer is ever started and two renders
 in one process (viewport during F12, a material preview) cannot contend for one.
 
-The cache folder must be chosen before the modules that define kernels are imported: the
-Blender layer calls ``use_cache_dir`` with the extension's user folder; the CLI and the tests
-get the user's cache folder (``default_cache_dir``), and ``NUMBA_CACHE_DIR`` overrides both.
-A read-only package folder is never written to.
+Numba checks a cached kernel against its own source file only, not against the files of the
+kernels it calls: a kernel cached before ``microfacet.py`` changed would be loaded stale. So
+the cache lives in a folder named by a fingerprint of all of DRT's core sources, Numba and
+Python (``_fingerprint``); a changed source means a new folder, and older folders are removed
+once the new one is complete.
+
+The cache's base folder must be chosen before the modules that define kernels are imported:
+the Blender layer calls ``use_cache_dir`` with the extension's user folder; the CLI and the
+tests get the user's cache folder (``default_cache_dir``), and ``NUMBA_CACHE_DIR`` overrides
+both. A read-only package folder is never written to.
 """
 from __future__ import annotations
 
 import hashlib
 import os
+import re
+import shutil
 import sys
 from pathlib import Path
 
-_ENV = "NUMBA_CACHE_DIR"
+import numba
+
+_STAMP = "compiled"  # written into a cache folder once a render has filled it
 
 
 def default_cache_dir() -> Path:
@@ -32,21 +42,36 @@ def default_cache_dir() -> Path:
     return base / "drt" / "kernels"
 
 
-if not os.environ.get(_ENV):
-    os.environ[_ENV] = str(default_cache_dir())
+def _fingerprint() -> str:
+    """What decides whether cached kernels can be loaded: DRT's core sources, Numba, Python."""
+    h = hashlib.sha256(f"{numba.__version__} {sys.version_info[:2]} {sys.platform}".encode())
+    core = Path(__file__).parent
+    for source in sorted(core.rglob("*.py")):
+        h.update(str(source.relative_to(core)).encode())
+        h.update(source.read_bytes())
+    return h.hexdigest()[:16]
 
-import numba  # noqa: E402  (after the cache folder is known: Numba reads it at import)
+
+_FINGERPRINT = _fingerprint()
+_base = Path(os.environ.get("NUMBA_CACHE_DIR") or default_cache_dir())
+
+
+def _apply() -> None:
+    numba.config.CACHE_DIR = str(_base / _FINGERPRINT)
 
 
 def use_cache_dir(path) -> None:
-    """Cache compiled kernels under ``path`` (call before kernel modules are imported)."""
-    path = str(Path(path) / "kernels")
-    os.environ[_ENV] = path
-    numba.config.CACHE_DIR = path
+    """Cache compiled kernels under ``path``/kernels (call before kernel modules are imported)."""
+    global _base
+    _base = Path(path) / "kernels"
+    _apply()
 
 
 def cache_dir() -> Path:
     return Path(numba.config.CACHE_DIR)
+
+
+_apply()
 
 
 def kernel(fn=None, **options):
@@ -62,29 +87,20 @@ def kernel(fn=None, **options):
     return numba.njit(**opts)(fn)
 
 
-def _fingerprint() -> str:
-    """What decides whether cached kernels can be loaded: DRT's core sources, Numba, Python."""
-    h = hashlib.sha256(f"{numba.__version__} {sys.version_info[:2]} {sys.platform}".encode())
-    for source in sorted(Path(__file__).parent.rglob("*.py")):
-        h.update(source.read_bytes())
-    return h.hexdigest()[:16]
-
-
-def _stamp() -> Path:
-    return cache_dir() / f"drt-{_fingerprint()}.compiled"
-
-
 def first_run() -> bool:
     """True until a render has compiled this version's kernels into the cache folder."""
-    return not _stamp().exists()
+    return not (cache_dir() / _STAMP).exists()
 
 
 def mark_compiled() -> None:
-    """Record that this version's kernels are in the cache (best effort: a read-only cache folder
-    only means the message shows again)."""
+    """Record that this version's kernels are in the cache and remove other versions' folders
+    (best effort: a read-only cache folder only means the message shows again)."""
     try:
-        stamp = _stamp()
-        stamp.parent.mkdir(parents=True, exist_ok=True)
-        stamp.touch()
+        folder = cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / _STAMP).touch()
+        for old in folder.parent.iterdir():
+            if old != folder and old.is_dir() and re.fullmatch(r"[0-9a-f]{16}", old.name):
+                shutil.rmtree(old, ignore_errors=True)
     except OSError:
         pass
