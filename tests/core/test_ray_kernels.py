@@ -128,6 +128,20 @@ m = np.array([np.eye(4), np.eye(4)]); m[1, :3, 3] = (1, 0, 0)
 cam = Camera(m, (-0.4, 0.4, -0.3, 0.3), (40, 30), aperture_radius=0.1, blades=5)
 r = camera_rays.generate(cam, rng.random(300) * 40, rng.random(300) * 30, rng.random((300, 2)), rng.random(300))
 out["camera"] = np.concatenate([r.origins.ravel(), r.directions.ravel(), r.tmax])
+import sys; sys.path.insert(0, "tests/core")
+from drt_engine.core.accel import Geometry
+from drt_engine.core.scene import Closure, Instance, Material, SceneData
+from scenes import plane, uv_sphere
+scene = SceneData(camera=None, meshes=[uv_sphere(1.0, segments=8, rings=6), plane(4.0, z=-1.0)],
+                  instances=[Instance(0, m), Instance(1, np.eye(4))], materials=[Material("m", [Closure("DIFFUSE")])])
+geo = Geometry(scene, np.array([0.0, 0.0, 5.0]))
+o, d, t = np.tile([0.5, 0.0, 5.0], (300, 1)), rng.normal(size=(300, 3)) * 0.3 + [0, 0, -1], rng.random(300)
+d /= np.linalg.norm(d, axis=1, keepdims=True)
+hits = geo.intersect(o, d, np.full(300, np.inf), t)
+i = np.flatnonzero(hits.hit)
+pos, ng, ns = geo.surface(hits, i, t)
+out["hits"] = np.concatenate([pos.ravel(), ng.ravel(), ns.ravel(), geo.smooth_offset(hits, i, t).ravel(),
+                              geo.offset_scale(hits.prim[i], pos)])
 np.savez(OUT, **out)
 """
 
@@ -143,4 +157,6 @@ def test_plain_python_gives_the_kernels_numbers(tmp_path):
     compiled, plain = results
     for name in ("SOBOL", "JITTERED", "GRID", "filter"):
         assert np.array_equal(compiled[name], plain[name]), name
-    assert compiled["camera"] == pytest.approx(plain["camera"], rel=1e-12, abs=1e-12)
+    for name in ("camera", "hits"):
+        assert len(compiled[name]) > 1000
+        assert compiled[name] == pytest.approx(plain[name], rel=1e-12, abs=1e-12), name
