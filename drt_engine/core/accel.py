@@ -325,16 +325,9 @@ class Geometry:
                 if len(idx) == 0:
                     continue
                 o, d = self._rays_in(pk, origins, directions, times, idx)
-                parts = self._run(scene, o, d, limit[idx], "INTERSECT")
-                prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
-                t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
-                closer = (prim >= 0) & (t < best.t[idx])
-                k = idx[closer]
-                best.t[k] = t[closer]
-                best.prim[k] = prim[closer] + part.base
-                best.u[k] = np.concatenate([p["u"] for p in parts])[closer]
-                best.v[k] = np.concatenate([p["v"] for p in parts])[closer]
-                limit[k] = t[closer]
+                for a, found in zip(range(0, len(idx), _CHUNK), self._run(scene, o, d, limit[idx], "INTERSECT")):
+                    _keep_closer(idx[a:a + _CHUNK], found["primID"], found["tfar"], found["u"], found["v"],
+                                 part.base, best.t, best.prim, best.u, best.v, limit)
         return best
 
     def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
@@ -541,6 +534,17 @@ def _spawns(pos, ng, direction, scale, out):
     for i in range(len(pos)):
         out[i, 0], out[i, 1], out[i, 2] = spawn_point(pos[i, 0], pos[i, 1], pos[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
                                                       direction[i, 0], direction[i, 1], direction[i, 2], scale[i])
+
+
+@kernel
+def _keep_closer(index, prim, t, u, v, base, best_t, best_prim, best_u, best_v, limit):
+    """Merge one Embree answer for rays ``index`` into the closest hits so far."""
+    for j in range(len(index)):
+        r = index[j]
+        if prim[j] >= 0 and t[j] < best_t[r]:
+            best_t[r] = limit[r] = t[j]
+            best_prim[r] = prim[j] + base
+            best_u[r], best_v[r] = u[j], v[j]
 
 
 @kernel
