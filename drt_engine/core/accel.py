@@ -14,7 +14,10 @@ precision and motion are ours to manage:
   float32 error of the hit.
 
 Triangles of all parts share one global numbering, so materials, normals and lights
-index the same arrays whatever part a hit came from.
+index the same arrays whatever part a hit came from. The per-ray arithmetic (hit
+reconstruction, the terminator lift, offsets, carrying rays into a part's frame) is in
+scalar kernels over ``Geometry.tables``, flat arrays a fused stage kernel can read too;
+Embree is called in batches between them.
 """
 from __future__ import annotations
 
@@ -71,7 +74,7 @@ class _Part:
     center: np.ndarray
     scenes: list
     motion: Motion | None = None
-    buckets: list | None = None  # deform: (world vertices of the part, mirrored) per time bucket
+    buckets: list | None = None  # deform, until Geometry.tables stacks them: (world vertices, mirrored) per bucket
     first_vertex: int = 0
 
 
