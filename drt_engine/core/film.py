@@ -162,15 +162,17 @@ class Film:
         self.lo = np.full((self.n, 3), np.inf) if track_range else None
         self.hi = np.full((self.n, 3), -np.inf) if track_range else None
 
-    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray):
-        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4)."""
+    def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray, replicate=None):
+        """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4);
+        ``replicate`` the samples' replicate (0 or 1), else ``self.replicate``; None splits them by id."""
         if len(pixel) == 0:
             return
         pixel = pixel if pixel.dtype == np.int64 else pixel.astype(np.int64)
         for name, total in self.sums.items():
             _splat(pixel, values[name], total)
         combined = values["Combined"]
-        replicate = -1 if self.replicate is None else int(self.replicate)
+        replicate = self.replicate if replicate is None else replicate
+        replicate = -1 if replicate is None else int(replicate)
         _splat_counts(pixel, np.asarray(sample, dtype=np.int64), combined, replicate,
                       self.count, self.count_a, self.sum_a)
         if self.lo is not None:
