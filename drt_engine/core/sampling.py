@@ -14,6 +14,10 @@ Patterns:
 - JITTERED: n x n stratified jitter for each pair of dimensions, strata visited in a
   per-pixel, per-pair random order.
 - GRID: regular n x n supersampling (stratum centres); only square counts.
+
+``sample_1d``/``sample_2d`` give one camera sample's value(s) from flat numbers
+(``Sampler.params``), so a stage kernel can draw its own; ``Sampler.get``/``get2d`` draw
+a wave's in one kernel call. Both are bit-identical to the NumPy versions they replaced.
 """
 from __future__ import annotations
 
