@@ -107,11 +107,11 @@ def frame_at(translation, quat, stretch, time, m):
     for k in range(4):
         cos += quat[i, k] * quat[j, k]
     cos = min(max(cos, -1.0), 1.0)
-    theta = math.acos(cos)
-    sin = math.sin(theta)
-    if sin < 1e-6:
+    if 1.0 - cos * cos < 1e-12:  # sin(theta) < 1e-6 (a step without turning): slerp is a lerp
         a, b = 1.0 - u, u
     else:
+        theta = math.acos(cos)
+        sin = math.sin(theta)
         a, b = math.sin((1.0 - u) * theta) / sin, math.sin(u * theta) / sin
     w, x, y, z = (a * quat[i, 0] + b * quat[j, 0], a * quat[i, 1] + b * quat[j, 1],
                   a * quat[i, 2] + b * quat[j, 2], a * quat[i, 3] + b * quat[j, 3])
