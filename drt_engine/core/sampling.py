@@ -139,8 +139,8 @@ SOBOL_TABLES = _byte_tables(_sobol_matrices())
 @kernel
 def sobol32(index, dim, tables):
     """Unscrambled Sobol point ``index`` in dimension ``dim`` (0-3) as 32-bit fixed point."""
-    return (tables[dim, 0, index & 0xFF] ^ tables[dim, 1, (index >> 8) & 0xFF]
-            ^ tables[dim, 2, (index >> 16) & 0xFF] ^ tables[dim, 3, (index >> 24) & 0xFF])
+    return int(tables[dim, 0, index & 0xFF] ^ tables[dim, 1, (index >> 8) & 0xFF]
+               ^ tables[dim, 2, (index >> 16) & 0xFF] ^ tables[dim, 3, (index >> 24) & 0xFF])
 
 
 @kernel
