@@ -14,7 +14,10 @@ precision and motion are ours to manage:
   float32 error of the hit.
 
 Triangles of all parts share one global numbering, so materials, normals and lights
-index the same arrays whatever part a hit came from.
+index the same arrays whatever part a hit came from. The per-ray arithmetic (hit
+reconstruction, the terminator lift, offsets, carrying rays into a part's frame) is in
+scalar kernels over ``Geometry.tables``, flat arrays a fused stage kernel can read too;
+Embree is called in batches between them.
 """
 from __future__ import annotations
 
@@ -22,9 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import microfacet as mf
 from .errors import SceneError
-from .motion import Motion, inverse3
+from .jit import kernel
+from .motion import Motion, frame_at, invert_frame, unit3
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
@@ -32,6 +35,7 @@ _EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates h
 _CHUNK = 1 << 16  # rays per Embree call: bounds its output buffers
 _FAR = np.float32(3.0e38)
 DEFORM_BUCKETS = 8
+_KINDS = {"static": 0, "rigid": 1, "deform": 2}
 
 
 @dataclass
@@ -50,18 +54,17 @@ class Hits:
 
 @dataclass
 class RayTimes:
-    """Shutter times of a batch of rays with every rigidly moving part's transform at them.
+    """Shutter times of a batch of rays (None when nothing moves).
 
-    A path keeps its camera sample's time down the whole tree, so the transforms (slerp,
-    matrix, inverse) are computed once per camera sample and gathered as paths go on.
+    A path keeps its camera sample's time down its whole tree. Kernels work out a moving
+    part's transform at a ray's time where they need it: a slerp and a 3x3 inverse cost
+    less than gathering precomputed transforms as paths go on.
     """
 
     values: np.ndarray | None
-    frames: dict  # part index -> (linear (N, 3, 3), translation (N, 3), inverse of linear)
 
     def __getitem__(self, index) -> "RayTimes":
-        values = None if self.values is None else self.values[index]
-        return RayTimes(values, {k: tuple(a[index] for a in f) for k, f in self.frames.items()})
+        return RayTimes(None if self.values is None else self.values[index])
 
 
 @dataclass
@@ -72,7 +75,7 @@ class _Part:
     center: np.ndarray
     scenes: list
     motion: Motion | None = None
-    buckets: list | None = None  # deform: (world vertices of the part, mirrored) per time bucket
+    buckets: list | None = None  # deform, until Geometry.tables stacks them: (world vertices, mirrored) per bucket
     first_vertex: int = 0
 
 
@@ -200,6 +203,7 @@ class Geometry:
         self.tri_scale = np.maximum(np.abs(rel).max(axis=(1, 2)), world) if len(rel) else np.zeros(0)
         for part in self.parts:
             self._build(part)
+        self.tables = self._tables()
 
     # -- construction helpers ------------------------------------------------------
     def _mid_world_normals(self, n_world):
@@ -250,6 +254,35 @@ class Geometry:
                 part.buckets.append((v, np.linalg.det(m[:3, :3]) < 0))
                 part.scenes.append(_embree(v - part.center, keep_tri))
 
+    def _tables(self):
+        """Everything the hit kernels read, as one tuple of flat arrays (see ``hit_surface``).
+
+        Per part: kind, the rows of its shutter steps in the stacked motion tables, the
+        first row of its vertices in the stacked deform buckets (and which buckets mirror)."""
+        n_parts = max(len(self.parts), 1)
+        kind = np.zeros(n_parts, np.int64)
+        steps = np.zeros((n_parts, 2), np.int64)  # first row and count in the motion tables
+        deform = np.zeros(n_parts, np.int64)  # offset from global vertex ids to bucket rows
+        mirrored = np.zeros((n_parts, DEFORM_BUCKETS), np.bool_)
+        motion = [np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3, 3))]
+        buckets, rows = [], 0
+        for k, part in enumerate(self.parts):
+            kind[k] = _KINDS[part.kind]
+            if part.kind == "rigid":
+                table = part.motion.table
+                steps[k] = len(motion[0]), len(table[0])
+                motion = [np.concatenate([a, b]) for a, b in zip(motion, table)]
+            elif part.kind == "deform" and part.scenes:
+                deform[k] = rows - part.first_vertex
+                buckets.append(np.stack([v for v, _ in part.buckets]))
+                mirrored[k] = [m for _, m in part.buckets]
+                rows += buckets[-1].shape[1]
+                part.buckets = None  # the rows below hold them
+        bucket_vertices = np.concatenate(buckets, axis=1) if buckets else np.zeros((DEFORM_BUCKETS, 0, 3))
+        ns = self.ns if self.ns is not None else np.zeros((0, 3, 3))
+        return (self.vertices, self.triangles, self.ng, ns, self.part, kind, steps,
+                motion[0], motion[1], motion[2], deform, bucket_vertices, mirrored, self.center, self.tri_scale)
+
     # -- queries ---------------------------------------------------------------------
     @property
     def triangle_count(self) -> int:
@@ -259,36 +292,25 @@ class Geometry:
     def moving(self) -> bool:
         return any(p.kind != "static" for p in self.parts)
 
-    def _run(self, scene, origins, directions, tmax, query):
-        o = np.ascontiguousarray(origins, dtype=np.float32)
-        d = np.ascontiguousarray(directions, dtype=np.float32)
+    def _run(self, scene, o, d, tmax, query):
         far = np.minimum(tmax, _FAR).astype(np.float32)
         output = 1 if query == "INTERSECT" else 0
         return [scene.run(o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query=query, output=output)
                 for a in range(0, max(len(o), 1), _CHUNK)]
 
     def ray_times(self, time) -> RayTimes:
-        """Times (or None when nothing moves) with the transforms of the moving parts at them."""
+        """The times as a RayTimes (None when nothing moves)."""
         if isinstance(time, RayTimes):
             return time
-        frames = {}
-        for k, part in enumerate(self.parts):
-            if part.kind == "rigid":
-                linear, translation = part.motion.at(time)
-                frames[k] = (linear, translation, inverse3(linear))
-        return RayTimes(None if time is None else np.asarray(time), frames)
+        return RayTimes(None if time is None else np.asarray(time, dtype=np.float64))
 
     def _rays_in(self, k: int, origins, directions, times: RayTimes, index):
-        """(origins, directions) of rays ``index`` (ascending, no repeats) in part k's Embree frame."""
-        part = self.parts[k]
-        if len(index) == len(origins):  # then index is every ray, in order: no gathers
-            index = slice(None)
-        if part.kind == "rigid":
-            _, translation, inv = (a[index] for a in times.frames[k])
-            o = np.einsum("nij,nj->ni", inv, origins[index] - translation) - part.center
-            d = np.einsum("nij,nj->ni", inv, directions[index])
-            return o, d
-        return origins[index] - part.center, directions[index]
+        """float32 (origins, directions) of rays ``index`` in part k's Embree frame."""
+        o = np.empty((len(index), 3), np.float32)
+        d = np.empty((len(index), 3), np.float32)
+        t = times.values if self.parts[k].kind == "rigid" else np.zeros(0)
+        _to_part(self.tables, k, origins, directions, t, index, self.parts[k].center, o, d)
+        return o, d
 
     def _groups(self, part: _Part, n: int, time):
         """(scene, ray indices) pairs a part must answer for n rays."""
@@ -309,16 +331,9 @@ class Geometry:
                 if len(idx) == 0:
                     continue
                 o, d = self._rays_in(pk, origins, directions, times, idx)
-                parts = self._run(scene, o, d, limit[idx], "INTERSECT")
-                prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
-                t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
-                closer = (prim >= 0) & (t < best.t[idx])
-                k = idx[closer]
-                best.t[k] = t[closer]
-                best.prim[k] = prim[closer] + part.base
-                best.u[k] = np.concatenate([p["u"] for p in parts])[closer]
-                best.v[k] = np.concatenate([p["v"] for p in parts])[closer]
-                limit[k] = t[closer]
+                for a, found in zip(range(0, len(idx), _CHUNK), self._run(scene, o, d, limit[idx], "INTERSECT")):
+                    _keep_closer(idx[a:a + _CHUNK], found["primID"], found["tfar"], found["u"], found["v"],
+                                 part.base, best.t, best.prim, best.u, best.v, limit)
         return best
 
     def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
@@ -338,82 +353,228 @@ class Geometry:
 
     def surface(self, hits: Hits, index: np.ndarray, time=None):
         """Float64 world position, geometric and shading normal of hits[index]."""
-        prim = hits.prim[index]
-        u, v = hits.u[index], hits.v[index]
-        w = 1.0 - u - v
-        bary = np.stack([w, u, v], axis=1)
-        p = self.vertices[self.triangles[prim]]
-        ng = self.ng[prim].copy()
-        ns = self._interpolated_normals(prim, bary, ng)
-        times = self.ray_times(time) if self.moving else None
-        for k, part in enumerate(self.parts):
-            if part.kind == "static":
-                continue
-            sel = np.flatnonzero(self.part[prim] == k)
-            if len(sel) == 0:
-                continue
-            rays = index[sel]
-            if part.kind == "rigid":  # this part's transforms only: gathering every part's is quadratic
-                linear, translation, inv = (a[rays] for a in times.frames[k])
-                normal_matrix = np.transpose(inv, (0, 2, 1))
-                p[sel] = np.einsum("nij,nkj->nki", linear, p[sel]) + translation[:, None, :]
-                ng[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ng[sel]), 1e-300)
-                ns[sel] = mf.normalize(np.einsum("nij,nj->ni", normal_matrix, ns[sel]), 1e-300)
-            else:
-                bucket = np.minimum((times.values[rays] * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
-                for b in np.unique(bucket):
-                    world, mirrored = part.buckets[b]
-                    s = sel[bucket == b]
-                    p[s] = world[self.triangles[prim[s]] - part.first_vertex]
-                    n_b, length = _cross_normals(p[s])
-                    ng[s] = n_b / np.maximum(length, 1e-300)[:, None] * (-1.0 if mirrored else 1.0)
-        pos = np.einsum("ni,nij->nj", bary, p)
-        return pos, ng, ns
+        n = len(index)
+        out = np.empty((n, 9))
+        _surfaces(self.tables, hits.prim, hits.u, hits.v, self._time_values(time), np.asarray(index), out)
+        return out[:, 0:3], out[:, 3:6], out[:, 6:9]
 
     def smooth_offset(self, hits: Hits, index: np.ndarray, time=None) -> np.ndarray:
-        """World vector from hits[index] to the smooth surface its corner normals describe.
-
-        Hanika's shadow-terminator fix (Ray Tracing Gems II, ch. 4), as Cycles applies it:
-        the hit is moved, for each corner, onto that corner's tangent plane where it lies
-        below it, and the moves are blended by the barycentrics. Zero on flat triangles.
-        """
+        """World vector from hits[index] to the smooth surface its corner normals describe (see
+        ``lift``); zero on flat triangles."""
         out = np.zeros((len(index), 3))
         if self.ns is None or len(index) == 0:
             return out
-        prim = hits.prim[index]
-        bary = np.stack([1.0 - hits.u[index] - hits.v[index], hits.u[index], hits.v[index]], axis=1)
-        corners = self.vertices[self.triangles[prim]]
-        normals = self.ns[prim]
-        p = np.einsum("ni,nij->nj", bary, corners)
-        to_p = p[:, None, :] - corners
-        below = np.minimum(np.einsum("nij,nij->ni", to_p, normals), 0.0)
-        out = np.einsum("ni,nij->nj", bary, -below[:, :, None] * normals)
-        times = self.ray_times(time) if self.moving else None
-        for k, part in enumerate(self.parts):
-            if part.kind != "rigid":
-                continue
-            sel = np.flatnonzero(self.part[prim] == k)
-            if len(sel):
-                linear = times.frames[k][0][index[sel]]
-                out[sel] = np.einsum("nij,nj->ni", linear, out[sel])
+        _lifts(self.tables, hits.prim, hits.u, hits.v, self._time_values(time), np.asarray(index), out)
         return out
 
-    def _interpolated_normals(self, prim, bary, ng):
-        if self.ns is None:
-            return ng.copy()
-        c = self.ns[prim]
-        return mf.normalize(np.einsum("ni,nij->nj", bary, c), 1e-300)
+    def _time_values(self, time) -> np.ndarray:
+        if not self.moving or time is None:
+            return np.zeros(0)
+        return self.ray_times(time).values
 
     def offset_scale(self, prim: np.ndarray, pos: np.ndarray) -> np.ndarray:
         """Distance that safely clears the surface of triangle ``prim`` at ``pos``."""
-        local = mf.max3(np.abs(pos - self.center))
-        return _EPS_REL * np.maximum(self.tri_scale[prim], local) + 1e-30
+        out = np.empty(len(prim))
+        _offset_scales(self.tables, prim, pos, out)
+        return out
 
 
 def spawn(pos: np.ndarray, ng: np.ndarray, direction: np.ndarray, scale: np.ndarray) -> np.ndarray:
-    """Ray origin pushed off the surface to the side ``direction`` leaves through."""
-    side = np.where(np.einsum("ij,ij->i", ng, direction) >= 0.0, 1.0, -1.0)
-    return pos + ng * (side * scale)[:, None]
+    """Ray origins pushed off the surface to the side ``direction`` leaves through."""
+    out = np.empty((len(pos), 3))
+    _spawns(pos, ng, direction, scale, out)
+    return out
+
+
+# -- kernels: one hit, one ray -----------------------------------------------------------
+@kernel
+def part_frame(geo, k, time, m):
+    """Object-to-world transform m (3, 4) of rigid part k at shutter fraction ``time``."""
+    steps, translation, quat, stretch = geo[6], geo[7], geo[8], geo[9]
+    a, count = steps[k, 0], steps[k, 1]
+    frame_at(translation[a:a + count], quat[a:a + count], stretch[a:a + count], time, m)
+
+
+@kernel
+def _bucket(time):
+    return min(int(time * DEFORM_BUCKETS), DEFORM_BUCKETS - 1)
+
+
+@kernel
+def hit_surface(geo, prim, u, v, time, scratch):
+    """World position, geometric and shading normal of the hit (prim, u, v) at ``time``.
+
+    Positions are rebuilt in float64 from the barycentrics; a rigid part's are carried to
+    the world by its transform at the ray's time, its normals by the inverse transpose; a
+    deforming part's come from the time bucket the ray was traced in. ``scratch`` is a
+    (2, 3, 4) work array.
+    """
+    vertices, triangles, ng_all, ns_all, part, kind = geo[0], geo[1], geo[2], geo[3], geo[4], geo[5]
+    w = 1.0 - u - v
+    k = part[prim]
+    i0, i1, i2 = triangles[prim, 0], triangles[prim, 1], triangles[prim, 2]
+    if kind[k] == 2:
+        b = _bucket(time)
+        rows, src = geo[10][k], geo[11][b]
+        ax, ay, az = src[i0 + rows, 0], src[i0 + rows, 1], src[i0 + rows, 2]
+        bx, by, bz = src[i1 + rows, 0], src[i1 + rows, 1], src[i1 + rows, 2]
+        cx, cy, cz = src[i2 + rows, 0], src[i2 + rows, 1], src[i2 + rows, 2]
+    else:
+        ax, ay, az = vertices[i0, 0], vertices[i0, 1], vertices[i0, 2]
+        bx, by, bz = vertices[i1, 0], vertices[i1, 1], vertices[i1, 2]
+        cx, cy, cz = vertices[i2, 0], vertices[i2, 1], vertices[i2, 2]
+    gx, gy, gz = ng_all[prim, 0], ng_all[prim, 1], ng_all[prim, 2]
+    if len(ns_all):
+        c = ns_all[prim]
+        sx, sy, sz = unit3(w * c[0, 0] + u * c[1, 0] + v * c[2, 0], w * c[0, 1] + u * c[1, 1] + v * c[2, 1],
+                           w * c[0, 2] + u * c[1, 2] + v * c[2, 2], 1e-300)
+    else:
+        sx, sy, sz = gx, gy, gz
+    px = w * ax + u * bx + v * cx
+    py = w * ay + u * by + v * cy
+    pz = w * az + u * bz + v * cz
+    if kind[k] == 1:
+        m, inv = scratch[0], scratch[1]
+        part_frame(geo, k, time, m)
+        invert_frame(m, inv)
+        px, py, pz = (m[0, 0] * px + m[0, 1] * py + m[0, 2] * pz + m[0, 3],
+                      m[1, 0] * px + m[1, 1] * py + m[1, 2] * pz + m[1, 3],
+                      m[2, 0] * px + m[2, 1] * py + m[2, 2] * pz + m[2, 3])
+        gx, gy, gz = unit3(inv[0, 0] * gx + inv[1, 0] * gy + inv[2, 0] * gz,
+                           inv[0, 1] * gx + inv[1, 1] * gy + inv[2, 1] * gz,
+                           inv[0, 2] * gx + inv[1, 2] * gy + inv[2, 2] * gz, 1e-300)
+        sx, sy, sz = unit3(inv[0, 0] * sx + inv[1, 0] * sy + inv[2, 0] * sz,
+                           inv[0, 1] * sx + inv[1, 1] * sy + inv[2, 1] * sz,
+                           inv[0, 2] * sx + inv[1, 2] * sy + inv[2, 2] * sz, 1e-300)
+    elif kind[k] == 2:
+        ex, ey, ez = bx - ax, by - ay, bz - az
+        fx, fy, fz = cx - ax, cy - ay, cz - az
+        gx, gy, gz = unit3(ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx, 1e-300)
+        if geo[12][k, _bucket(time)]:
+            gx, gy, gz = -gx, -gy, -gz
+    return px, py, pz, gx, gy, gz, sx, sy, sz
+
+
+@kernel
+def lift(geo, prim, u, v, time, scratch):
+    """World vector from the hit to the smooth surface its corner normals describe.
+
+    Hanika's shadow-terminator fix (Ray Tracing Gems II, ch. 4), as Cycles applies it:
+    the hit is moved, for each corner, onto that corner's tangent plane where it lies
+    below it, and the moves are blended by the barycentrics. Zero on flat triangles.
+    """
+    vertices, triangles, ns = geo[0], geo[1], geo[3]
+    if len(ns) == 0:
+        return 0.0, 0.0, 0.0
+    bary = (1.0 - u - v, u, v)
+    px = py = pz = 0.0
+    for j in range(3):
+        i = triangles[prim, j]
+        px += bary[j] * vertices[i, 0]
+        py += bary[j] * vertices[i, 1]
+        pz += bary[j] * vertices[i, 2]
+    ox = oy = oz = 0.0
+    for j in range(3):
+        i = triangles[prim, j]
+        nx, ny, nz = ns[prim, j, 0], ns[prim, j, 1], ns[prim, j, 2]
+        below = min((px - vertices[i, 0]) * nx + (py - vertices[i, 1]) * ny + (pz - vertices[i, 2]) * nz, 0.0)
+        ox -= bary[j] * below * nx
+        oy -= bary[j] * below * ny
+        oz -= bary[j] * below * nz
+    k = geo[4][prim]
+    if geo[5][k] == 1:
+        m = scratch[0]
+        part_frame(geo, k, time, m)
+        ox, oy, oz = (m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz, m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz,
+                      m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz)
+    return ox, oy, oz
+
+
+@kernel
+def offset_scale(geo, prim, px, py, pz):
+    """Distance that safely clears the surface of triangle ``prim`` at (px, py, pz): a bound
+    on the float32 error of the hit, from the triangle's and the point's distance to the centre."""
+    center, tri_scale = geo[13], geo[14]
+    local = max(abs(px - center[0]), abs(py - center[1]), abs(pz - center[2]))
+    return _EPS_REL * max(tri_scale[prim], local) + 1e-30
+
+
+@kernel
+def spawn_point(px, py, pz, gx, gy, gz, dx, dy, dz, scale):
+    """Ray origin pushed off the surface (normal g) to the side direction d leaves through."""
+    side = scale if gx * dx + gy * dy + gz * dz >= 0.0 else -scale
+    return px + gx * side, py + gy * side, pz + gz * side
+
+
+# -- kernels: batch loops ------------------------------------------------------------------
+@kernel
+def _time_of(times, r):
+    return times[r] if len(times) else 0.5
+
+
+@kernel
+def _surfaces(geo, prim, u, v, times, index, out):
+    scratch = np.empty((2, 3, 4))
+    for i in range(len(index)):
+        r = index[i]
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5], out[i, 6], out[i, 7], out[i, 8] = \
+            hit_surface(geo, prim[r], u[r], v[r], _time_of(times, r), scratch)
+
+
+@kernel
+def _lifts(geo, prim, u, v, times, index, out):
+    scratch = np.empty((2, 3, 4))
+    for i in range(len(index)):
+        r = index[i]
+        out[i, 0], out[i, 1], out[i, 2] = lift(geo, prim[r], u[r], v[r], _time_of(times, r), scratch)
+
+
+@kernel
+def _offset_scales(geo, prim, pos, out):
+    for i in range(len(prim)):
+        out[i] = offset_scale(geo, prim[i], pos[i, 0], pos[i, 1], pos[i, 2])
+
+
+@kernel
+def _spawns(pos, ng, direction, scale, out):
+    for i in range(len(pos)):
+        out[i, 0], out[i, 1], out[i, 2] = spawn_point(pos[i, 0], pos[i, 1], pos[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
+                                                      direction[i, 0], direction[i, 1], direction[i, 2], scale[i])
+
+
+@kernel
+def _keep_closer(index, prim, t, u, v, base, best_t, best_prim, best_u, best_v, limit):
+    """Merge one Embree answer for rays ``index`` into the closest hits so far."""
+    for j in range(len(index)):
+        r = index[j]
+        if prim[j] >= 0 and t[j] < best_t[r]:
+            best_t[r] = limit[r] = t[j]
+            best_prim[r] = prim[j] + base
+            best_u[r], best_v[r] = u[j], v[j]
+
+
+@kernel
+def _to_part(geo, k, origins, directions, times, index, center, o, d):
+    """Rays ``index`` in part k's Embree frame (float32): object space at each ray's time for a
+    rigid part (directions not renormalised: distances stay world distances), less the centre."""
+    m = np.empty((3, 4))
+    inv = np.empty((3, 4))
+    rigid = geo[5][k] == 1
+    for i in range(len(index)):
+        r = index[i]
+        x, y, z = origins[r, 0], origins[r, 1], origins[r, 2]
+        dx, dy, dz = directions[r, 0], directions[r, 1], directions[r, 2]
+        if rigid:
+            part_frame(geo, k, times[r], m)
+            invert_frame(m, inv)
+            x, y, z = x - m[0, 3], y - m[1, 3], z - m[2, 3]
+            x, y, z = (inv[0, 0] * x + inv[0, 1] * y + inv[0, 2] * z, inv[1, 0] * x + inv[1, 1] * y + inv[1, 2] * z,
+                       inv[2, 0] * x + inv[2, 1] * y + inv[2, 2] * z)
+            dx, dy, dz = (inv[0, 0] * dx + inv[0, 1] * dy + inv[0, 2] * dz,
+                          inv[1, 0] * dx + inv[1, 1] * dy + inv[1, 2] * dz,
+                          inv[2, 0] * dx + inv[2, 1] * dy + inv[2, 2] * dz)
+        o[i, 0], o[i, 1], o[i, 2] = x - center[0], y - center[1], z - center[2]
+        d[i, 0], d[i, 1], d[i, 2] = dx, dy, dz
 
 
 def _normal_matrix(linear: np.ndarray) -> np.ndarray:

@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from .jit import kernel
 from .settings import PASS_CHANNELS
 
 _TABLE = 1024
 _BUCKETS = 1 << 14  # uniform cells over u that locate a sample's segment of the filter table
 _IMAGE_BLOCK = 1 << 20  # pixels per block when the passes are read out
-_ODD_BITS = np.uint32(0xAAAAAAAA)
+_ODD_BITS = 0xAAAAAAAA
 
 
 def _filter_profile(kind: str, width: float, x: np.ndarray) -> np.ndarray:
@@ -59,34 +60,86 @@ class PixelFilter:
         self._steps = int(np.ceil(np.log2(np.diff(self._first).max() + 1)))
 
     def offset(self, u: np.ndarray) -> np.ndarray:
-        """``np.interp(u, cdf, x)``, computed the same way, but each u finds its table segment
-        from a uniform grid over u and a few bisection steps inside its cell (np.interp bisects
-        all 1024 segments: 9% of a diffuse scene's render time)."""
-        k = np.minimum((u * _BUCKETS).astype(np.intp), _BUCKETS - 1)
-        lo, hi = self._first[k], self._first[k + 1]
-        for _ in range(self._steps):
-            mid = (lo + hi + 1) >> 1
-            up = u >= self._cdf[mid]
-            lo, hi = np.where(up, mid, lo), np.where(up, hi, mid - 1)
-        return self._slope[lo] * (u - self._cdf[lo]) + self._x[lo]
+        """``np.interp(u, cdf, x)``, computed the same way (see ``filter_offset``)."""
+        out = np.empty(u.shape)
+        _offsets(self.table, u.reshape(-1), out.reshape(-1))
+        return out
+
+    @property
+    def table(self):
+        """What ``filter_offset`` takes before u (flat arrays and the bisection depth)."""
+        return self._cdf, self._x, self._slope, self._first, self._steps
 
 
-def sample_is_class_a(sample: np.ndarray) -> np.ndarray:
+@kernel
+def filter_offset(cdf, x, slope, first, steps, u):
+    """Offset from the pixel centre for the value u: the filter's inverse CDF, interpolated.
+
+    Each u finds its table segment from a uniform grid over u and a few bisection steps
+    inside its cell (bisecting all 1024 segments, as np.interp does, cost 9% of a diffuse
+    scene's render time in NumPy)."""
+    k = min(int(u * _BUCKETS), _BUCKETS - 1)
+    lo, hi = first[k], first[k + 1]
+    for _ in range(steps):
+        mid = (lo + hi + 1) >> 1
+        if u >= cdf[mid]:
+            lo = mid
+        else:
+            hi = mid - 1
+    return slope[lo] * (u - cdf[lo]) + x[lo]
+
+
+@kernel
+def _offsets(table, u, out):
+    cdf, x, slope, first, steps = table
+    for i in range(len(u)):
+        out[i] = filter_offset(cdf, x, slope, first, steps, u[i])
+
+
+@kernel
+def sample_is_class_a(sample):
     """Cycles' split of sample ids into two classes: odd parity of the odd-position bits.
 
     Ids 0..4k-1 hold exactly 2k of each class, and each class of a (0, 2)-sequence
     stays stratified, so a half estimate is nearly as good as a full one of half size.
     """
-    return _popcount_parity(np.asarray(sample, dtype=np.uint32) & _ODD_BITS)
+    x = sample & _ODD_BITS
+    x ^= x >> 16
+    x ^= x >> 8
+    x ^= x >> 4
+    x ^= x >> 2
+    x ^= x >> 1
+    return (x & 1) == 1
 
 
-def _popcount_parity(x: np.ndarray) -> np.ndarray:
-    x = x ^ (x >> np.uint32(16))
-    x = x ^ (x >> np.uint32(8))
-    x = x ^ (x >> np.uint32(4))
-    x = x ^ (x >> np.uint32(2))
-    x = x ^ (x >> np.uint32(1))
-    return (x & np.uint32(1)).astype(bool)
+@kernel
+def _splat(pixel, values, total):
+    """Add each sample's values to its pixel's sums, in wave order (a fixed order for any
+    thread count, so the sums are bit-identical)."""
+    for i in range(len(pixel)):
+        for c in range(values.shape[1]):
+            total[pixel[i], c] += values[i, c]
+
+
+@kernel
+def _splat_counts(pixel, sample, combined, replicate, count, count_a, sum_a):
+    """Sample counts, and the count and Combined RGB sums of class A: the samples of replicate 1,
+    or (replicate < 0: GRID, nothing to replicate) the class of each sample id."""
+    for i in range(len(pixel)):
+        p = pixel[i]
+        count[p] += 1.0
+        if sample_is_class_a(int(sample[i])) if replicate < 0 else replicate == 1:
+            count_a[p] += 1.0
+            for c in range(3):
+                sum_a[p, c] += combined[i, c]
+
+
+@kernel
+def _extend_range(pixel, combined, lo, hi):
+    for i in range(len(pixel)):
+        for c in range(3):
+            lo[pixel[i], c] = min(lo[pixel[i], c], combined[i, c])
+            hi[pixel[i], c] = max(hi[pixel[i], c], combined[i, c])
 
 
 class Film:
@@ -110,31 +163,18 @@ class Film:
 
     def add(self, pixel: np.ndarray, values: dict[str, np.ndarray], sample: np.ndarray, replicate=None):
         """Accumulate one wave of camera samples; ``values`` per pass, Combined as (N, 4);
-        ``replicate`` the samples' replicate (0 or 1), or None to split them by id.
-
-        Sums run over the pixel range the wave touches (a wave of a large image covers a
-        band of it), so the cost follows the wave, not the image.
-        """
+        ``replicate`` the samples' replicate (0 or 1); None splits them by sample id (GRID)."""
         if len(pixel) == 0:
             return
-        lo = int(pixel.min())
-        span = slice(lo, int(pixel.max()) + 1)
-        m = span.stop - lo
-        local = pixel - lo
-        self.count[span] += np.bincount(local, minlength=m)
+        pixel = pixel if pixel.dtype == np.int64 else pixel.astype(np.int64)
         for name, total in self.sums.items():
-            v = values[name]
-            for c in range(v.shape[1]):
-                total[span, c] += np.bincount(local, weights=v[:, c], minlength=m)
-        a = sample_is_class_a(sample) if replicate is None else np.full(len(pixel), replicate == 1)
-        la = local[a]
-        self.count_a[span] += np.bincount(la, minlength=m)
-        rgb = values["Combined"][a, :3]
-        for c in range(3):
-            self.sum_a[span, c] += np.bincount(la, weights=rgb[:, c], minlength=m)
+            _splat(pixel, values[name], total)
+        combined = values["Combined"]
+        replicate = -1 if replicate is None else int(replicate)
+        _splat_counts(pixel, np.asarray(sample, dtype=np.int64), combined, replicate,
+                      self.count, self.count_a, self.sum_a)
         if self.lo is not None:
-            np.minimum.at(self.lo, pixel, values["Combined"][:, :3])
-            np.maximum.at(self.hi, pixel, values["Combined"][:, :3])
+            _extend_range(pixel, combined, self.lo, self.hi)
 
     def mean(self, name: str) -> np.ndarray:
         return self.sums[name] / np.maximum(self.count, 1)[:, None]

@@ -14,6 +14,10 @@ Patterns:
 - JITTERED: n x n stratified jitter for each pair of dimensions, strata visited in a
   per-pixel, per-pair random order.
 - GRID: regular n x n supersampling (stratum centres); only square counts.
+
+``sample_1d``/``sample_2d`` give one camera sample's value(s) from flat numbers
+(``Sampler.params``), so a stage kernel can draw its own; ``Sampler.get``/``get2d`` draw
+a wave's in one kernel call. Both are bit-identical to the NumPy versions they replaced.
 """
 from __future__ import annotations
 
@@ -21,58 +25,79 @@ import math
 
 import numpy as np
 
-_U32 = np.uint32
+from .jit import kernel
+
+# Integer arithmetic runs on 64-bit ints masked to 32 bits (Python ints when NUMBA_DISABLE_JIT=1):
+# the low 32 bits of a product are exact either way, and no unsigned/signed mixing can turn
+# an expression into floats in Numba.
+_MASK = 0xFFFFFFFF
+_GOLDEN = 0x9E3779B9
+SOBOL, JITTERED, GRID = 0, 1, 2
+_PATTERNS = {"SOBOL": SOBOL, "JITTERED": JITTERED, "GRID": GRID}
 
 
-def hash_u32(x: np.ndarray) -> np.ndarray:
-    """A well-mixing 32-bit integer hash (lowbias32), vectorised."""
-    x = np.array(x, dtype=_U32, copy=True, ndmin=1)
-    x ^= x >> _U32(16)
-    x *= _U32(0x7FEB352D)
-    x ^= x >> _U32(15)
-    x *= _U32(0x846CA68B)
-    x ^= x >> _U32(16)
+@kernel
+def hash32(x):
+    """A well-mixing 32-bit integer hash (lowbias32)."""
+    x &= _MASK
+    x ^= x >> 16
+    x = (x * 0x7FEB352D) & _MASK
+    x ^= x >> 15
+    x = (x * 0x846CA68B) & _MASK
+    x ^= x >> 16
     return x
+
+
+@kernel
+def hash_mix(h, v):
+    """One step of ``hash_combine``: h folded with the 32-bit value v."""
+    v &= _MASK
+    return hash32(h ^ ((v + _GOLDEN + (h << 6) + (h >> 2)) & _MASK))
+
+
+@kernel
+def _hash_rows(values, out):
+    for i in range(values.shape[0]):
+        h = 0
+        for k in range(values.shape[1]):
+            h = hash_mix(h, int(values[i, k]))
+        out[i] = h
 
 
 def hash_combine(*values) -> np.ndarray:
-    """Hash of several integers or integer arrays (broadcast together)."""
-    h = np.zeros(1, dtype=_U32)
-    for v in values:
-        v = np.atleast_1d(np.asarray(v))  # arrays wrap silently; 0-d scalars would warn
-        v = (v.astype(np.int64) & 0xFFFFFFFF).astype(_U32) if v.dtype != _U32 else v
-        h = hash_u32(h ^ (v + _U32(0x9E3779B9) + (h << _U32(6)) + (h >> _U32(2))))
-    return h
+    """Hash of several integers or integer arrays (broadcast together), as uint32."""
+    arrays = np.broadcast_arrays(*(np.atleast_1d(np.asarray(v)).astype(np.int64) for v in values))
+    rows = np.ascontiguousarray(np.stack(arrays, axis=-1).reshape(-1, len(values)))
+    out = np.empty(len(rows), np.int64)
+    _hash_rows(rows, out)
+    return out.astype(np.uint32).reshape(arrays[0].shape)
 
 
-_M1, _M2, _M4 = _U32(0x55555555), _U32(0x33333333), _U32(0x0F0F0F0F)
+@kernel
+def reverse_bits32(x):
+    """Bit reversal by swapping bits, pairs, nibbles, bytes and halves."""
+    x = ((x >> 1) & 0x55555555) | ((x & 0x55555555) << 1)
+    x = ((x >> 2) & 0x33333333) | ((x & 0x33333333) << 2)
+    x = ((x >> 4) & 0x0F0F0F0F) | ((x & 0x0F0F0F0F) << 4)
+    x = ((x >> 8) & 0x00FF00FF) | ((x & 0x00FF00FF) << 8)
+    return ((x >> 16) | (x << 16)) & _MASK
 
 
-def _reverse_bits(x: np.ndarray) -> np.ndarray:
-    """Bit reversal by swapping bits, pairs and nibbles, then bytes (arithmetic runs ~3x
-    faster than byte-table lookups, which are gathers)."""
-    y = (x >> _U32(1)) & _M1
-    y |= (x & _M1) << _U32(1)
-    z = (y >> _U32(2)) & _M2
-    z |= (y & _M2) << _U32(2)
-    y = (z >> _U32(4)) & _M4
-    y |= (z & _M4) << _U32(4)
-    return y.byteswap(inplace=True)
-
-
-def _laine_karras(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
+@kernel
+def laine_karras(x, seed):
     """Bit j of the result depends only on bits <= j of x (Laine-Karras, Vegdahl's constants)."""
-    x = x + seed
-    x ^= x * _U32(0x6C50B47C)
-    x ^= x * _U32(0xB82F1E52)
-    x ^= x * _U32(0xC7AFE638)
-    x ^= x * _U32(0x8D22F6E6)
+    x = (x + seed) & _MASK
+    x ^= (x * 0x6C50B47C) & _MASK
+    x ^= (x * 0xB82F1E52) & _MASK
+    x ^= (x * 0xC7AFE638) & _MASK
+    x ^= (x * 0x8D22F6E6) & _MASK
     return x
 
 
-def nested_uniform_scramble(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
-    """Owen scrambling of 32-bit fixed-point values: each bit flips by the bits above it."""
-    return _reverse_bits(_laine_karras(_reverse_bits(x), seed))
+@kernel
+def nested_uniform_scramble(x, seed):
+    """Owen scrambling of a 32-bit fixed-point value: each bit flips by the bits above it."""
+    return reverse_bits32(laine_karras(reverse_bits32(x), seed))
 
 
 def _sobol_matrices() -> np.ndarray:
@@ -90,12 +115,12 @@ def _sobol_matrices() -> np.ndarray:
                 for k in range(1, deg):
                     v[i] ^= ((a >> (deg - 1 - k)) & 1) * v[i - k]
         out[d] = v[1:]
-    return out.astype(_U32)
+    return out.astype(np.uint32)
 
 
 def _byte_tables(matrices: np.ndarray) -> np.ndarray:
     """(dims, 4, 256): XOR of the generator columns selected by each byte of the index."""
-    tables = np.zeros((len(matrices), 4, 256), dtype=_U32)
+    tables = np.zeros((len(matrices), 4, 256), dtype=np.int64)
     for d, columns in enumerate(matrices):
         for k in range(4):
             for b in range(256):
@@ -107,61 +132,128 @@ def _byte_tables(matrices: np.ndarray) -> np.ndarray:
     return tables
 
 
-_SOBOL = _byte_tables(_sobol_matrices())
+SOBOL_TABLES = _byte_tables(_sobol_matrices())
+"""(4, 4, 256) int64: what each byte of an index contributes to Sobol dimensions 0-3."""
 
 
-def sobol_u32(index: np.ndarray, dim: int) -> np.ndarray:
-    """Unscrambled Sobol point ``index`` in dimension ``dim`` (1-3; dimension 0, the bit reversal, is
-    Sampler._sobol's own) as 32-bit fixed point."""
-    index = np.asarray(index, dtype=_U32)
-    t = _SOBOL[dim]
-    out = np.take(t[0], index & _U32(0xFF))
-    out ^= np.take(t[1], (index >> _U32(8)) & _U32(0xFF))
-    out ^= np.take(t[2], (index >> _U32(16)) & _U32(0xFF))
-    out ^= np.take(t[3], index >> _U32(24))
-    return out
+@kernel
+def sobol32(index, dim, tables):
+    """Unscrambled Sobol point ``index`` in dimension ``dim`` (0-3) as 32-bit fixed point."""
+    return int(tables[dim, 0, index & 0xFF] ^ tables[dim, 1, (index >> 8) & 0xFF]
+               ^ tables[dim, 2, (index >> 16) & 0xFF] ^ tables[dim, 3, (index >> 24) & 0xFF])
 
 
-def _to_unit(x: np.ndarray) -> np.ndarray:
-    """32-bit fixed point to float64 in [0, 1), never 1.0."""
-    return (x >> _U32(8)).astype(np.float64) * (1.0 / (1 << 24))
+@kernel
+def to_unit(x):
+    """32-bit fixed point to a float in [0, 1), never 1.0."""
+    return (x >> 8) * (1.0 / (1 << 24))
 
 
-def permute(i: np.ndarray, n: int, seed: np.ndarray) -> np.ndarray:
+@kernel
+def permute(i, n, seed):
     """Random permutation of [0, n) applied to i, one per seed (Kensler 2013, cycle walking)."""
-    i = np.array(i, dtype=_U32, copy=True)
-    seed = np.broadcast_to(np.asarray(seed, dtype=_U32), i.shape)
-    w = _U32(n - 1)
-    for s in (1, 2, 4, 8, 16):
-        w |= w >> _U32(s)
-    todo = np.ones(i.shape, dtype=bool)
-    out = np.empty_like(i)
-    while todo.any():
-        x, p = i[todo], seed[todo]
+    w = n - 1
+    w |= w >> 1
+    w |= w >> 2
+    w |= w >> 4
+    w |= w >> 8
+    w |= w >> 16
+    p = seed & _MASK
+    x = i & _MASK
+    while True:
         x ^= p
-        x *= _U32(0xE170893D)
-        x ^= p >> _U32(16)
-        x ^= (x & w) >> _U32(4)
-        x ^= p >> _U32(8)
-        x *= _U32(0x0929EB3F)
-        x ^= p >> _U32(23)
-        x ^= (x & w) >> _U32(1)
-        x *= _U32(1) | (p >> _U32(27))
-        x *= _U32(0x6935FA69)
-        x ^= (x & w) >> _U32(11)
-        x *= _U32(0x74DCB303)
-        x ^= (x & w) >> _U32(2)
-        x *= _U32(0x9E501CC3)
-        x ^= (x & w) >> _U32(2)
-        x *= _U32(0xC860A3DF)
+        x = (x * 0xE170893D) & _MASK
+        x ^= p >> 16
+        x ^= (x & w) >> 4
+        x ^= p >> 8
+        x = (x * 0x0929EB3F) & _MASK
+        x ^= p >> 23
+        x ^= (x & w) >> 1
+        x = (x * (1 | (p >> 27))) & _MASK
+        x = (x * 0x6935FA69) & _MASK
+        x ^= (x & w) >> 11
+        x = (x * 0x74DCB303) & _MASK
+        x ^= (x & w) >> 2
+        x = (x * 0x9E501CC3) & _MASK
+        x ^= (x & w) >> 2
+        x = (x * 0xC860A3DF) & _MASK
         x &= w
-        x ^= x >> _U32(5)
-        done = x < _U32(n)
-        idx = np.flatnonzero(todo)
-        out[idx[done]] = (x[done] + p[done]) % _U32(n)
-        i[idx[~done]] = x[~done]
-        todo[idx[done]] = False
-    return out
+        x ^= x >> 5
+        if x < n:
+            return ((x + p) & _MASK) % n
+
+
+@kernel
+def _sobol_component(pixel_seed, index, dim, c, tables):
+    """Component c of the pair at ``dim`` from its shuffled index.
+
+    The pixel and lens pairs (dimensions 0-3) are one 4D Sobol net, so defocus, whose
+    integrand couples image position and lens position, is stratified jointly; later
+    pairs are padded from Sobol dimensions 0 and 1 with their own shuffles.
+    """
+    scramble = hash32(pixel_seed ^ (((dim + c) * 0x85EBCA6B) & _MASK) ^ 0x0A11)
+    source = dim + c if dim < 4 else c
+    if source == 0:  # Sobol dimension 0 is the bit reversal, which the scramble undoes first
+        return to_unit(reverse_bits32(laine_karras(index, scramble)))
+    return to_unit(nested_uniform_scramble(sobol32(index, source, tables), scramble))
+
+
+@kernel
+def _sobol_index(pixel_seed, sample, dim):
+    """The sample index shuffled for the pair at even ``dim`` (one shuffle for dimensions 0-3)."""
+    group = 0 if dim < 4 else dim
+    return nested_uniform_scramble(sample & _MASK, hash32(pixel_seed ^ ((group * _GOLDEN) & _MASK)))
+
+
+@kernel
+def _stratified(pixel, sample, dim, seed, nx, ny, pattern):
+    """Pair ``dim`` of a jittered or grid sample: a stratum in a per-pixel, per-pair order."""
+    if dim == 0 and pattern == GRID:
+        stratum = sample & _MASK  # the full grid in raster order
+    else:
+        stratum = permute(sample, nx * ny,
+                          hash_mix(hash_mix(hash_mix(hash_mix(0, pixel), dim), seed), 0x57A7))
+    if pattern == GRID:
+        o0 = o1 = 0.5
+    else:
+        h = hash_mix(hash_mix(0, pixel), sample)
+        o0 = to_unit(hash_mix(hash_mix(hash_mix(h, dim), seed), 0x1177))
+        o1 = to_unit(hash_mix(hash_mix(hash_mix(h, dim + 1), seed), 0x1177))
+    return ((stratum % nx) + o0) / nx, ((stratum // nx) + o1) / ny
+
+
+@kernel
+def sample_2d(pattern, seed, nx, ny, tables, pixel, sample, dim):
+    """Dimensions (dim, dim + 1), dim even, of camera sample ``sample`` of ``pixel``."""
+    if pattern == SOBOL:
+        pixel_seed = hash_mix(hash_mix(0, pixel), seed)
+        index = _sobol_index(pixel_seed, sample, dim)
+        return (_sobol_component(pixel_seed, index, dim, 0, tables),
+                _sobol_component(pixel_seed, index, dim, 1, tables))
+    return _stratified(pixel, sample, dim, seed, nx, ny, pattern)
+
+
+@kernel
+def sample_1d(pattern, seed, nx, ny, tables, pixel, sample, dim):
+    """Dimension ``dim`` alone (it shares the stratification of its pair)."""
+    pair = dim - dim % 2
+    if pattern == SOBOL:
+        pixel_seed = hash_mix(hash_mix(0, pixel), seed)
+        return _sobol_component(pixel_seed, _sobol_index(pixel_seed, sample, pair), pair, dim % 2, tables)
+    u0, u1 = _stratified(pixel, sample, pair, seed, nx, ny, pattern)
+    return u1 if dim % 2 else u0
+
+
+@kernel
+def _fill_1d(pattern, seed, nx, ny, tables, pixel, sample, dim, out):
+    for i in range(len(pixel)):
+        out[i] = sample_1d(pattern, seed, nx, ny, tables, int(pixel[i]), int(sample[i]), dim)
+
+
+@kernel
+def _fill_2d(pattern, seed, nx, ny, tables, pixel, sample, dim, out):
+    for i in range(len(pixel)):
+        out[i, 0], out[i, 1] = sample_2d(pattern, seed, nx, ny, tables, int(pixel[i]), int(sample[i]), dim)
 
 
 class Sampler:
@@ -170,6 +262,8 @@ class Sampler:
     ``get(pixel, sample, dim)`` returns float64 values in [0, 1) for arrays of pixel
     ids and sample ids; ``get2d`` returns dims (dim, dim + 1) as an (N, 2) array and
     must be called with an even ``dim`` so both values share a stratification.
+    ``params`` are the numbers ``sample_1d``/``sample_2d`` take before (pixel, sample, dim),
+    for kernels that draw values themselves.
     """
 
     def __init__(self, pattern: str, samples: int, seed: int = 0):
@@ -184,52 +278,21 @@ class Sampler:
             nx = nx if nx * nx >= samples else nx + 1
             self.strata = (nx, -(-samples // nx))
         self.samples = self.strata[0] * self.strata[1] if pattern == "GRID" else samples
+        self.params = (_PATTERNS[pattern], self.seed, self.strata[0], self.strata[1], SOBOL_TABLES)
 
     def get(self, pixel: np.ndarray, sample: np.ndarray, dim: int) -> np.ndarray:
-        if self.pattern == "SOBOL":
-            return self._sobol(pixel, sample, dim - dim % 2, (dim % 2,))[:, 0]
-        return self._stratified(pixel, sample, dim - dim % 2)[:, dim % 2]
+        out = np.empty(len(pixel))
+        _fill_1d(*self.params, _ints(pixel), _ints(sample), int(dim), out)
+        return out
 
     def get2d(self, pixel: np.ndarray, sample: np.ndarray, dim: int) -> np.ndarray:
         assert dim % 2 == 0, "2D dimensions start at an even index"
-        if self.pattern == "SOBOL":
-            return self._sobol(pixel, sample, dim, (0, 1))
-        return self._stratified(pixel, sample, dim)
-
-    def _sobol(self, pixel, sample, dim, components):
-        """Dimensions dim + c for c in components, sharing one shuffled index.
-
-        The pixel and lens pairs (dimensions 0-3) are one 4D Sobol net, so defocus, whose
-        integrand couples image position and lens position, is stratified jointly; later
-        pairs are padded from Sobol dimensions 0 and 1 with their own shuffles.
-        """
-        pixel_seed = hash_combine(pixel, self.seed)
-        group = 0 if dim < 4 else dim
-        index = nested_uniform_scramble(np.asarray(sample, dtype=_U32),
-                                        hash_u32(pixel_seed ^ _U32(group * 0x9E3779B9 & 0xFFFFFFFF)))
-        out = np.empty((len(index), len(components)))
-        for k, c in enumerate(components):
-            scramble = hash_u32(pixel_seed ^ _U32((dim + c) * 0x85EBCA6B & 0xFFFFFFFF) ^ _U32(0x0A11))
-            source = dim + c if dim < 4 else c
-            if source == 0:  # Sobol dimension 0 is the bit reversal, which the scramble undoes first
-                out[:, k] = _to_unit(_reverse_bits(_laine_karras(index, scramble)))
-            else:
-                out[:, k] = _to_unit(nested_uniform_scramble(sobol_u32(index, source), scramble))
+        out = np.empty((len(pixel), 2))
+        _fill_2d(*self.params, _ints(pixel), _ints(sample), int(dim), out)
         return out
 
-    def _stratified(self, pixel, sample, dim):
-        nx, ny = self.strata
-        pixel = np.asarray(pixel)
-        sample = np.asarray(sample, dtype=_U32)
-        if dim == 0 and self.pattern == "GRID":
-            stratum = sample  # the full grid in raster order
-        else:
-            stratum = permute(sample, nx * ny, hash_combine(pixel, dim, self.seed, 0x57A7))
-        cell = np.stack([stratum % _U32(nx), stratum // _U32(nx)], axis=1).astype(np.float64)
-        if self.pattern == "GRID":
-            offset = 0.5
-        else:
-            offset = np.stack(
-                [_to_unit(hash_combine(pixel, sample, dim + k, self.seed, 0x1177)) for k in (0, 1)], axis=1
-            )
-        return (cell + offset) / np.array([nx, ny], dtype=np.float64)
+
+def _ints(a) -> np.ndarray:
+    """int64 ids (one kernel specialisation whatever integer type the caller has)."""
+    a = np.asarray(a)
+    return a if a.dtype == np.int64 else a.astype(np.int64)
