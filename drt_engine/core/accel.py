@@ -27,7 +27,8 @@ import numpy as np
 
 from .errors import SceneError
 from .jit import kernel
-from .motion import Motion, frame_at, invert_frame, unit3
+from .microfacet import unit
+from .motion import Motion, frame_at, invert_frame
 from .scene import SceneData
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
@@ -426,7 +427,7 @@ def hit_surface(geo, prim, u, v, time, scratch):
     gx, gy, gz = ng_all[prim, 0], ng_all[prim, 1], ng_all[prim, 2]
     if len(ns_all):
         c = ns_all[prim]
-        sx, sy, sz = unit3(w * c[0, 0] + u * c[1, 0] + v * c[2, 0], w * c[0, 1] + u * c[1, 1] + v * c[2, 1],
+        sx, sy, sz = unit(w * c[0, 0] + u * c[1, 0] + v * c[2, 0], w * c[0, 1] + u * c[1, 1] + v * c[2, 1],
                            w * c[0, 2] + u * c[1, 2] + v * c[2, 2], 1e-300)
     else:
         sx, sy, sz = gx, gy, gz
@@ -440,16 +441,16 @@ def hit_surface(geo, prim, u, v, time, scratch):
         px, py, pz = (m[0, 0] * px + m[0, 1] * py + m[0, 2] * pz + m[0, 3],
                       m[1, 0] * px + m[1, 1] * py + m[1, 2] * pz + m[1, 3],
                       m[2, 0] * px + m[2, 1] * py + m[2, 2] * pz + m[2, 3])
-        gx, gy, gz = unit3(inv[0, 0] * gx + inv[1, 0] * gy + inv[2, 0] * gz,
+        gx, gy, gz = unit(inv[0, 0] * gx + inv[1, 0] * gy + inv[2, 0] * gz,
                            inv[0, 1] * gx + inv[1, 1] * gy + inv[2, 1] * gz,
                            inv[0, 2] * gx + inv[1, 2] * gy + inv[2, 2] * gz, 1e-300)
-        sx, sy, sz = unit3(inv[0, 0] * sx + inv[1, 0] * sy + inv[2, 0] * sz,
+        sx, sy, sz = unit(inv[0, 0] * sx + inv[1, 0] * sy + inv[2, 0] * sz,
                            inv[0, 1] * sx + inv[1, 1] * sy + inv[2, 1] * sz,
                            inv[0, 2] * sx + inv[1, 2] * sy + inv[2, 2] * sz, 1e-300)
     elif kind[k] == 2:
         ex, ey, ez = bx - ax, by - ay, bz - az
         fx, fy, fz = cx - ax, cy - ay, cz - az
-        gx, gy, gz = unit3(ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx, 1e-300)
+        gx, gy, gz = unit(ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx, 1e-300)
         if geo[12][k, _bucket(time)]:
             gx, gy, gz = -gx, -gy, -gz
     return px, py, pz, gx, gy, gz, sx, sy, sz

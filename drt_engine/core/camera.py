@@ -12,7 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .jit import kernel
-from .motion import Motion, frame_at, unit3
+from .microfacet import concentric_disk
+from .microfacet import unit
+from .motion import Motion, frame_at
 from .scene import Camera
 
 
@@ -39,19 +41,6 @@ def lens_table(camera: Camera) -> np.ndarray:
 
 
 @kernel
-def _concentric_disk(u0, u1):
-    """Shirley's concentric map of the unit square onto the unit disk."""
-    a, b = 2.0 * u0 - 1.0, 2.0 * u1 - 1.0
-    if a == 0.0 and b == 0.0:
-        return 0.0, 0.0
-    if abs(a) > abs(b):
-        r, phi = a, (math.pi / 4) * (b / a)
-    else:
-        r, phi = b, math.pi / 2 - (math.pi / 4) * (a / b)
-    return r * math.cos(phi), r * math.sin(phi)
-
-
-@kernel
 def aperture_sample(lens, u0, u1):
     """Uniform point on the aperture: a disk, or a regular polygon with ``blades`` sides."""
     blades = int(lens[9])
@@ -63,7 +52,7 @@ def aperture_sample(lens, u0, u1):
         b1, b2 = su * (1 - u1), su * u1  # uniform in the triangle (centre, corner k, corner k+1)
         x, y = b1 * math.cos(a0) + b2 * math.cos(a1), b1 * math.sin(a0) + b2 * math.sin(a1)
     else:
-        x, y = _concentric_disk(u0, u1)
+        x, y = concentric_disk(u0, u1)
     return x * lens[7] / lens[8], y * lens[7]
 
 
@@ -80,11 +69,11 @@ def camera_ray(lens, m, px, py, u0, u1, use_lens):
     focus = lens[11]
     if lens[0] == 0.0:  # perspective: from the eye (or a point of the lens) toward the plane in focus
         ox, oy, oz = 0.0, 0.0, 0.0
-        dx, dy, dz = unit3(sx, sy, -1.0, 1e-30)
+        dx, dy, dz = unit(sx, sy, -1.0)
         if use_lens:
             ox, oy = aperture_sample(lens, u0, u1)
             f = focus / -dz
-            dx, dy, dz = unit3(dx * f - ox, dy * f - oy, dz * f, 1e-30)
+            dx, dy, dz = unit(dx * f - ox, dy * f - oy, dz * f)
     else:
         # as Cycles: the ray leaves a point of the aperture around its own image point
         # and passes where the pinhole ray crosses the plane in focus
@@ -93,15 +82,15 @@ def camera_ray(lens, m, px, py, u0, u1, use_lens):
         if use_lens:
             ax, ay = aperture_sample(lens, u0, u1)
             ox, oy = sx + ax, sy + ay
-            dx, dy, dz = unit3(sx - ox, sy - oy, -focus, 1e-30)
+            dx, dy, dz = unit(sx - ox, sy - oy, -focus)
     axial = -dz
     t_start = lens[12] / axial
     t_end = lens[13] / axial
     wx = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3]
     wy = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3]
     wz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3]
-    vx, vy, vz = unit3(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
-                       m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz, 1e-30)
+    vx, vy, vz = unit(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
+                       m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
     return (wx + vx * t_start, wy + vy * t_start, wz + vz * t_start, vx, vy, vz,
             max(t_end - t_start, 0.0), t_start, axial)
 

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from .jit import kernel
+from .microfacet import concentric_disk
 from .scene import Light
 from .shadernodes import LUMINANCE
 
@@ -120,20 +121,6 @@ def basis(nx, ny, nz):
     a = -1.0 / (s + nz)
     b = nx * ny * a
     return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
-
-
-@kernel(inline="always")
-def concentric_disk(u0, u1):
-    """Shirley's concentric map of the unit square onto the unit disk."""
-    a = 2.0 * u0 - 1.0
-    b = 2.0 * u1 - 1.0
-    if a == 0.0 and b == 0.0:
-        return 0.0, 0.0
-    if abs(a) > abs(b):
-        r, phi = a, (math.pi / 4) * (b / a)
-    else:
-        r, phi = b, math.pi / 2 - (math.pi / 4) * (a / b)
-    return r * math.cos(phi), r * math.sin(phi)
 
 
 @kernel(inline="always")

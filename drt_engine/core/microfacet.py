@@ -98,9 +98,9 @@ def ggx_g2(cos_o, cos_i, alpha):
 
 
 @kernel
-def unit(x, y, z):
-    """(x, y, z) scaled to unit length; lengths under 1e-30 count as 1e-30."""
-    length = max(np.sqrt(x * x + y * y + z * z), _TINY)
+def unit(x, y, z, tiny=_TINY):
+    """(x, y, z) scaled to unit length; lengths under ``tiny`` count as ``tiny``."""
+    length = max(np.sqrt(x * x + y * y + z * z), tiny)
     return x / length, y / length, z / length
 
 
@@ -210,23 +210,18 @@ def refract(wx, wy, wz, hx, hy, hz, eta):
     return x, y, z, k > 0.0
 
 
-def cosine_hemisphere(u: np.ndarray) -> np.ndarray:
-    """Concentric-disk mapping lifted to the hemisphere (local z up)."""
-    d = concentric_disk(u)
-    z = np.sqrt(np.maximum(1.0 - (d * d).sum(axis=1), 0.0))
-    return np.concatenate([d, z[:, None]], axis=1)
-
-
-def concentric_disk(u: np.ndarray) -> np.ndarray:
-    a = 2.0 * u[:, 0] - 1.0
-    b = 2.0 * u[:, 1] - 1.0
-    first = np.abs(a) > np.abs(b)
-    r = np.where(first, a, b)
-    safe_a = np.where(a == 0, 1.0, a)
-    safe_b = np.where(b == 0, 1.0, b)
-    phi = np.where(first, (np.pi / 4) * (b / safe_a), np.pi / 2 - (np.pi / 4) * (a / safe_b))
-    phi = np.where((a == 0) & (b == 0), 0.0, phi)
-    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+@kernel(inline="always")
+def concentric_disk(u0, u1):
+    """Shirley's concentric map of the unit square onto the unit disk (lens, disk lights, cones)."""
+    a = 2.0 * u0 - 1.0
+    b = 2.0 * u1 - 1.0
+    if a == 0.0 and b == 0.0:
+        return 0.0, 0.0
+    if abs(a) > abs(b):
+        r, phi = a, (np.pi / 4) * (b / a)
+    else:
+        r, phi = b, np.pi / 2 - (np.pi / 4) * (a / b)
+    return r * np.cos(phi), r * np.sin(phi)
 
 
 @kernel

@@ -137,13 +137,6 @@ def _frames(translation, quat, stretch, time, out):
 
 
 @kernel
-def unit3(x, y, z, tiny):
-    """(x, y, z) scaled to unit length; lengths under ``tiny`` count as ``tiny``."""
-    length = max(math.sqrt(x * x + y * y + z * z), tiny)
-    return x / length, y / length, z / length
-
-
-@kernel
 def invert_frame(m, inv):
     """inv (3, 4) = the inverse of the affine transform m (3, 4), by cofactors (a singular
     linear part is treated as having determinant 1e-30, never divided by zero)."""
