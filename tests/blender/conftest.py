@@ -13,6 +13,7 @@ import pytest
 import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
 from drt_engine.core.settings import PASS_CHANNELS
+from datablocks import new_material, new_world
 from render_helpers import read_channels
 
 CAMERA_HEIGHT = 5.0
@@ -40,7 +41,7 @@ def _plane_mesh(name: str, half: float):
 
 
 def emission_material(strength: float, color=(1.0, 1.0, 1.0)):
-    mat = bpy.data.materials.new("Emitter")
+    mat = new_material("Emitter")
     tree = mat.node_tree
     tree.nodes.clear()
     emission = tree.nodes.new("ShaderNodeEmission")
@@ -52,7 +53,7 @@ def emission_material(strength: float, color=(1.0, 1.0, 1.0)):
 
 
 def set_world(scene, color=(0.0, 0.0, 0.0), strength=1.0):
-    world = scene.world or bpy.data.worlds.new("World")
+    world = scene.world or new_world("World")
     scene.world = world
     background = world.node_tree.nodes["Background"]
     background.inputs["Color"].default_value = (*color, 1.0)

@@ -60,6 +60,7 @@ import numpy as np
 import pytest
 
 import render_helpers as rh
+from datablocks import new_material, new_world
 
 SAMPLE_SCENES = rh.ROOT / "sample_scenes"
 DATA = rh.ROOT / "tests" / "data"
@@ -308,7 +309,7 @@ def focused_scene(width: int, height: int, ortho_scale: float, camera_location, 
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     rh.set_resolution(scene, width, height)
-    scene.world = bpy.data.worlds.new("World")
+    scene.world = new_world("World")
     background = scene.world.node_tree.nodes["Background"]
     background.inputs["Color"].default_value = (world, world, world, 1.0)
     background.inputs["Strength"].default_value = 1.0
@@ -361,7 +362,7 @@ def test_spot_light_blend_region(drt, tmp_path, radius):
     height = 2.0
     edge = height * np.tan(np.radians(25.0))
     scene = focused_scene(32, 32, 0.6, (edge, 0.0, 1.0), 0.0)
-    floor = bpy.data.materials.new("Floor")
+    floor = new_material("Floor")
     floor.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
     floor.node_tree.nodes["Principled BSDF"].inputs["Specular IOR Level"].default_value = 0.0
     mesh = bpy.data.meshes.new("Floor")
@@ -394,7 +395,7 @@ def test_rough_metal_distribution(drt, tmp_path, node, distribution):
     Multiscatter image here).
     """
     scene = focused_scene(16, 16, 0.5, (0.0, 0.0, 1.0), 0.0)
-    metal = bpy.data.materials.new("Metal")
+    metal = new_material("Metal")
     tree = metal.node_tree
     tree.nodes.clear()
     shader = tree.nodes.new(node)
@@ -454,17 +455,17 @@ def hdri_scene(path: str):
         bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=location, segments=48, ring_count=24)
         obj = bpy.context.active_object
         bpy.ops.object.shade_smooth()
-        mat = bpy.data.materials.new(name)
+        mat = new_material(name)
         bsdf = mat.node_tree.nodes["Principled BSDF"]
         bsdf.inputs["Base Color"].default_value = color
         bsdf.inputs["Metallic"].default_value = metallic
         bsdf.inputs["Roughness"].default_value = 0.35
         obj.data.materials.append(mat)
     bpy.ops.mesh.primitive_plane_add(size=20.0)
-    floor = bpy.data.materials.new("Floor")
+    floor = new_material("Floor")
     floor.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1)
     bpy.context.active_object.data.materials.append(floor)
-    world = bpy.data.worlds.new("Sky")
+    world = new_world("Sky")
     scene.world = world
     rh.environment_texture(world, path, np.radians(30), 1.5)
     return scene
