@@ -116,8 +116,14 @@ def diffuse(name, color):
     return _material(name, "ShaderNodeBsdfDiffuse", {"Color": color, "Roughness": 0.0})
 
 
+PRINCIPLED_DEFAULTS = {"Subsurface_Scale": 0.05}
+"""Inputs whose default differs between Blender versions (5.2 made Subsurface Scale 0.005), set to
+the value of the committed files (saved by 5.0) so that every version builds the same scene."""
+
+
 def principled(name, **inputs):
     """Principled BSDF; keyword names are socket names with spaces as underscores."""
+    inputs = {**PRINCIPLED_DEFAULTS, **inputs}
     return _material(name, "ShaderNodeBsdfPrincipled", {k.replace("_", " "): v for k, v in inputs.items()})
 
 
