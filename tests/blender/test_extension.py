@@ -94,6 +94,7 @@ def test_zipped_package_registers_under_the_extension_namespace(dist, tmp_path):
     with zipfile.ZipFile(zip_for(dist, "linux-x64")) as archive:
         archive.extractall(package)
     script = textwrap.dedent("""
+        import os
         import sys
         import bpy
         sys.path = [p for p in sys.path if p not in ("", %r)]
@@ -111,7 +112,8 @@ def test_zipped_package_registers_under_the_extension_namespace(dist, tmp_path):
         else:
             raise AssertionError("DRT still registered after unregister()")
         assert not any(m.startswith("drt_engine") for m in sys.modules), "imported the repo copy"
-        print("ok")
+        print("ok", flush=True)
+        os._exit(0)  # no interpreter teardown: the bpy 4.2 module crashes there (tests/blender/conftest.py)
     """) % (str(ROOT), str(tmp_path))
     proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stdout[-2000:] + proc.stderr[-3000:]
