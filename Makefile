@@ -115,7 +115,7 @@ bench-throughput: $(STAMP)
 
 clean:
 	rm -rf $(OUT) $(DIST) .pytest_cache
-	find . -path ./$(VENV) -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
+	find . -path './$(VENV)*' -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
 
 distclean: clean
 	rm -rf $(VENV) $(VENV)-* wheels
