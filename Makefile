@@ -1,6 +1,8 @@
 # DRT: distribution ray tracing for Blender.
 #   make render      venv + render the default sample scene to out/ (SCENE=name for another one)
 #   make test        venv + the whole test suite (TESTS=path and PYTEST_ARGS=... to narrow it)
+#   make test-versions tests/core and tests/blender under each bpy of BPY_VERSIONS (4.2 5.0 5.2 LTS),
+#                    each in its own venv (.venv-X.Y from requirements-X.Y.txt; 5.0 is .venv)
 #   make extension   download the embreex wheels, validate, build the extension zips into dist/
 #   make scenes      rebuild the sample .blend files from their scripts
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
@@ -9,7 +11,7 @@
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
 #   make texture-parity  DRT vs Cycles per procedural texture and mode (tools/texture_parity.py: README table)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
-#   make clean       remove out/, dist/ and caches; make distclean also removes .venv and wheels/
+#   make clean       remove out/, dist/ and caches; make distclean also removes the venvs and wheels/
 #   make blender-env build (once, cached in BLENDER_ENV) a Debian 13 root with Blender 4.3.2; needs root
 #   make test-blender install the extension into that Blender and test it there (headless and GUI)
 
@@ -17,10 +19,20 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
 PYTHON311 ?= python3.11
+PYTHON313 ?= python3.13
 VENV := .venv
 PY := $(VENV)/bin/python
 # Written after a successful install; newer than requirements.txt means the venv is current.
 STAMP := $(VENV)/.drt-requirements-installed
+
+# The Blender version matrix of `make test-versions`: each a bpy wheel in a venv of its own, made from
+# its own requirements file (5.0, the pinned default, is .venv from requirements.txt) with the Python
+# that file names on its "# python: X.Y" line (PYTHON311 or PYTHON313 says which interpreter).
+BPY_VERSIONS ?= 4.2 5.0 5.2
+VERSION_TESTS ?= tests/core tests/blender
+requirements_of = $(if $(filter 5.0,$1),requirements.txt,requirements-$1.txt)
+venv_of = $(if $(filter 5.0,$1),$(VENV),$(VENV)-$1)
+python_of = $(shell sed -n 's/^\# python: *\([0-9.]*\).*/\1/p' $1)
 
 SCENE ?= cornell_box
 OUT ?= out
@@ -34,7 +46,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test extension scenes bench bench-throughput bench-farm texture-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-farm texture-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -42,16 +54,12 @@ help:
 venv: $(STAMP)
 
 $(STAMP): requirements.txt
-	@if [ ! -x $(PY) ]; then \
-	  command -v $(PYTHON311) >/dev/null 2>&1 || { \
-	    echo "error: $(PYTHON311) not found on PATH. DRT needs Python 3.11 (bpy 5.0.1 exists only for 3.11);" \
-	         "install it, or pass PYTHON311=/path/to/python3.11" >&2; exit 1; }; \
-	  echo "creating $(VENV) with $$(command -v $(PYTHON311))"; \
-	  $(PYTHON311) -m venv $(VENV); \
-	fi
-	@$(PY) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' || { \
-	  echo "error: $(VENV) is not a Python 3.11 environment; remove it (make distclean) and run make again" >&2; exit 1; }
-	$(PY) -m pip install --disable-pip-version-check -r requirements.txt
+	tools/venv.sh $(VENV) $< $(call python_of,$<) $(PYTHON$(subst .,,$(call python_of,$<)))
+	@touch $@
+
+# The other Blender versions' venvs: .venv-X.Y from requirements-X.Y.txt.
+$(VENV)-%/.drt-requirements-installed: requirements-%.txt
+	tools/venv.sh $(VENV)-$* $< $(call python_of,$<) $(PYTHON$(subst .,,$(call python_of,$<)))
 	@touch $@
 
 render: $(STAMP)
@@ -63,6 +71,15 @@ render: $(STAMP)
 # a suite that runs no test must not pass CI.
 test: $(STAMP)
 	$(PY) -m pytest $(TESTS) -q $(PYTEST_ARGS)
+
+# Every version runs even when one fails; the summary names the ones that failed.
+test-versions: $(foreach v,$(BPY_VERSIONS),$(call venv_of,$v)/.drt-requirements-installed)
+	@failed=; $(foreach v,$(BPY_VERSIONS),\
+	  echo "== Blender $v: $(call venv_of,$v)/bin/python -m pytest $(VERSION_TESTS) -q $(PYTEST_ARGS)"; \
+	  start=$$SECONDS; \
+	  $(call venv_of,$v)/bin/python -m pytest $(VERSION_TESTS) -q $(PYTEST_ARGS) || failed="$$failed $v"; \
+	  echo "== Blender $v: $$((SECONDS - start)) s";) \
+	if [ -n "$$failed" ]; then echo "test-versions: failed under Blender$$failed" >&2; exit 1; fi
 
 # One wheel per file name: embreex-VERSION-cpXY-cpXY-PLATFORM.whl gives pip its Python version and
 # platform (the last tag of a compound manylinux platform).
@@ -104,10 +121,10 @@ bench-farm: $(STAMP)
 
 clean:
 	rm -rf $(OUT) $(DIST) .pytest_cache
-	find . -path ./$(VENV) -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
+	find . -path './$(VENV)*' -prune -o -name __pycache__ -type d -prune -exec rm -rf {} +
 
 distclean: clean
-	rm -rf $(VENV) wheels
+	rm -rf $(VENV) $(VENV)-* wheels
 
 # A real Blender: Debian 13's Blender 4.3.2 in a debootstrap root kept outside the repository
 # (about 1.5 GB, built once in under 3 minutes, reused while it exists).

@@ -1,6 +1,4 @@
 """``python -m drt_engine ...``: the headless command line (see cli.py)."""
-import sys
+from .cli import exit_now, main
 
-from .cli import main
-
-sys.exit(main())
+exit_now(main())

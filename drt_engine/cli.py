@@ -8,6 +8,7 @@ import argparse
 import math
 import os
 import re
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -408,3 +409,19 @@ def main(argv=None) -> int:
         os.dup2(saved_stderr, 2)
         os.close(saved_stderr)
         stderr.close()
+
+
+def exit_now(code: int) -> None:
+    """End the process with the CLI's own exit status, skipping the interpreter's teardown.
+
+    The bpy module of Blender 4.2 crashes while Python tears it down (SIGSEGV, exit 139), after
+    the image and the report are written; a caller must see the status of the work, not of the
+    teardown. The one thing that teardown does that matters here, removing Blender's session
+    temp folder, is done first.
+    """
+    bpy = sys.modules.get("bpy")
+    if bpy is not None and os.path.basename(os.path.normpath(bpy.app.tempdir)).startswith("blender_"):
+        shutil.rmtree(bpy.app.tempdir, ignore_errors=True)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)

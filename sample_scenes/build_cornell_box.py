@@ -50,3 +50,4 @@ def build():
 if __name__ == "__main__":
     build()
     sh.save(sh.output_path("cornell_box"))
+    sh.done()

@@ -56,3 +56,4 @@ def build():
 if __name__ == "__main__":
     build()
     sh.save(sh.output_path("dof_row"))
+    sh.done()

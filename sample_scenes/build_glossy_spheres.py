@@ -37,3 +37,4 @@ def build():
 if __name__ == "__main__":
     build()
     sh.save(sh.output_path("glossy_spheres"))
+    sh.done()

@@ -270,3 +270,4 @@ if __name__ == "__main__":
     for scene_name in SCENES:
         build(scene_name)
         sh.save(out / f"{scene_name}.blend")
+    sh.done()

@@ -54,3 +54,4 @@ def build():
 if __name__ == "__main__":
     build()
     sh.save(sh.output_path("motion_blur"))
+    sh.done()

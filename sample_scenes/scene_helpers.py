@@ -116,8 +116,14 @@ def diffuse(name, color):
     return _material(name, "ShaderNodeBsdfDiffuse", {"Color": color, "Roughness": 0.0})
 
 
+PRINCIPLED_DEFAULTS = {"Subsurface_Scale": 0.05}
+"""Inputs whose default differs between Blender versions (5.2 made Subsurface Scale 0.005), set to
+the value of the committed files (saved by 5.0) so that every version builds the same scene."""
+
+
 def principled(name, **inputs):
     """Principled BSDF; keyword names are socket names with spaces as underscores."""
+    inputs = {**PRINCIPLED_DEFAULTS, **inputs}
     return _material(name, "ShaderNodeBsdfPrincipled", {k.replace("_", " "): v for k, v in inputs.items()})
 
 
@@ -224,3 +230,16 @@ def save(path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=True)
     print(f"wrote {path}")
+
+
+def done() -> None:
+    """End a build script run by the bpy 4.2 module now, with status 0.
+
+    That module crashes (SIGSEGV) while Python tears it down once a property with an update
+    callback was registered, as DRT's are, which would fail `make scenes` after the files are
+    written. Inside Blender itself (``blender --python``) and under other versions it does nothing.
+    """
+    if bpy.app.version[:2] == (4, 2) and not bpy.app.binary_path:
+        from drt_engine.cli import exit_now
+
+        exit_now(0)

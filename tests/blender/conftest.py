@@ -4,6 +4,7 @@ The scenes are chosen so the right image is known exactly: a camera 5 m above an
 emissive plane that fills the view sees the emission strength at every pixel and a
 depth of 5 m, whatever the sampling.
 """
+from pathlib import Path
 from types import SimpleNamespace
 
 import bpy
@@ -12,10 +13,14 @@ import pytest
 
 import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
+from drt_engine.cli import exit_now
 from drt_engine.core.settings import PASS_CHANNELS
-from render_helpers import read_channels
+import sample_scene_files
+from datablocks import new_material, new_world
+from render_helpers import read_channels, set_exr_output
 
 CAMERA_HEIGHT = 5.0
+_EXIT_STATUS = pytest.StashKey[int]()
 
 
 def drt_is_registered() -> bool:
@@ -32,6 +37,37 @@ def drt():
         drt_engine.unregister()
 
 
+def pytest_sessionfinish(session, exitstatus):
+    session.config.stash[_EXIT_STATUS] = int(exitstatus)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    """Under the bpy 4.2 module, end the test session here with pytest's own status.
+
+    That module crashes (SIGSEGV, exit 139) while Python tears it down once a property with an
+    update callback was registered, as DRT's are, after every test has passed or failed: the
+    status must be the tests'. The CLI ends the same way (drt_engine.cli.exit_now).
+    """
+    if bpy.app.version[:2] == (4, 2) and _EXIT_STATUS in config.stash:
+        exit_now(config.stash[_EXIT_STATUS])
+
+
+@pytest.fixture(scope="session")
+def sample_scene(tmp_path_factory):
+    """``sample_scene(name)``: the path of that sample scene's .blend for this Blender to open; the
+    committed file, or under Blender 4.x a copy built by its script (once per session)."""
+    folder = tmp_path_factory.mktemp("sample_scenes")
+
+    def path(name: str) -> Path:
+        if sample_scene_files.OPENS_COMMITTED_FILES:
+            return sample_scene_files.SCENES_DIR / f"{name}.blend"
+        target = folder / f"{name}.blend"
+        return target if target.exists() else sample_scene_files.build(name, target)
+
+    return path
+
+
 def _plane_mesh(name: str, half: float):
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
@@ -40,7 +76,7 @@ def _plane_mesh(name: str, half: float):
 
 
 def emission_material(strength: float, color=(1.0, 1.0, 1.0)):
-    mat = bpy.data.materials.new("Emitter")
+    mat = new_material("Emitter")
     tree = mat.node_tree
     tree.nodes.clear()
     emission = tree.nodes.new("ShaderNodeEmission")
@@ -52,7 +88,7 @@ def emission_material(strength: float, color=(1.0, 1.0, 1.0)):
 
 
 def set_world(scene, color=(0.0, 0.0, 0.0), strength=1.0):
-    world = scene.world or bpy.data.worlds.new("World")
+    world = scene.world or new_world("World")
     scene.world = world
     background = world.node_tree.nodes["Background"]
     background.inputs["Color"].default_value = (*color, 1.0)
@@ -87,13 +123,7 @@ def emission_scene(width=16, height=12, strength=2.0, world=(0.0, 0.0, 0.0), sam
 
 def render_exr(scene, path) -> dict:
     """Render ``scene`` with bpy.ops.render.render, write a multilayer EXR, read its channels back."""
-    settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    scene.render.filepath = str(path)
-    scene.render.use_file_extension = False
+    set_exr_output(scene, path)
     bpy.ops.render.render(write_still=True, scene=scene.name)
     return read_channels(path)
 

@@ -126,7 +126,8 @@ def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name
 def set_exr_output(scene, path: Path) -> Path:
     """Write renders of ``scene`` to ``path`` as a 32-bit multilayer EXR (in memory only)."""
     settings = scene.render.image_settings
-    settings.media_type = "MULTI_LAYER_IMAGE"
+    if hasattr(settings, "media_type"):  # Blender 5.0+
+        settings.media_type = "MULTI_LAYER_IMAGE"
     settings.file_format = "OPEN_EXR_MULTILAYER"
     settings.color_depth = "32"
     scene.render.filepath = str(path)

@@ -20,7 +20,7 @@ from drt_engine.blender.export import export_scene
 from drt_engine.core.adaptive import first_test, true_error
 from drt_engine.core.render import Renderer
 from drt_engine.core.settings import RenderSettings
-from test_sample_scenes import SCENES, SCENES_DIR
+from sample_scene_files import SCENES
 
 WIDTH = 32
 REFERENCE_SAMPLES = 1024
@@ -41,8 +41,8 @@ samples can see a highlight they missed. At 64 px the same step reads 0.89 (benc
 
 
 @pytest.fixture(scope="module", params=SCENES)
-def scene(request, drt):
-    bpy.ops.wm.open_mainfile(filepath=str(SCENES_DIR / f"{request.param}.blend"), load_ui=False)
+def scene(request, drt, sample_scene):
+    bpy.ops.wm.open_mainfile(filepath=str(sample_scene(request.param)), load_ui=False)
     blender_scene = bpy.context.scene
     render = blender_scene.render
     aspect = render.resolution_y / render.resolution_x

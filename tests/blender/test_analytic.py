@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import render_helpers as rh
+from datablocks import new_material, new_world
 
 ALBEDO = 0.5
 HEIGHT = 2.0  # light above the plane
@@ -37,7 +38,7 @@ def lambert_scene(material: str) -> bpy.types.Scene:
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     rh.set_resolution(scene, SIZE, SIZE)
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
 
@@ -60,7 +61,7 @@ def lambert_scene(material: str) -> bpy.types.Scene:
 
 
 def shader_material(name: str, node_type: str, inputs: dict) -> bpy.types.Material:
-    material = bpy.data.materials.new(name)
+    material = new_material(name)
     tree = material.node_tree
     tree.nodes.clear()
     shader = tree.nodes.new(node_type)

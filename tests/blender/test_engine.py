@@ -21,6 +21,8 @@ from drt_engine.core.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import PASSES, RenderSettings
 
+from datablocks import new_compositor
+
 STRENGTH = 2.0
 LAYER = "ViewLayer"
 
@@ -257,8 +259,7 @@ def test_cancel_returns_promptly_with_the_image_so_far():
 
 def test_pass_toggles_update_the_compositor_sockets(bl):
     scene = bl.emission_scene()
-    scene.compositing_node_group = bpy.data.node_groups.new("Compositing", "CompositorNodeTree")
-    node = scene.compositing_node_group.nodes.new("CompositorNodeRLayers")
+    node = new_compositor(scene).nodes.new("CompositorNodeRLayers")
     node.scene, node.layer = scene, LAYER
     view_layer = scene.view_layers[LAYER]
 

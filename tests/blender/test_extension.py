@@ -94,6 +94,7 @@ def test_zipped_package_registers_under_the_extension_namespace(dist, tmp_path):
     with zipfile.ZipFile(zip_for(dist, "linux-x64")) as archive:
         archive.extractall(package)
     script = textwrap.dedent("""
+        import os
         import sys
         import bpy
         sys.path = [p for p in sys.path if p not in ("", %r)]
@@ -111,7 +112,55 @@ def test_zipped_package_registers_under_the_extension_namespace(dist, tmp_path):
         else:
             raise AssertionError("DRT still registered after unregister()")
         assert not any(m.startswith("drt_engine") for m in sys.modules), "imported the repo copy"
-        print("ok")
+        print("ok", flush=True)
+        os._exit(0)  # no interpreter teardown: the bpy 4.2 module crashes there (tests/blender/conftest.py)
     """) % (str(ROOT), str(tmp_path))
     proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stdout[-2000:] + proc.stderr[-3000:]
+
+
+WHEEL_CHECK = """
+import sys
+sys.path.insert(0, %r)
+import numpy as np
+import embreex, llvmlite, numba
+from embreex import rtcore_scene
+from embreex.mesh_construction import TriangleMesh
+for module in (embreex, llvmlite, numba):
+    assert module.__file__.startswith(sys.path[0]), module.__file__
+
+@numba.njit(cache=False, nogil=True)
+def total(values):
+    sum = 0.0
+    for value in values:
+        sum += value
+    return sum
+
+assert total(np.arange(10.0)) == 45.0
+scene = rtcore_scene.EmbreeScene()
+TriangleMesh(scene, np.array([[-1, -1, 0], [1, -1, 0], [0, 1, 0]], np.float32), np.array([[0, 1, 2]], np.int32))
+hits = scene.run(np.array([[0, 0, 1], [5, 5, 1]], np.float32), np.array([[0, 0, -1], [0, 0, -1]], np.float32))
+assert hits.tolist() == [0, -1], hits
+print("ok", numba.__version__, np.__version__)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the zips' wheels are checked on Linux")
+def test_zip_bundles_working_wheels_for_this_python(dist, tmp_path):
+    """The linux-x64 zip holds embreex, numba and llvmlite wheels for this Blender's Python, and they
+    work unpacked as Blender installs an extension's wheels (a folder of their own on sys.path), with
+    this Python and its NumPy: run under each version of `make test-versions`, this checks that the
+    bundled wheels cover each version's Python."""
+    tag = f"cp{sys.version_info.major}{sys.version_info.minor}"
+    site = tmp_path / "site-packages"
+    with zipfile.ZipFile(zip_for(dist, "linux-x64")) as archive:
+        wheels = [n for n in archive.namelist() if n.endswith(".whl") and f"-{tag}-" in n]
+        assert sorted(w.split("/")[-1].split("-")[0] for w in wheels) == ["embreex", "llvmlite", "numba"], wheels
+        for wheel in wheels:
+            archive.extract(wheel, tmp_path)
+    for wheel in wheels:
+        with zipfile.ZipFile(tmp_path / wheel) as archive:
+            archive.extractall(site)
+    proc = subprocess.run([sys.executable, "-c", WHEEL_CHECK % str(site)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0 and proc.stdout.startswith("ok"), proc.stdout[-2000:] + proc.stderr[-3000:]

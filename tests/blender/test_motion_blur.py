@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import emission_material, render_exr
+from datablocks import new_world
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
 from scene_helpers import fcurves  # noqa: E402
@@ -49,7 +50,7 @@ def sliding_edge_scene():
     for curve in fcurves(edge):
         for key in curve.keyframe_points:
             key.interpolation = "LINEAR"
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     scene.frame_set(1)

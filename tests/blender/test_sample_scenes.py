@@ -3,17 +3,12 @@ motion each one exercises), stay within what DRT supports (constant-input shader
 a uniform world), carry Cycles settings for a like-for-like comparison, and are exactly what their
 build scripts produce today."""
 import math
-import subprocess
-import sys
-from pathlib import Path
 
 import bpy
 import pytest
 from mathutils import Vector
 
-ROOT = Path(__file__).resolve().parents[2]
-SCENES_DIR = ROOT / "sample_scenes"
-SCENES = ("cornell_box", "glossy_spheres", "dof_row", "motion_blur")
+from sample_scene_files import OPENS_COMMITTED_FILES, SCENES, SCENES_DIR, build
 SHADERS = {"BSDF_PRINCIPLED", "EMISSION", "BSDF_DIFFUSE", "BSDF_GLOSSY", "BSDF_GLASS"}
 
 
@@ -90,13 +85,12 @@ def rebuilt(tmp_path_factory):
     """Each build script run afresh into a temporary folder, as `make scenes` runs it."""
     out = tmp_path_factory.mktemp("scenes")
     for name in SCENES:
-        proc = subprocess.run([sys.executable, str(SCENES_DIR / f"build_{name}.py"), str(out / f"{name}.blend")],
-                              capture_output=True, text=True, timeout=120)
-        assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+        build(name, out / f"{name}.blend")
     return out
 
 
 @pytest.mark.parametrize("name", SCENES)
+@pytest.mark.skipif(not OPENS_COMMITTED_FILES, reason="Blender 4.x cannot open the committed files (saved by 5.0)")
 def test_build_script_reproduces_the_committed_scene(name, rebuilt):
     committed = fingerprint(load(SCENES_DIR / f"{name}.blend"))
     fresh = fingerprint(load(rebuilt / f"{name}.blend"))
@@ -104,8 +98,8 @@ def test_build_script_reproduces_the_committed_scene(name, rebuilt):
 
 
 @pytest.mark.parametrize("name", SCENES)
-def test_scene_is_small_supported_and_comparable_with_cycles(name):
-    scene = load(SCENES_DIR / f"{name}.blend")
+def test_scene_is_small_supported_and_comparable_with_cycles(name, sample_scene):
+    scene = load(sample_scene(name))
     render, cycles = scene.render, scene.cycles
     assert scene.camera is not None and scene.camera.type == "CAMERA"
     assert 64 <= render.resolution_x <= 256 and 64 <= render.resolution_y <= 256
@@ -143,8 +137,8 @@ def view_depth(camera, point):
     return -(camera.matrix_world.inverted() @ Vector(point)).z
 
 
-def test_cornell_box():
-    scene = load(SCENES_DIR / "cornell_box.blend")
+def test_cornell_box(sample_scene):
+    scene = load(sample_scene("cornell_box"))
     assert light_kinds(scene) == [("AREA", "SQUARE")]
     light = next(o for o in scene.objects if o.type == "LIGHT")
     facing = light.matrix_world.to_3x3() @ Vector((0, 0, -1))
@@ -165,8 +159,8 @@ def test_cornell_box():
         assert all(-1 < c.x < 1 and -1 < c.y < 1 and -1e-6 <= c.z < 2 for c in corners), box.name
 
 
-def test_glossy_spheres():
-    scene = load(SCENES_DIR / "glossy_spheres.blend")
+def test_glossy_spheres(sample_scene):
+    scene = load(sample_scene("glossy_spheres"))
     lights = [o.data for o in scene.objects if o.type == "LIGHT"]
     assert [l.type for l in lights] == ["AREA", "AREA"]
     areas = [l.size * (l.size_y if l.shape in ("RECTANGLE", "ELLIPSE") else l.size) for l in lights]
@@ -184,8 +178,8 @@ def test_glossy_spheres():
     assert sum(m == 1 for m, _ in principled) == 1, "one metal"
 
 
-def test_dof_row():
-    scene = load(SCENES_DIR / "dof_row.blend")
+def test_dof_row(sample_scene):
+    scene = load(sample_scene("dof_row"))
     assert light_kinds(scene) == [("AREA", "DISK"), ("SUN", None)]
     camera = scene.camera
     dof = camera.data.dof
@@ -202,8 +196,8 @@ def test_dof_row():
     assert blur[0] > 4 and blur[-1] > 2, f"near and far objects visibly blurred, CoC {blur} px"
 
 
-def test_motion_blur():
-    scene = load(SCENES_DIR / "motion_blur.blend")
+def test_motion_blur(sample_scene):
+    scene = load(sample_scene("motion_blur"))
     assert scene.render.use_motion_blur and scene.render.motion_blur_shutter > 0
     assert light_kinds(scene) == [("POINT", None), ("SPOT", None)]
     assert all(o.data.shadow_soft_size > 0 for o in scene.objects if o.type == "LIGHT")

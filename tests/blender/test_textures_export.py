@@ -16,6 +16,7 @@ from drt_engine.core.render import Renderer
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.textures import MAGENTA, srgb_to_linear
 import render_helpers as rh
+from datablocks import new_material, new_world
 from export_helpers import add_object, empty_scene, render_export
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
@@ -37,10 +38,10 @@ def textured_scene(width=RES):
     for loop, value in zip(uv.data, [(0, 0), (1, 0), (1, 1), (0, 1)]):
         loop.uv = value
     mesh.update()
-    mat = bpy.data.materials.new("Textured")
+    mat = new_material("Textured")
     mesh.materials.append(mat)
     add_object(scene, "Plane", mesh)
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (1, 1, 1, 1)
     scene.world = world
     return scene, mat

@@ -24,12 +24,13 @@ import numpy as np
 
 from ...core.errors import SceneError
 from ...core.scene import Light
+from .materials import uses_nodes
 from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
 
 
 def _node_emission(light, warnings: list[str]) -> np.ndarray:
     """Colour × strength of the light's Emission nodes (1 without nodes, as in Cycles)."""
-    if not (light.use_nodes and light.node_tree):
+    if not uses_nodes(light):
         return np.ones(3)
     output = light.node_tree.get_output_node("CYCLES")
     if output is None:

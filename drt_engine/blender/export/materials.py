@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import bpy
 import numpy as np
 
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
@@ -17,10 +16,15 @@ from .shader_graph import Compiler, ImageTable, is_ref
 
 
 def uses_nodes(idblock) -> bool:
-    """Whether Cycles reads the node tree (5.0 dropped the ``use_nodes`` switch)."""
+    """Whether Cycles reads the node tree of a material, world or light.
+
+    Blender dropped the ``use_nodes`` switch (5.0 for materials and worlds, 5.2 for lights): it is
+    then deprecated, always True, and reading it warns, so it is read only where it still counts.
+    """
     if idblock.node_tree is None:
         return False
-    return bpy.app.version >= (5, 0, 0) or idblock.use_nodes
+    switch = idblock.bl_rna.properties["use_nodes"]
+    return getattr(switch, "is_deprecated", False) or idblock.use_nodes
 
 
 def _multiscatter(node, issues) -> bool:
