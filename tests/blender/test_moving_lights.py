@@ -12,7 +12,7 @@ within BIAS (1%), and the mean relative difference over 4x4-pixel blocks brighte
 the image mean within BIAS plus twice the same statistic between the two DRT seeds (noise).
 Every case also runs the checks on the DRT image scaled by 0.97 and requires them to fail,
 so a 3% loss of light cannot pass. The point light (radius 0) has an analytic answer in
-tests/core/test_moving_lights.py.
+tests/core/test_moving_light_irradiance.py.
 """
 import sys
 from pathlib import Path
