@@ -224,7 +224,9 @@ def test_worker_without_drt_is_named_in_one_line(tmp_path):
 
 
 def test_ctrl_c_cancels_and_leaves_no_process(tmp_path):
-    proc = start("render", SCENE, "-o", tmp_path / "x.exr", *OPTIONS, "--workers", 2)
+    # samples enough that no task can end before Ctrl-C reaches it (the render is cancelled, not waited for)
+    long = ["--samples", 1 << 20, *OPTIONS[2:]]
+    proc = start("render", SCENE, "-o", tmp_path / "x.exr", *long, "--workers", 2)
     tree = Tree(proc.pid)
     try:
         wait_for_render(proc, tree)
