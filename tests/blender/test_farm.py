@@ -21,7 +21,6 @@ import pytest
 from render_helpers import read_channels
 
 ROOT = Path(__file__).resolve().parents[2]
-SCENE = ROOT / "sample_scenes" / "cornell_box.blend"
 SAMPLES, SEED, SIZE = 8, 5, 32
 OPTIONS = ["--samples", SAMPLES, "--seed", SEED, "--resolution", f"{SIZE}x{SIZE}", "--engine-threads", 1]
 RELATIVE = 1e-6
@@ -46,9 +45,15 @@ def one_error_line(result, *words):
 
 
 @pytest.fixture(scope="module")
-def single(tmp_path_factory):
+def cornell_box(sample_scene):
+    """The Cornell box this Blender can open (under 4.x, built by its script: the worker CLIs run this Python)."""
+    return sample_scene("cornell_box")
+
+
+@pytest.fixture(scope="module")
+def single(cornell_box, tmp_path_factory):
     out = tmp_path_factory.mktemp("single") / "single.exr"
-    result = run("render", SCENE, "-o", out, *OPTIONS)
+    result = run("render", cornell_box, "-o", out, *OPTIONS)
     assert result.returncode == 0, result.stderr
     return out
 
@@ -120,10 +125,10 @@ def wait_for_render(proc, tree, timeout=90.0):
     pytest.fail("no task render started")
 
 
-def test_split_render_with_a_killed_worker_equals_the_single_render(single, tmp_path):
+def test_split_render_with_a_killed_worker_equals_the_single_render(cornell_box, single, tmp_path):
     """2 sample ranges on 2 local workers; the worker of the first task to start is killed mid-task."""
     out = tmp_path / "split.exr"
-    proc = start("render", SCENE, "-o", out, *OPTIONS, "--workers", 2)
+    proc = start("render", cornell_box, "-o", out, *OPTIONS, "--workers", 2)
     tree = Tree(proc.pid)
     try:
         victim = wait_for_render(proc, tree)[0]
@@ -142,13 +147,13 @@ def test_split_render_with_a_killed_worker_equals_the_single_render(single, tmp_
     tree.assert_all_gone()
 
 
-def test_merged_parts_from_blender_and_the_cli_equal_the_single_render(drt, single, tmp_path):
+def test_merged_parts_from_blender_and_the_cli_equal_the_single_render(drt, cornell_box, single, tmp_path):
     """Samples 0:3 from a `blender -b`-style render (scene.drt.sample_offset / count), 3:8 from the CLI."""
     cli_part = tmp_path / "b.exr"
-    job = subprocess.Popen(cli("render", SCENE, "-o", cli_part, *OPTIONS, "--sample-range", "3:8"), cwd=ROOT,
+    job = subprocess.Popen(cli("render", cornell_box, "-o", cli_part, *OPTIONS, "--sample-range", "3:8"), cwd=ROOT,
                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
-        bpy.ops.wm.open_mainfile(filepath=str(SCENE), load_ui=False)
+        bpy.ops.wm.open_mainfile(filepath=str(cornell_box), load_ui=False)
         scene = bpy.context.scene
         scene.render.engine = "DRT"
         scene.render.resolution_x = scene.render.resolution_y = SIZE
@@ -175,23 +180,23 @@ def test_merged_parts_from_blender_and_the_cli_equal_the_single_render(drt, sing
     one_error_line(run("merge", blender_part, blender_part, cli_part, "-o", tmp_path / "x.exr"), "overlaps")
     one_error_line(run("merge", single, "-o", tmp_path / "x.exr"), "not a DRT part")
     other_seed = tmp_path / "seed.exr"
-    assert run("render", SCENE, "-o", other_seed, *OPTIONS, "--seed", 6, "--sample-range", "3:8").returncode == 0
+    assert run("render", cornell_box, "-o", other_seed, *OPTIONS, "--seed", 6, "--sample-range", "3:8").returncode == 0
     one_error_line(run("merge", blender_part, other_seed, "-o", tmp_path / "x.exr"), "different seeds")
 
 
-def test_missing_scheduler_is_one_line_within_a_minute(tmp_path):
+def test_missing_scheduler_is_one_line_within_a_minute(cornell_box, tmp_path):
     with socket.socket() as s:  # a port nothing listens on
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     began = time.monotonic()
-    result = run("render", SCENE, "-o", tmp_path / "x.exr", *OPTIONS, "--cluster", f"tcp://127.0.0.1:{port}",
+    result = run("render", cornell_box, "-o", tmp_path / "x.exr", *OPTIONS, "--cluster", f"tcp://127.0.0.1:{port}",
                  "--connect-timeout", 5, timeout=60)
     one_error_line(result, "no Dask scheduler answered", f"127.0.0.1:{port}")
     assert time.monotonic() - began < 60
     assert "Traceback" not in result.stdout
 
 
-def test_worker_without_drt_is_named_in_one_line(tmp_path):
+def test_worker_without_drt_is_named_in_one_line(cornell_box, tmp_path):
     """A `dask worker` started outside the repository, where drt_engine is not importable."""
     dask = Path(sys.executable).with_name("dask")
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
@@ -208,7 +213,7 @@ def test_worker_without_drt_is_named_in_one_line(tmp_path):
         worker = subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--no-nanny", "--host", "127.0.0.1",
                                    "--no-dashboard"], cwd=tmp_path, env=env,
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        result = run("render", SCENE, "-o", tmp_path / "x.exr", *OPTIONS, "--cluster", address,
+        result = run("render", cornell_box, "-o", tmp_path / "x.exr", *OPTIONS, "--cluster", address,
                      "--connect-timeout", 30, timeout=90)
         line = one_error_line(result, "worker tcp://127.0.0.1:", "cannot run DRT", "drt_engine")
         assert "No module named" in line
@@ -223,10 +228,10 @@ def test_worker_without_drt_is_named_in_one_line(tmp_path):
                     proc.wait()
 
 
-def test_ctrl_c_cancels_and_leaves_no_process(tmp_path):
+def test_ctrl_c_cancels_and_leaves_no_process(cornell_box, tmp_path):
     # samples enough that no task can end before Ctrl-C reaches it (the render is cancelled, not waited for)
     long = ["--samples", 1 << 20, *OPTIONS[2:]]
-    proc = start("render", SCENE, "-o", tmp_path / "x.exr", *long, "--workers", 2)
+    proc = start("render", cornell_box, "-o", tmp_path / "x.exr", *long, "--workers", 2)
     tree = Tree(proc.pid)
     try:
         wait_for_render(proc, tree)
@@ -268,23 +273,24 @@ def test_frame_outputs():
     (["--frames", "1-3"], ["--frames needs --workers or --cluster"]),
     (["--workers", "2", "--cluster", "tcp://127.0.0.1:1"], ["not both"]),
 ])
-def test_bad_farm_options_are_one_line(drt, tmp_path, extra, words):
+def test_bad_farm_options_are_one_line(drt, cornell_box, tmp_path, extra, words):
     """In this process (the checks come before any render or cluster)."""
     from drt_engine import cli
 
     with pytest.raises(cli.CLIError) as caught:
-        cli._render(cli.build_parser().parse_args(["render", str(SCENE), "-o", str(tmp_path / "x.exr"),
+        cli._render(cli.build_parser().parse_args(["render", str(cornell_box), "-o", str(tmp_path / "x.exr"),
                                                    *map(str, OPTIONS), *extra]))
     for word in words:
         assert word in str(caught.value)
 
 
-def test_tls_options_make_an_encrypted_client(tmp_path):
+def test_tls_options_make_an_encrypted_client(cornell_box, tmp_path):
     from drt_engine import cli
     from drt_engine.farm import _security
 
     def args(*extra):
-        return cli.build_parser().parse_args(["render", str(SCENE), "-o", "x.exr", "--cluster", "tls://h:8786", *extra])
+        return cli.build_parser().parse_args(["render", str(cornell_box), "-o", "x.exr", "--cluster", "tls://h:8786",
+                                              *extra])
 
     assert not _security(args()).require_encryption  # Dask's own configuration then
     with pytest.raises(cli.CLIError, match="no such file"):
