@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 import render_helpers as rh
+from datablocks import new_material, new_world
 from test_cycles_compare import add_light, focused_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
@@ -36,7 +37,7 @@ DARKER = 0.97
 
 
 def grey_floor(scene):
-    mat = bpy.data.materials.new("Floor")
+    mat = new_material("Floor")
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
     bsdf.inputs["Specular IOR Level"].default_value = 0.0
@@ -69,7 +70,7 @@ def moving_camera_scene():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     rh.set_resolution(scene, 32, 32)
-    scene.world = bpy.data.worlds.new("World")
+    scene.world = new_world("World")
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     mat = grey_floor(scene)
     bpy.ops.mesh.primitive_cube_add(size=0.6, location=(0.0, 0.0, 0.3))
