@@ -49,7 +49,7 @@ def _fingerprint() -> str:
     for source in sorted(core.rglob("*.py")):
         h.update(str(source.relative_to(core)).encode())
         h.update(source.read_bytes())
-    return h.hexdigest()[:16]
+    return f"py{sys.version_info[0]}{sys.version_info[1]}-{h.hexdigest()[:16]}"
 
 
 _FINGERPRINT = _fingerprint()
@@ -93,14 +93,16 @@ def first_run() -> bool:
 
 
 def mark_compiled() -> None:
-    """Record that this version's kernels are in the cache and remove other versions' folders
-    (best effort: a read-only cache folder only means the message shows again)."""
+    """Record that this version's kernels are in the cache and remove the folders of older versions
+    for the same Python (other Pythons' folders belong to other Blenders or venvs and stay; best
+    effort: a read-only cache folder only means the message shows again)."""
     try:
         folder = cache_dir()
         folder.mkdir(parents=True, exist_ok=True)
         (folder / _STAMP).touch()
         for old in folder.parent.iterdir():
-            if old != folder and old.is_dir() and re.fullmatch(r"[0-9a-f]{16}", old.name):
+            same_python = re.fullmatch(re.escape(_FINGERPRINT.split("-")[0]) + r"-[0-9a-f]{16}", old.name)
+            if old != folder and old.is_dir() and same_python:
                 shutil.rmtree(old, ignore_errors=True)
     except OSError:
         pass
