@@ -23,7 +23,8 @@ Two modes decide which pixels keep receiving samples after the minimum:
 The error of the whole image comes from the film's per-pixel variance estimate:
 RMSE over pixels and RGB channels, and relMSE = mean of variance / (true value^2 + 0.01)
 (Rousselle et al. 2011), the same measure the benchmark computes against a reference, with
-true value^2 estimated without bias (``image_error``).
+true value^2 estimated without bias and each pixel's term pooled over its 5x5 neighbourhood
+(``image_error``).
 """
 from __future__ import annotations
 
