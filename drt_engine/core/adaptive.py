@@ -250,7 +250,8 @@ def pooled_relative_error(film: Film) -> np.ndarray:
     r = np.empty(film.n)
     for span, var, mean in _rgb_blocks(film):
         square = mean * mean
-        r[span] = (var / (np.maximum(square - var, TRUE_FLOOR * square) + RELMSE_EPSILON)).sum(axis=1) * film.count[span]
+        true_square = np.maximum(square - var, TRUE_FLOOR * square)
+        r[span] = (var / (true_square + RELMSE_EPSILON)).sum(axis=1) * film.count[span]
     h, w = film.height, film.width
     return box_mean(r, h, w, POOL_RADIUS) / box_mean(film.count, h, w, POOL_RADIUS)
 

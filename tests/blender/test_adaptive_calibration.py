@@ -3,13 +3,13 @@
 At every logged step, the estimated RMSE and relMSE of the image (``adaptive.image_error``,
 from the film's two independent replicates) are each within a factor of 1.5 of the true ones
 against a reference of 1024 samples with another seed, less the reference's own estimated
-variance (the relMSE from RELMSE_FROM samples up). Both are pooled over four seeds (RMSE as the root of the mean square, relMSE as
-the mean): at 32 pixels wide the error of
-glossy_spheres sits in the handful of pixels that hold the gold sphere's highlight, so
-one render's true error is itself a sum of a few squares (one seed alone ranged from
-0.5 to 1.9 times its estimate). Adaptive renders are compared step by step (the k-th
-logged step of each seed; their rounds follow their own pixels, so the most samples a
-pixel holds can differ between seeds), which always includes the first test.
+variance (the relMSE from RELMSE_FROM samples up), with and without adaptive sampling.
+Both are pooled over four seeds (RMSE as the root of the mean square, relMSE as the mean):
+at 32 pixels wide the error of glossy_spheres sits in the handful of pixels that hold the gold
+sphere's highlight, so one render's true error is itself a sum of a few squares (one seed alone
+ranged from 0.5 to 1.9 times its estimate). Adaptive renders are compared step by step (the k-th
+logged step of each seed; their rounds follow their own pixels, so the most samples a pixel
+holds can differ between seeds), which always includes the first test.
 """
 import bpy
 import numpy as np
