@@ -207,6 +207,28 @@ def test_film_error_of_independent_halves_is_unbiased():
     assert film.variance().mean() == pytest.approx(0.04 / n, rel=0.08)
 
 
+
+def test_relmse_estimate_pools_pixels_by_their_counts():
+    """With equal counts the pooled estimate keeps the image's relMSE (up to the repeated edges);
+    a pixel stopped on an estimate of 0 among pixels that kept sampling reads their error."""
+    rng = np.random.default_rng(5)
+    film = Film(32, 32, ("Combined",))
+    film.count[:], film.count_a[:] = 16, 8
+    film.sums["Combined"][:] = 16 * 0.5
+    film.sum_a[:] = 8 * (0.5 + rng.exponential(0.05, (film.n, 1)))
+    var = film.variance()
+    own = (var / (np.maximum(0.25 - var, 0.25 * 0.25) + adaptive.RELMSE_EPSILON)).mean()
+    assert adaptive.image_error(film)[1] == pytest.approx(own, rel=0.03)
+
+    film.count[:], film.count_a[:] = 32, 16
+    film.sums["Combined"][:] = 32 * 0.5
+    film.sum_a[:] = 16 * 0.55
+    centre = 16 * 32 + 16
+    film.count[centre], film.count_a[centre] = 8, 4
+    film.sums["Combined"][centre], film.sum_a[centre] = 8 * 0.5, 4 * 0.5
+    pooled = adaptive.pooled_relative_error(film)
+    assert pooled[centre] == pytest.approx(pooled[0], rel=0.05) and pooled[0] > 0
+
 # -- stop rules ---------------------------------------------------------------------------
 
 def test_target_error_stops_at_the_first_step_under_it():
