@@ -17,6 +17,7 @@ import bpy
 import mathutils
 import numpy as np
 
+from datablocks import new_material, new_world
 from export_helpers import empty_scene
 
 TILE = 32
@@ -143,7 +144,7 @@ def _musgrave_converted(tree, tex, sockets, kind, detail, dimension):
 
 
 def _material(case: Case):
-    mat = bpy.data.materials.new(case.name)
+    mat = new_material(case.name)
     tree = mat.node_tree
     tree.nodes.clear()
     coords = tree.nodes.new("ShaderNodeTexCoord")
@@ -183,6 +184,15 @@ def _material(case: Case):
     return mat
 
 
+def _scene(width: int, height: int):
+    """An empty scene whose Cycles renders with the classic (Tabulated Sobol) pattern, as a new
+    scene in Blender 5.0 does: 4.x's default (Automatic) dithers its samples as blue noise, which
+    changes Cycles' own seed-to-seed block figure, the yardstick of ``parity``."""
+    scene = empty_scene(width, height)
+    scene.cycles.sampling_pattern = "TABULATED_SOBOL"
+    return scene
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))
@@ -191,11 +201,11 @@ def grid_shape(n: int) -> tuple[int, int]:
 def grid_scene(cases=CASES):
     """The cases as a grid of emissive tiles (row-major from the top left) under a black world."""
     cols, rows = grid_shape(len(cases))
-    scene = empty_scene(cols * TILE, rows * TILE)
+    scene = _scene(cols * TILE, rows * TILE)
     cam = scene.camera
     cam.data.type = "ORTHO"
     cam.data.ortho_scale = 2.0 * max(cols, rows)
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     for i, case in enumerate(cases):
@@ -234,7 +244,7 @@ def parity(drt: np.ndarray, cycles0: np.ndarray, cycles1: np.ndarray) -> dict:
 
 def _diffuse(name, color_from):
     """A Diffuse BSDF material whose colour ``color_from(tree)`` (an output socket) gives."""
-    mat = bpy.data.materials.new(name)
+    mat = new_material(name)
     tree = mat.node_tree
     tree.nodes.clear()
     bsdf = tree.nodes.new("ShaderNodeBsdfDiffuse")
@@ -272,11 +282,11 @@ def _sphere_color(tree):
 def lit_scene(width=48):
     """Textures under light: a ground of Voronoi colours times noise and a sphere of bricks
     and waves, both diffuse, lit by a sun and a point light (shadows on textured ground)."""
-    scene = empty_scene(width, width)
+    scene = _scene(width, width)
     cam = scene.camera
     cam.location = (0.0, -6.0, 4.0)
     cam.rotation_euler = (0.98, 0.0, 0.0)
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     bpy.ops.mesh.primitive_plane_add(size=8.0)
@@ -299,11 +309,11 @@ def box_scene(width=48, blend=0.3):
     """An emissive sphere, turned, seen from above at an angle, coloured by an 8x8 image of random
     colours (Closest) in Box projection of its Object coordinates: the three faces and the
     blended seams between them, which follow the object-space normal."""
-    scene = empty_scene(width, width)
+    scene = _scene(width, width)
     cam = scene.camera
     cam.location = (2.6, -3.4, 2.4)
     cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
-    world = bpy.data.worlds.new("World")
+    world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=64, ring_count=32, rotation=(0.3, 0.2, 0.5))
@@ -313,7 +323,7 @@ def box_scene(width=48, blend=0.3):
     texels[..., 3] = 1.0
     image.pixels.foreach_set(texels.ravel())
     image.pack()  # a generated image would be generated again (blank) for the render
-    mat = bpy.data.materials.new("Box")
+    mat = new_material("Box")
     tree = mat.node_tree
     tree.nodes.clear()
     coords = tree.nodes.new("ShaderNodeTexCoord")
