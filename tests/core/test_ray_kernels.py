@@ -151,7 +151,8 @@ def test_plain_python_gives_the_kernels_numbers(tmp_path):
     results = []
     for disable in ("0", "1"):
         out = tmp_path / f"jit{disable}.npz"
-        env = dict(os.environ, NUMBA_DISABLE_JIT=disable, PYTHONPATH=str(ROOT))
+        path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))  # keep the caller's
+        env = dict(os.environ, NUMBA_DISABLE_JIT=disable, PYTHONPATH=path)
         subprocess.run([sys.executable, "-c", f"OUT = {str(out)!r}\n" + _SCRIPT], env=env, check=True, cwd=ROOT)
         results.append(np.load(out))
     compiled, plain = results
