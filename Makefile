@@ -6,7 +6,7 @@
 #   make extension   download the embreex wheels, validate, build the extension zips into dist/
 #   make scenes      rebuild the sample .blend files from their scripts
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
-#                    bench/plots/), then ray throughput and memory; about 20 min on 2 cores
+#                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
 #   make texture-parity  DRT vs Cycles per procedural texture and mode (tools/texture_parity.py: README table)
