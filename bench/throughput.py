@@ -223,6 +223,7 @@ def main(argv=None):
         scene, data = load(name, args.width)
         prepared = PreparedScene(data)
         cam = camera_batch(data, WAVE)
+        drt_rate(data, prepared, scene, 1, 1)  # compile or load the kernels before timing (Cycles' are built in)
         (raw1, raw_cpu), (raw, _) = raw_embree(prepared.geometry, cam, 1), raw_embree(prepared.geometry, cam, cores)
         drt1, drt_cpu, seconds1, _, _ = drt_rate(data, prepared, scene, 1, args.samples)
         drt, _, seconds, rays, plan = drt_rate(data, prepared, scene, 0, args.samples)
