@@ -85,7 +85,7 @@ def log_interp(points, t):
 
 def sample_scenes(width, names):
     import drt_engine
-    from scenes import load, settings
+    from scenes import load
 
     drt_engine.register()
     for name in names:
