@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from .jit import kernel
-from .microfacet import concentric_disk
+from .microfacet import basis, concentric_disk
 from .scene import Light
 from .shadernodes import LUMINANCE
 
@@ -111,16 +111,6 @@ def _spread_terms(spread: float):
     if h <= 0:
         return 2.0, 0.0, 0.0
     return 1.0, math.tan(h), 3.0 / h ** 3 if h <= 0.05 else 1.0 / (math.tan(h) - h)
-
-
-# -- small vector helpers ---------------------------------------------------------------
-@kernel(inline="always")
-def basis(nx, ny, nz):
-    """Two unit vectors completing a unit vector to a right-handed frame (Duff et al. 2017)."""
-    s = 1.0 if nz >= 0 else -1.0
-    a = -1.0 / (s + nz)
-    b = nx * ny * a
-    return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
 
 
 @kernel(inline="always")

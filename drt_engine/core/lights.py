@@ -23,8 +23,8 @@ from .environment import Environment, map_direction, map_pdf
 from .errors import SceneError
 from .jit import kernel
 from .light_choice import pick_light, pick_probability
-from .light_kinds import (TINY, basis, concentric_disk, hit_light, light_pdf, light_row, light_table, sample_light,
-                          sun_seen)
+from .light_kinds import TINY, hit_light, light_pdf, light_row, light_table, sample_light, sun_seen
+from .microfacet import basis, concentric_disk
 from .motion import Motion
 from .scene import Light, SceneData
 from .shadernodes import LUMINANCE

@@ -211,6 +211,16 @@ def refract(wx, wy, wz, hx, hy, hz, eta):
 
 
 @kernel(inline="always")
+def basis(nx, ny, nz):
+    """Two unit vectors completing a unit vector to a right-handed frame (Duff et al. 2017);
+    the per-ray form of ``orthonormal_basis``."""
+    s = 1.0 if nz >= 0 else -1.0
+    a = -1.0 / (s + nz)
+    b = nx * ny * a
+    return 1.0 + s * nx * nx * a, s * b, -s * nx, b, s + ny * ny * a, -ny
+
+
+@kernel(inline="always")
 def concentric_disk(u0, u1):
     """Shirley's concentric map of the unit square onto the unit disk (lens, disk lights, cones)."""
     a = 2.0 * u0 - 1.0
