@@ -64,6 +64,8 @@ def render(args, blend: Path, output: Path) -> str:
     except KeyboardInterrupt:
         if futures:
             client.cancel(futures, force=True)
+        if cluster is not None:
+            _end_local_renders()
         raise CLIError("cancelled: the tasks were cancelled" + (" and the local cluster shut down" if cluster
                                                                 else ""), 130) from None
     finally:
@@ -177,6 +179,20 @@ def _check_workers(client, args) -> list[str]:
         if isinstance(result, BaseException):
             raise CLIError(f"worker {address} cannot run DRT: {_one_line(result)}")
     return sorted(results)
+
+
+def _end_local_renders() -> None:
+    """Ctrl-C on a local cluster: end the workers' render processes at once. A render busy in
+    compiled code (a kernel compiling on a cold cache) answers its SIGINT only when it returns to
+    Python, and its worker cannot close before it ends."""
+    import psutil
+
+    for child in psutil.Process().children(recursive=True):
+        try:
+            if "--sample-range" in child.cmdline():
+                child.kill()
+        except psutil.Error:
+            pass
 
 
 def _close(client, cluster) -> None:
