@@ -157,6 +157,13 @@ def measure(size: int, samples: int) -> dict:
     }
 
 
+def _load_words(m: dict) -> str:
+    """What the load average says about the wall times."""
+    if max(m["load"]) > m["cores"]:
+        return "other jobs shared the cores, so wall times are stretched and the CPU seconds are the figures to go by"
+    return "nothing else ran, so wall times are the machine's own"
+
+
 def section(m: dict) -> str:
     f, s = m["farm"], m["single"]
     mod = m["model"]
@@ -169,8 +176,9 @@ def section(m: dict) -> str:
     p = m["parts"]
     return f"""{MARK_BEGIN}
 Measured by `bench/farm.py` on this machine ({m['cores']} cores; load average {m['load'][0]:.0f} at the start and
-{m['load'][1]:.0f} at the end: other jobs shared the cores, so wall times are stretched several times and the
-CPU seconds are the figures to go by): `{m['scene']}` at {m['size']}x{m['size']}, {m['samples']} samples.
+{m['load'][1]:.0f} at the end: {_load_words(m)}): `{m['scene']}` at {m['size']}x{m['size']}, {m['samples']} samples.
+2 local workers took {f['wall_s'] / s['wall_s']:.2f} times the wall time of 1 process (cluster start and each task's
+overhead below against a render of {s['render_s']:.1f} s).
 
 | run | wall (s) | CPU, all processes (s) | rendering, wall (s) | rendering, CPU (s) |
 |---|---|---|---|---|
