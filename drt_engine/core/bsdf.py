@@ -491,6 +491,17 @@ class MaterialShader:
         lk.colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
         return diff, gloss
 
+    def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
+        """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles
+        splits its closures for the Denoising Albedo pass (``lobe_kernels.denoising_albedos``)."""
+        n = len(mu_o)
+        diff = np.empty((n, 3))
+        spec = np.empty((n, 3))
+        take = np.empty(n, bool)
+        lk.denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
+                          diff, spec, take)
+        return diff, spec, take
+
     def lobe_weights(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,
         per-hit scale) times its multiple-scattering factor, what the albedo tables decide."""
