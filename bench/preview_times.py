@@ -1,6 +1,7 @@
 """Material preview times in the bpy wheel: Blender's own preview renders (icon and large
 preview, ``bpy.ops.wm.previews_ensure``, the engine's ``is_preview`` path) of the Cornell
-box's materials, kernels cached (a first round warms them), and where each render's time goes.
+box's materials, kernels cached, and where each render's time goes: every material's previews
+are rendered WARM_ROUNDS times (the first compiles or loads the kernels), then once more, measured.
 
     .venv/bin/python bench/preview_times.py [--label NAME] [--readme]
 
@@ -19,7 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 RESULTS = ROOT / "bench" / "preview_times.json"
-ROUNDS = 3
+WARM_ROUNDS = 3
 
 
 def measure() -> dict:
@@ -62,13 +63,13 @@ def measure() -> dict:
     engine_module.DRTRenderEngine.render = logged
 
     materials = [m for m in bpy.data.materials if m.users and not m.name.startswith("Floor")]
-    for round_ in range(ROUNDS + 1):  # round 0 compiles or loads the kernels
+    for _ in range(WARM_ROUNDS + 1):
         renders.clear()
         for material in materials:
             material.preview_ensure().reload()
         bpy.ops.wm.previews_ensure()
     sizes = sorted({r["size"] for r in renders})
-    out = {"blender": bpy.app.version_string, "materials": [m.name for m in materials], "rounds": ROUNDS}
+    out = {"blender": bpy.app.version_string, "materials": [m.name for m in materials], "warm_rounds": WARM_ROUNDS}
     for name, size in zip(("icon", "large"), sizes):
         mine = [r for r in renders if r["size"] == size]
         out[name] = {"size": size, "renders": len(mine),
@@ -93,7 +94,7 @@ def readme_block(runs: dict) -> str:
     first = next(iter(runs.values()))
     lines.append("")
     lines.append(f"Blender {first['blender']} (bpy wheel), previews of the Cornell box's materials "
-                 f"({', '.join(first['materials'])}), {first['rounds']} rounds after one that loads the kernels; "
+                 f"({', '.join(first['materials'])}), each rendered once after {first['warm_rounds']} warm-up rounds; "
                  "written by `bench/preview_times.py` on a 2-core machine shared with other jobs.")
     return "\n".join(lines)
 
