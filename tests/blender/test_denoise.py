@@ -163,3 +163,21 @@ def test_denoise_node_brings_16_samples_closer_to_1024(drt, sample_scene, tmp_pa
     print(f"relMSE 16 spp noisy {noisy_error:.3g}, denoised {denoised_error:.3g}, "
           f"ratio {noisy_error / denoised_error:.2f}")
     assert denoised_error < noisy_error
+
+
+def test_the_cli_exr_carries_the_passes(bl, tmp_path):
+    """An emitter seen by the camera: its emission is the albedo (Cycles adds emission met while
+    the features are open) and, without a BSDF, the normal is zero."""
+    from test_cli import run_cli
+
+    scene = bl.emission_scene(strength=0.5, samples=2)
+    scene.view_layers[LAYER].drt.use_pass_denoising_data = True
+    blend = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out = tmp_path / "out.exr"
+    result = run_cli("render", blend, "-o", out)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    channels = bl.read_channels(out)
+    assert {"Denoising Albedo", "Denoising Normal"} <= bl.passes_in(channels, LAYER)
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Denoising Albedo"), 0.5, rtol=1e-5)
+    np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Denoising Normal"), 0.0)
