@@ -23,6 +23,8 @@ BLENDER_PASS_TOGGLES = {
 DRT_PASS_TOGGLES = {
     "Sample Count": "use_pass_sample_count",
     "Noise": "use_pass_noise",
+    "Denoising Albedo": "use_pass_denoising_data",
+    "Denoising Normal": "use_pass_denoising_data",
 }
 """DRT's own passes, toggled by ``view_layer.drt.<property>``."""
 
@@ -225,6 +227,13 @@ class DRTViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_noise: BoolProperty(
         name="Noise",
         description="Write each pixel's standard error of the Combined estimate",
+        default=False,
+        update=_update_render_passes,
+    )
+    use_pass_denoising_data: BoolProperty(
+        name="Denoising Data",
+        description="Write the Denoising Albedo and Denoising Normal passes, as Cycles does, for the "
+        "compositor's Denoise node (Image, Albedo and Normal inputs)",
         default=False,
         update=_update_render_passes,
     )

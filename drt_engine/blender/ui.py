@@ -203,6 +203,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_z")
         col.prop(view_layer, "use_pass_normal")
         col.prop(view_layer, "use_pass_position")
+        col.prop(view_layer.drt, "use_pass_denoising_data")
         col = layout.column(heading="Light", align=True)
         col.prop(view_layer, "use_pass_diffuse_color", text="Diffuse Color")
         col.prop(view_layer, "use_pass_glossy_color", text="Glossy Color")

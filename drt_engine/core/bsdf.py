@@ -17,6 +17,7 @@ arrays ``MaterialShader`` packs the lobes into.
 from __future__ import annotations
 
 import copy
+import threading
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -88,6 +89,12 @@ the second level (roughness 0.004) they are exact. Measured: lobe weights (layer
 multiple-scattering factors) within 0.1% of the exact tables' for view cosines above 0.2,
 0.5% above 0.1 and 1.7% at 0.02 (test_bsdf)."""
 _GRID_TABLES: dict = {}
+_EXACT_TABLES: dict = {}
+_EXACT_TABLES_MAX = 512
+_EXACT_LOCK = threading.Lock()
+"""Exact tables by (Fresnel key, alpha), kept across shaders and renders (a material preview
+or a re-render builds the same lobes again; computing a table cost about 50 ms, measured in
+bench/preview_times.py); read-only, oldest dropped first past the cap (each is a few kB)."""
 
 
 class Tables:
@@ -100,7 +107,7 @@ class Tables:
     def albedo(self, alpha: float, fresnel, key) -> tuple[np.ndarray, np.ndarray]:
         s = max(float(alpha), 0.0) ** 0.25 * ROUGHNESS_GRID  # sqrt(roughness) in grid units
         if not self.grid or s < 2.0:
-            return mf.directional_albedo(alpha, fresnel)
+            return _exact_table(key, float(alpha), fresnel)
         k = min(int(np.floor(s)), ROUGHNESS_GRID - 1)
         t = s - k
         lo = self._grid(key, k, fresnel)
@@ -127,6 +134,22 @@ class Tables:
         if found is None:
             found = _GRID_TABLES[(key, k)] = mf.directional_albedo((k / ROUGHNESS_GRID) ** 4, fresnel)
         return found
+
+
+def _exact_table(key, alpha: float, fresnel):
+    """``mf.directional_albedo(alpha, fresnel)``, kept by (key, alpha): a key names its Fresnel."""
+    if key is None:
+        return mf.directional_albedo(alpha, fresnel)
+    found = _EXACT_TABLES.get((key, alpha))
+    if found is None:
+        mu, e = mf.directional_albedo(alpha, fresnel)
+        e.setflags(write=False)
+        found = (mu, e)
+        with _EXACT_LOCK:  # a viewport's worker may prepare a scene meanwhile
+            if len(_EXACT_TABLES) >= _EXACT_TABLES_MAX:
+                _EXACT_TABLES.pop(next(iter(_EXACT_TABLES)))
+            _EXACT_TABLES[(key, alpha)] = found
+    return found
 
 
 EXACT = Tables()
@@ -490,6 +513,17 @@ class MaterialShader:
         gloss = np.empty((n, 3))
         lk.colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
         return diff, gloss
+
+    def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
+        """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles
+        splits its closures for the Denoising Albedo pass (``lobe_kernels.denoising_albedos``)."""
+        n = len(mu_o)
+        diff = np.empty((n, 3))
+        spec = np.empty((n, 3))
+        take = np.empty(n, bool)
+        lk.denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
+                          diff, spec, take)
+        return diff, spec, take
 
     def lobe_weights(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,

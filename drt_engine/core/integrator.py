@@ -18,6 +18,7 @@ from . import camera as camera_rays
 from . import dims as D
 from . import microfacet as mf
 from .accel import spawn
+from .denoising import Features
 from .film import PixelFilter
 from .records import BsdfSample, PathState, Samples, ShadowRays, SurfaceHits
 from .shading import SurfaceContext
@@ -25,7 +26,7 @@ from .shading import SurfaceContext
 _TINY = 1e-30
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
-        ("Emit", "RGB"), ("Env", "RGB"))
+        ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"))
 
 
 def _power(a, b):
@@ -60,6 +61,7 @@ class WaveOutput:
     radiance: np.ndarray
     alpha: np.ndarray
     aux: dict
+    features: Features | None = None  # the denoising features' walks, when those passes are on
 
     def values(self, clamp: float) -> dict:
         radiance = self.radiance
@@ -102,6 +104,8 @@ class Integrator:
                                                         if name in s.passes})
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
+        if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
+            out.features = Features(n, self.camera, out.aux)
         for depth in range(s.max_depth + 1):
             if len(state) == 0:
                 break
@@ -133,6 +137,8 @@ class Integrator:
             for group, u_g, shader in self._bind_materials(surf, u, hits):
                 if depth == 0:
                     self._colors(group, shader, out)
+                if out.features is not None:
+                    out.features.surface(group, shader)
                 if self.lights.strategies and shader.lobes:
                     # the terminator lift is for diffuse shading over coarse facets (measured on
                     # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
@@ -183,6 +189,8 @@ class Integrator:
             contrib = contrib.copy()
             contrib[smooth] *= _power(rays.prev_pdf[smooth], pl)[:, None]
         out.radiance[rays.path] += rays.throughput * contrib
+        if out.features is not None:
+            out.features.emitted(rays.path, contrib)
         if self.film_transparent:
             direct = rays.straight
             out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
@@ -207,11 +215,15 @@ class Integrator:
                 weight[smooth] = _power(rays.prev_pdf[smooth],
                                         lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
             out.radiance[rays.path] += rays.throughput * world * weight[:, None]
+            if out.features is not None:
+                out.features.emitted(rays.path, world * weight[:, None])
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
             weight = np.where(np.isinf(bounced.prev_pdf), 1.0, _power(bounced.prev_pdf, pdf_sun))
             out.radiance[bounced.path] += bounced.throughput * sun * weight[:, None]
+            if out.features is not None:
+                out.features.emitted(bounced.path, sun * weight[:, None])
 
     def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
@@ -246,6 +258,8 @@ class Integrator:
             weight[smooth] = _power(prev_pdf[smooth], pl)
         e = surf.throughput[glowing] * emission * weight[:, None]
         out.radiance[surf.path[glowing]] += e
+        if out.features is not None:
+            out.features.emitted(surf.path[glowing], emission * weight[:, None])
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]

@@ -416,6 +416,50 @@ def colours(lp, lt, hp, r, mu, mu_o):
     return d0, d1, d2, g0, g1, g2
 
 
+DENOISE_ROUGH = 0.075
+"""GGX alpha above which Cycles counts a closure as diffuse-like for the denoising features
+(``bsdf_get_specular_roughness_squared > sqr(0.075)`` in kernel/film/denoising_passes.h)."""
+
+
+@kernel(inline="always")
+def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
+    """(diffuse-like albedo RGB, specular-like albedo RGB, whether the hit is diffuse-like enough
+    to take the denoising features), by Cycles' rule: each lobe's albedo goes to one side by its
+    roughness, and the hit waits for the next bounce if 75% or more of the lobes' weight (the
+    mean of their albedos) is specular-like."""
+    j, t = locate(mu, mu_o)
+    d0 = d1 = d2 = s0 = s1 = s2 = 0.0
+    total = diffuse = 0.0
+    for l in range(lp.shape[0]):
+        kind = int(lp[l, P_KIND])
+        if kind == GLASS:
+            w0, w1, w2 = lobe_scale(lp, lt, hp, r, j, t, l)
+            f = 0.0
+            if lp[l, P_REFRACT_ONLY] == 0.0:
+                f = mf.fresnel_dielectric1(-mu_o if inside else mu_o, lp[l, P_ETA])
+            a0 = w0 * (hp[r, l, H_TINT_R] * f + hp[r, l, H_TINT_T] * (1.0 - f))
+            a1 = w1 * (hp[r, l, H_TINT_R + 1] * f + hp[r, l, H_TINT_T + 1] * (1.0 - f))
+            a2 = w2 * (hp[r, l, H_TINT_R + 2] * f + hp[r, l, H_TINT_T + 2] * (1.0 - f))
+        elif kind == REFLECT:
+            w0, w1, w2 = lobe_scale(lp, lt, hp, r, j, t, l)
+            e0, e1, e2 = reflect_albedo(lp, lt, hp, r, j, t, l, True)
+            a0, a1, a2 = w0 * e0, w1 * e1, w2 * e2
+        else:
+            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+        weight = (a0 + a1 + a2) / 3.0
+        total += weight
+        if kind == DIFFUSE or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
+            d0 += a0
+            d1 += a1
+            d2 += a2
+            diffuse += weight
+        else:
+            s0 += a0
+            s1 += a1
+            s2 += a2
+    return d0, d1, d2, s0, s1, s2, total == 0.0 or 4.0 * diffuse > total
+
+
 # -- batch loops over a wave's arrays --------------------------------------------------
 @kernel
 def selection_rows(lp, lt, hp, prow, mu, mu_o, out):
@@ -452,6 +496,15 @@ def colours_rows(lp, lt, hp, prow, mu, mu_o, diff, gloss):
         v = colours(lp, lt, hp, prow[i], mu, mu_o[i])
         diff[i, 0], diff[i, 1], diff[i, 2] = v[0], v[1], v[2]
         gloss[i, 0], gloss[i, 1], gloss[i, 2] = v[3], v[4], v[5]
+
+
+@kernel
+def denoising_rows(lp, lt, hp, prow, mu, mu_o, inside, diff, spec, take):
+    for i in range(len(mu_o)):
+        v = denoising_albedos(lp, lt, hp, prow[i], mu, mu_o[i], inside[i])
+        diff[i, 0], diff[i, 1], diff[i, 2] = v[0], v[1], v[2]
+        spec[i, 0], spec[i, 1], spec[i, 2] = v[3], v[4], v[5]
+        take[i] = v[6]
 
 
 @kernel

@@ -20,6 +20,8 @@ PASSES = (
     "Env",  # environment seen directly
     "Sample Count",  # samples taken per pixel
     "Noise",  # standard error of the Combined estimate per pixel
+    "Denoising Albedo",  # Cycles' albedo of the first diffuse-like hit, for the Denoise node (core.denoising)
+    "Denoising Normal",  # its normal in Cycles' camera space
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -32,6 +34,8 @@ PASS_CHANNELS = {
     "Env": "RGB",
     "Sample Count": "X",
     "Noise": "RGB",
+    "Denoising Albedo": "RGB",
+    "Denoising Normal": "XYZ",
 }
 
 

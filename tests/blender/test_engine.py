@@ -90,6 +90,7 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
         setattr(view_layer, attr, True)
     view_layer.drt.use_pass_sample_count = True
     view_layer.drt.use_pass_noise = True
+    view_layer.drt.use_pass_denoising_data = True
     channels = bl.render_exr(scene, tmp_path / "all.exr")
     assert bl.passes_in(channels, LAYER) == set(PASSES)
     for name in PASSES:

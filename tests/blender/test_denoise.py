@@ -1,0 +1,183 @@
+"""Blender's compositor Denoise node takes DRT's Image, Denoising Albedo and Denoising Normal as
+it takes Cycles': the passes hold what Cycles writes there, and denoising a 16-sample render
+brings it closer to a 1024-sample one (OpenImageDenoise is in the bpy 5.0 wheel's compositor;
+Debian's Blender 4.3 has none, so this runs here)."""
+import json
+import math
+
+import bpy
+import numpy as np
+
+from datablocks import new_compositor, new_material
+from render_helpers import ROOT, read_channels, save_side_by_side, set_exr_output, set_resolution
+
+LAYER = "ViewLayer"
+COLOUR = (0.2, 0.4, 0.6)
+TINT = (0.9, 0.5, 0.7)
+NOISY_SPP, REFERENCE_SPP, RESOLUTION = 16, 1024, 96
+UI_DIR = ROOT / "out" / "ui"
+
+
+def _plane(name, half, z, material, x=0.0, facing_down=False):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = (x, 0.0, z)
+    if facing_down:
+        obj.rotation_euler = (math.pi, 0.0, 0.0)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def _bsdf_material(name, node_type, color, roughness=None):
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    bsdf = tree.nodes.new(node_type)
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    if roughness is not None:
+        bsdf.inputs["Roughness"].default_value = roughness
+    tree.links.new(bsdf.outputs[0], tree.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+    return mat
+
+
+def mirror_and_paint_scene():
+    """Camera 2 m above a floor: left half a tinted mirror, right half diffuse paint; 3 m up a
+    diffuse ceiling facing down, which the mirror shows. Tilted about x so normals are not axes."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    set_resolution(scene, 16, 8)
+    paint = _bsdf_material("Paint", "ShaderNodeBsdfDiffuse", COLOUR)
+    _plane("Mirror", 2.0, 0.0, _bsdf_material("Mirror", "ShaderNodeBsdfGlossy", TINT, roughness=0.0), x=-2.0)
+    _plane("Paint", 2.0, 0.0, paint, x=2.0)
+    _plane("Ceiling", 20.0, 3.0, _bsdf_material("Ceiling", "ShaderNodeBsdfDiffuse", (0.8, 0.6, 0.4)),
+           facing_down=True)
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.location = (0.0, 0.0, 2.0)
+    camera.rotation_euler = (0.1, 0.0, 0.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    return scene
+
+
+def denoising_passes(scene, engine, tmp_path):
+    """(albedo, normal) of a render of ``scene`` by ``engine`` with its denoising data on."""
+    scene.render.engine = engine
+    view_layer = scene.view_layers[LAYER]
+    if engine == "CYCLES":
+        scene.cycles.device, scene.cycles.samples, scene.cycles.use_denoising = "CPU", 4, False
+        view_layer.cycles.denoising_store_passes = True
+    else:
+        scene.drt.samples = 4
+        view_layer.drt.use_pass_denoising_data = True
+    path = set_exr_output(scene, tmp_path / f"{engine}.exr")
+    assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
+    channels = read_channels(path)
+    return tuple(np.stack([channels[f"{LAYER}.{name}.{c}"] for c in ids], axis=-1)
+                 for name, ids in (("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ")))
+
+
+def test_denoising_passes_match_cycles(drt, tmp_path):
+    """Diffuse paint: its colour and its normal in Cycles' camera space; the mirror: its tint
+    times the ceiling's colour, the ceiling's normal. Columns next to the seam mix both."""
+    scene = mirror_and_paint_scene()
+    drt_albedo, drt_normal = denoising_passes(scene, "DRT", tmp_path)
+    cycles_albedo, cycles_normal = denoising_passes(scene, "CYCLES", tmp_path)
+    inner = np.r_[0:6, 10:16]
+    np.testing.assert_allclose(drt_albedo[:, 10:], np.broadcast_to(COLOUR, (8, 6, 3)), atol=1e-4)
+    np.testing.assert_allclose(drt_albedo[:, :6], np.broadcast_to(np.multiply(TINT, (0.8, 0.6, 0.4)), (8, 6, 3)),
+                               atol=0.02)
+    np.testing.assert_allclose(drt_albedo[:, inner], cycles_albedo[:, inner], atol=0.02)
+    np.testing.assert_allclose(drt_normal[:, inner], cycles_normal[:, inner], atol=1e-3)
+    assert abs(drt_normal[0, 12, 1]) > 0.05  # the tilt shows: not a normal along an axis
+
+
+def test_the_toggle_adds_both_sockets_to_render_layers(drt):
+    scene = mirror_and_paint_scene()
+    scene.render.engine = "DRT"
+    node = new_compositor(scene).nodes.new("CompositorNodeRLayers")
+    node.scene, node.layer = scene, LAYER
+    names = {"Denoising Albedo", "Denoising Normal"}
+    assert not names & {s.name for s in node.outputs if s.enabled}
+    scene.view_layers[LAYER].drt.use_pass_denoising_data = True
+    assert names <= {s.name for s in node.outputs if s.enabled}
+
+
+def _denoise_compositor(scene):
+    """Render Layers (Image, Denoising Albedo, Denoising Normal) -> Denoise -> the composite
+    output (Composite node in 4.x, the group output in 5.0), as Cycles users wire it."""
+    tree = new_compositor(scene)
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    layers.scene, layers.layer = scene, LAYER
+    denoise = tree.nodes.new("CompositorNodeDenoise")
+    for output, socket in (("Image", "Image"), ("Denoising Albedo", "Albedo"), ("Denoising Normal", "Normal")):
+        tree.links.new(layers.outputs[output], denoise.inputs[socket])
+    if hasattr(scene, "compositing_node_group"):
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+        tree.links.new(denoise.outputs["Image"], tree.nodes.new("NodeGroupOutput").inputs[0])
+    else:
+        tree.links.new(denoise.outputs["Image"], tree.nodes.new("CompositorNodeComposite").inputs["Image"])
+
+
+def relmse(image, reference):
+    """Mean relative squared error over pixels and channels, (x - ref)^2 / (ref^2 + 0.01)."""
+    return float(np.mean((image - reference) ** 2 / (reference ** 2 + 1e-2)))
+
+
+def test_denoise_node_brings_16_samples_closer_to_1024(drt, sample_scene, tmp_path):
+    bpy.ops.wm.open_mainfile(filepath=str(sample_scene("cornell_box")), load_ui=False)
+    scene = bpy.context.scene
+    scene.render.engine = "DRT"
+    set_resolution(scene, RESOLUTION, RESOLUTION)
+    drt = scene.drt
+    drt.use_adaptive_sampling, drt.time_limit, drt.target_error, drt.seed = False, 0.0, 0.0, 1
+    scene.view_layers[LAYER].drt.use_pass_denoising_data = True
+    _denoise_compositor(scene)
+    settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):
+        settings.media_type = "IMAGE"
+    settings.file_format, settings.color_depth = "OPEN_EXR", "32"
+    scene.render.use_file_extension = False
+
+    def render(name, samples, composite):
+        drt.samples = samples
+        scene.render.use_compositing = composite
+        scene.render.filepath = str(tmp_path / f"{name}.exr")
+        assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
+        channels = read_channels(scene.render.filepath)
+        return np.stack([channels[c] for c in "RGB"], axis=-1)
+
+    denoised = render("denoised", NOISY_SPP, True)
+    noisy = render("noisy", NOISY_SPP, False)  # the same samples (fixed seed), not composited
+    reference = render("reference", REFERENCE_SPP, False)
+    assert not np.array_equal(denoised, noisy), "the Denoise node did not change the image"
+    noisy_error, denoised_error = relmse(noisy, reference), relmse(denoised, reference)
+    UI_DIR.mkdir(parents=True, exist_ok=True)
+    save_side_by_side("denoise_noisy_16spp", noisy, reference, folder=UI_DIR)
+    save_side_by_side("denoise_denoised_16spp", denoised, reference, folder=UI_DIR)
+    (UI_DIR / "denoise.json").write_text(json.dumps({
+        "scene": "cornell_box", "resolution": RESOLUTION, "samples": NOISY_SPP, "reference_samples": REFERENCE_SPP,
+        "blender": bpy.app.version_string, "relmse_noisy": noisy_error, "relmse_denoised": denoised_error,
+        "ratio": noisy_error / denoised_error}, indent=2) + "\n")
+    print(f"relMSE 16 spp noisy {noisy_error:.3g}, denoised {denoised_error:.3g}, "
+          f"ratio {noisy_error / denoised_error:.2f}")
+    assert denoised_error < noisy_error
+
+
+def test_the_cli_exr_carries_the_passes(bl, tmp_path):
+    """An emitter seen by the camera: its emission is the albedo (Cycles adds emission met while
+    the features are open) and, without a BSDF, the normal is zero."""
+    from test_cli import run_cli
+
+    scene = bl.emission_scene(strength=0.5, samples=2)
+    scene.view_layers[LAYER].drt.use_pass_denoising_data = True
+    blend = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out = tmp_path / "out.exr"
+    result = run_cli("render", blend, "-o", out)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    channels = bl.read_channels(out)
+    assert {"Denoising Albedo", "Denoising Normal"} <= bl.passes_in(channels, LAYER)
+    np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Denoising Albedo"), 0.5, rtol=1e-5)
+    np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Denoising Normal"), 0.0)
