@@ -5,7 +5,8 @@ Defined as Cycles defines its "Denoising Albedo" and "Denoising Normal" passes
 lobes are mostly specular-like (GGX alpha at most 0.075: mirrors, clear glass, transparency),
 multiplying a feature throughput by their specular albedo, and at the first hit that is not
 (or has no lobes) writes that throughput times the hit's diffuse-like albedo, and its shading
-normal in Cycles' camera space (x right, y up, z away from the viewer). Emission and the
+normal in Cycles' camera space (x right, y up, z away from the viewer), which Cycles from
+Blender 5.2 on scales by the walk's mean feature throughput (``weighted``). Emission and the
 world seen while the walk is still open add to the albedo, as in Cycles. The film averages
 both over the pixel's samples.
 """
@@ -28,8 +29,9 @@ class Features:
     """The open feature walks of one wave: each camera sample's feature throughput and
     whether its features are still to be written; writes into the wave's passes ``aux``."""
 
-    def __init__(self, n: int, camera, aux: dict):
+    def __init__(self, n: int, camera, aux: dict, weighted: bool = False):
         self.throughput = np.ones((n, 3))
+        self.weighted = weighted
         self.open = np.ones(n, bool)
         self.to_camera = world_to_camera(camera)
         self.albedo = aux.get(ALBEDO)
@@ -55,6 +57,9 @@ class Features:
             self.albedo[done] += self.throughput[done] * diffuse[take]
         if self.normal is not None:
             # a hit without lobes (pure emission, holdout) has no normal to give: zero, as Cycles
-            self.normal[done] = hits.ns[keep[take]] @ self.to_camera.T if shader.lobes else 0.0
+            normal = hits.ns[keep[take]] @ self.to_camera.T if shader.lobes else 0.0
+            if self.weighted:
+                normal = normal * self.throughput[done].mean(axis=1)[:, None]
+            self.normal[done] = normal
         self.open[done] = False
         self.throughput[going] *= specular[~take]

@@ -105,7 +105,7 @@ class Integrator:
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
-            out.features = Features(n, self.camera, out.aux)
+            out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
         for depth in range(s.max_depth + 1):
             if len(state) == 0:
                 break

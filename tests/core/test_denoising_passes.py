@@ -12,8 +12,9 @@ DENOISING = ("Combined", "Denoising Albedo", "Denoising Normal")
 COLOUR = (0.2, 0.4, 0.6)
 
 
-def render(scene, passes=DENOISING, samples=4):
-    return Renderer(scene, RenderSettings(samples=samples, threads=1, max_depth=4, passes=passes)).render()
+def render(scene, passes=DENOISING, samples=4, weighted=False):
+    return Renderer(scene, RenderSettings(samples=samples, threads=1, max_depth=4, passes=passes,
+                                          weighted_denoising_normal=weighted)).render()
 
 
 def floor_scene(material, camera=None, ceiling=None):
@@ -61,6 +62,10 @@ def test_through_a_mirror_albedo_is_tint_times_the_seen_surface():
     assert np.allclose(passes["Denoising Albedo"], glossy * np.array(COLOUR), atol=1e-6)
     # the ceiling's normal faces the reflected ray (world -z): away from this camera, as in Cycles
     assert np.allclose(passes["Denoising Normal"], [0.0, 0.0, 1.0], atol=1e-6)
+    # Blender 5.2's Cycles scales it by the walk's mean throughput: the mirror's mean reflectance
+    weighted = render(floor_scene(mirror, camera, ceiling), weighted=True).passes
+    assert np.allclose(weighted["Denoising Normal"], [0.0, 0.0, 1.0] * glossy.mean(axis=-1)[..., None], atol=1e-6)
+    assert np.array_equal(weighted["Denoising Albedo"], passes["Denoising Albedo"])
 
 
 def test_a_mirror_with_nothing_to_reflect_has_no_features():
