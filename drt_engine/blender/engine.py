@@ -97,11 +97,9 @@ def preview_settings(settings):
                                sample_start=0, sample_end=0)
 
 
-def viewport_settings(settings):
-    """Settings for Rendered shading: few samples, Combined only, no stop rules."""
-    from .viewport import MAX_SAMPLES
-
-    return dataclasses.replace(settings, samples=min(settings.samples, MAX_SAMPLES), passes=("Combined",),
+def viewport_settings(settings, preview_samples: int):
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules."""
+    return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
                                sample_start=0, sample_end=0)
 
@@ -282,14 +280,15 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self.update_stats("", _one_line(str(error)))
             return
         self._view_scene = scene_data
-        self._view_settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer))
+        self._view_settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer),
+                                                depsgraph.scene.drt.preview_samples)
         self._view_key = None  # view_draw restarts the render with the region's camera
 
     def view_draw(self, context, depsgraph):
         """Draw the newest viewport image; restart the render first if the view changed."""
         import gpu
 
-        from .export.viewport import viewport_camera
+        from .export.viewport import level_cameras, viewport_camera
         from .viewport import ViewportTexture
 
         region, region_data = context.region, context.region_data
@@ -297,8 +296,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             key = (region.width, region.height, tuple(map(tuple, region_data.view_matrix)),
                    tuple(map(tuple, region_data.window_matrix)))
             if key != self._view_key:
-                camera = viewport_camera(region, region_data)
-                self._viewport.start(self._view_scene, camera, self._view_settings)
+                cameras = level_cameras(viewport_camera(region, region_data))
+                self._viewport.start(self._view_scene, cameras, self._view_settings)
                 self._view_key = key
         if self._viewport is None:
             return

@@ -6,7 +6,9 @@ only safe on the main thread), then a worker thread prepares it (core.prepared: 
 scenes, lights, materials) and traces, publishing the image after every round of samples;
 ``view_draw`` only uploads the newest image and draws it. A new scene or a new view stops
 the running worker (it notices at its next progress call) and starts another one; a new
-view of the same scene (orbit, zoom) reuses its prepared scene, only a new scene prepares again. The worker never holds the
+view of the same scene (orbit, zoom) reuses its prepared scene, only a new scene prepares again.
+Each view renders progressively: one sample at 1/8, 1/4 and 1/2 of the region's resolution
+(drawn stretched), then the full resolution accumulating the viewport samples. The worker never holds the
 engine: it asks for redraws through a weak reference, so Blender can free the engine
 whenever it wants, and a ``weakref.finalize`` on the engine stops the worker first.
 """
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import threading
+import time
 import traceback
 import weakref
 from collections.abc import Callable
@@ -22,8 +25,9 @@ import numpy as np
 
 from ..core.errors import DRTError
 
-MAX_SAMPLES = 16
-"""Camera samples per pixel the viewport takes at most (the scene's DRT samples if fewer)."""
+PUBLISH_INTERVAL = 1.0
+"""Seconds between two images of the full-resolution render within a round of samples (every
+round's end publishes too: 1, 2, 4, ... samples)."""
 
 STOP_TIMEOUT = 5.0
 """Seconds the engine waits, when Blender frees it, for the worker to reach its next progress call."""
@@ -44,12 +48,14 @@ class ViewportRender:
         self._prepared = None  # (SceneData, PreparedScene) of the newest scene prepared
         self._prepare_lock = threading.Lock()
 
-    def start(self, scene_data, camera, settings) -> None:
-        """Stop the running worker (without waiting for it) and render ``scene_data`` seen by ``camera``."""
+    def start(self, scene_data, cameras, settings) -> None:
+        """Stop the running worker (without waiting for it) and render ``scene_data`` seen by
+        ``cameras``: coarse to fine, the same view at growing resolutions, one sample each but
+        the last, which takes ``settings.samples``."""
         self._stop.set()
         stop = threading.Event()
         self._stop = stop
-        self._thread = threading.Thread(target=self._run, args=(scene_data, camera, settings, stop),
+        self._thread = threading.Thread(target=self._run, args=(scene_data, cameras, settings, stop),
                                         name="DRT viewport", daemon=True)
         self._thread.start()
 
@@ -82,23 +88,31 @@ class ViewportRender:
                 self._prepared = (scene_data, PreparedScene(scene_data))
             return self._prepared[1]
 
-    def _run(self, scene_data, camera, settings, stop: threading.Event) -> None:
+    def _run(self, scene_data, cameras, settings, stop: threading.Event) -> None:
         from ..core.render import Renderer
         from .engine import done_line, stats_line
 
         try:
             prepared = self.prepared(scene_data)
-            if stop.is_set():
-                return
-            renderer = Renderer(dataclasses.replace(scene_data, camera=camera), settings, prepared)
-            if stop.is_set():  # the view changed while the scene was being prepared
-                return
+            coarse = dataclasses.replace(settings, samples=1)
+            for camera in cameras[:-1]:  # one sample each, a new view on screen at once
+                renderer = Renderer(dataclasses.replace(scene_data, camera=camera), coarse, prepared)
+                result = renderer.render(progress=lambda _: not stop.is_set())
+                if result.cancelled or stop.is_set():
+                    return
+                width, height = camera.resolution
+                self._publish(result.passes["Combined"], stop, f"Preview {width} x {height}")
+            renderer = Renderer(dataclasses.replace(scene_data, camera=cameras[-1]), settings, prepared)
+            last = [0.0]
 
             def progress(update) -> bool:
                 if stop.is_set():
                     return False
-                self._publish(update.passes()["Combined"], stop,
-                              stats_line(update.samples_done, update.samples_total, update.error, update.elapsed))
+                now = time.monotonic()
+                if update.entry is not None or (now - last[0] >= PUBLISH_INTERVAL and update.samples_everywhere):
+                    last[0] = now
+                    self._publish(update.passes()["Combined"], stop,
+                                  stats_line(update.samples_done, update.samples_total, update.error, update.elapsed))
                 return not stop.is_set()
 
             result = renderer.render(progress=progress)
