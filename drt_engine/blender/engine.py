@@ -163,6 +163,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         self._view_settings = None
         self._view_key = None  # region size and matrices the running viewport render is for
         self._view_texture = None
+        self._view_meshes = None  # export.geometry.MeshCache: meshes kept between viewport exports
 
     def render(self, depsgraph):
         try:
@@ -263,15 +264,20 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             )
 
     def view_update(self, context, depsgraph):
-        """The scene changed (or the viewport opened): export it and restart the viewport render."""
+        """The scene changed (or the viewport opened): export what changed and restart the
+        viewport render, whose worker updates the prepared scene for the edit."""
         from .export import export_scene
+        from .export.geometry import MeshCache
+        from .export.viewport import edited_geometry
         from .viewport import ViewportRender, weak_redraw
 
         if self._viewport is None:
             self._viewport = ViewportRender(weak_redraw(self))
+            self._view_meshes = MeshCache()
             weakref.finalize(self, self._viewport.stop)  # Blender frees the engine: stop the worker
+        self._view_meshes.forget(edited_geometry(depsgraph.updates))
         try:
-            scene_data = export_scene(depsgraph)
+            scene_data = export_scene(depsgraph, meshes=self._view_meshes)
         except Exception as error:
             if not isinstance(error, DRTError):  # a bug of ours: details in the console
                 print(f"DRT: unexpected error while exporting for the viewport\n{traceback.format_exc()}")

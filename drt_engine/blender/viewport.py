@@ -6,7 +6,8 @@ only safe on the main thread), then a worker thread prepares it (core.prepared: 
 scenes, lights, materials) and traces, publishing the image after every round of samples;
 ``view_draw`` only uploads the newest image and draws it. A new scene or a new view stops
 the running worker (it notices at its next progress call) and starts another one; a new
-view of the same scene (orbit, zoom) reuses its prepared scene, only a new scene prepares again.
+view of the same scene (orbit, zoom) reuses its prepared scene, an edited scene updates it
+(only the meshes, materials or lights the edit touched are rebuilt).
 Each view renders progressively: one sample at 1/8, 1/4 and 1/2 of the region's resolution
 (drawn stretched), then the full resolution accumulating the viewport samples. The worker never holds the
 engine: it asks for redraws through a weak reference, so Blender can free the engine
@@ -79,13 +80,17 @@ class ViewportRender:
         self._redraw()
 
     def prepared(self, scene_data):
-        """The prepared scene of ``scene_data``: the one made for it before, else a new one
-        (under a lock: a stale worker and a new one never prepare the same scene twice)."""
+        """The prepared scene of ``scene_data``: the one made for it before, else the previous
+        scene's updated for the edit (core.prepared.PreparedScene.update rebuilds only what
+        changed), else a new one (under a lock: a stale worker and a new one never prepare the
+        same scene twice)."""
         from ..core.prepared import PreparedScene
 
         with self._prepare_lock:
-            if self._prepared is None or self._prepared[0] is not scene_data:
+            if self._prepared is None:
                 self._prepared = (scene_data, PreparedScene(scene_data))
+            elif self._prepared[0] is not scene_data:
+                self._prepared = (scene_data, self._prepared[1].update(scene_data))
             return self._prepared[1]
 
     def _run(self, scene_data, cameras, settings, stop: threading.Event) -> None:

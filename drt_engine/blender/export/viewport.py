@@ -31,6 +31,13 @@ def level_cameras(camera: Camera, divisors=COARSE_LEVELS) -> list[Camera]:
     return coarse + [camera]
 
 
+def edited_geometry(updates) -> set[str]:
+    """Names of the datablocks whose geometry ``depsgraph.updates`` reports changed (an edited
+    mesh: its object and its mesh; a moved object reports a transform alone): the meshes the
+    viewport's export must read again (export.geometry.MeshCache.forget)."""
+    return {update.id.name for update in updates if update.is_updated_geometry}
+
+
 def camera_from_matrices(view_matrix, window_matrix, resolution: tuple[int, int]) -> Camera:
     """A DRT camera seeing what an OpenGL view and projection matrix pair sees.
 
