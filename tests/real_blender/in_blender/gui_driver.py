@@ -136,10 +136,24 @@ def instrument_engine() -> None:
 
     engine.render, engine.view_draw = logged_render, logged_view_draw
     module.write_passes = logged_write_passes
+    worker = sys.modules[engine.__module__.rsplit(".", 1)[0] + ".viewport"].ViewportRender
+    start, publish = worker.start, worker._publish
+
+    def logged_start(self, *args):
+        events.append((time.monotonic(), "start", None))
+        start(self, *args)
+
+    def logged_publish(self, image, stop, status):
+        events.append((time.monotonic(), "publish", list(image.shape[:2])))
+        publish(self, image, stop, status)
+
+    worker.start, worker._publish = logged_start, logged_publish
 
 
 draws = []
 """(time, image version, status, image shape) at each viewport draw."""
+events = []
+"""(time, "start" | "publish", image shape) of the viewport worker: where a step's time goes."""
 
 
 def wait_for_viewport(since: float):
@@ -294,17 +308,23 @@ STEP_TIMEOUT = 30.0
 
 def wait_for_image(since: float, full: tuple[int, int]):
     """Yield until a draw after ``since`` shows an image of the full size ``full`` newer than
-    any drawn before; returns (seconds to the first newer image, to the full-size one)."""
-    old = max((d[1] for d in draws if d[0] <= since), default=0)
+    the draw that restarted the render; returns (seconds to the first newer image, to the
+    full-size one, what happened meanwhile: the restart and the worker's images, in seconds)."""
     first = done = None
     while time.monotonic() - since < STEP_TIMEOUT:
-        newer = [d for d in draws if d[0] > since and d[1] > old and d[3] is not None]
+        after = [d for d in draws if d[0] > since]
+        if not after:
+            yield 0.02
+            continue
+        old = after[0][1]  # the first draw restarts the render; older images cannot come after it
+        newer = [d for d in after if d[1] > old and d[3] is not None]
         first = newer[0][0] - since if newer else None
         done = next((d[0] - since for d in newer if d[3][:2] == [full[1], full[0]]), None)
         if done is not None:
             break
         yield 0.02
-    return first, done
+    seen = [[round(t - since, 3), kind, shape] for t, kind, shape in events if t > since]
+    return first, done, seen[:8]
 
 
 def measure_viewport(window, view3d, scene):
@@ -321,14 +341,15 @@ def measure_viewport(window, view3d, scene):
     full = (region.width, region.height)
     times = {"region": list(full), "preview_samples": scene.drt.preview_samples, "orbits": [], "edits": []}
     since = time.monotonic()
-    first, done = yield from wait_for_image(since, full)  # the maximised region's own first render
+    yield from wait_for_image(since, full)  # the maximised region's own first render
     shot("viewport_full_resolution")
     turn = Quaternion((0.0, 0.0, 1.0), math.radians(ORBIT_DEGREES))
     for step in range(ORBITS):
         since = time.monotonic()
         region_3d.view_rotation = turn @ region_3d.view_rotation
-        first, done = yield from wait_for_image(since, full)
-        times["orbits"].append({"first_image_s": first, "full_resolution_s": done, "rss_mb": round(resident_mb(), 1)})
+        first, done, seen = yield from wait_for_image(since, full)
+        times["orbits"].append({"first_image_s": first, "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
+                                "worker": seen})
         if step == 0:
             shot("viewport_orbit")
     light = next(o for o in scene.objects if o.type == "LIGHT")
@@ -339,9 +360,9 @@ def measure_viewport(window, view3d, scene):
             box.location.x += 0.02 if step % 4 == 1 else -0.02
         else:
             light.data.color = (1.0, 0.9, 0.8) if step % 4 == 0 else (0.2, 0.4, 1.0)
-        first, done = yield from wait_for_image(since, full)
+        first, done, seen = yield from wait_for_image(since, full)
         times["edits"].append({"kind": "transform" if step % 2 else "light", "first_image_s": first,
-                               "full_resolution_s": done, "rss_mb": round(resident_mb(), 1)})
+                               "full_resolution_s": done, "rss_mb": round(resident_mb(), 1), "worker": seen})
     images = [d for d in draws if d[3] is not None]
     times["last_image_shape"] = images[-1][3] if images else None
     state["viewport_times"] = times
