@@ -13,6 +13,7 @@ status line), with times. Screenshots of the whole X screen (``import -window ro
 to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on the
 host checks. Blender quits at the end, also after an error (recorded in the state).
 """
+import importlib
 import json
 import math
 import subprocess
@@ -128,15 +129,17 @@ def instrument_engine() -> None:
                                  "size": [self.resolution_x, self.resolution_y], **written})
 
     def logged_view_draw(self, context, depsgraph):
+        started = time.monotonic()
         view_draw(self, context, depsgraph)
         viewport = self._viewport
         if viewport is not None:
             version, image = viewport.latest()
             draws.append((time.monotonic(), version, viewport.status, None if image is None else list(image.shape)))
+            events.append((started, "draw", round(time.monotonic() - started, 3)))
 
     engine.render, engine.view_draw = logged_render, logged_view_draw
     module.write_passes = logged_write_passes
-    worker = sys.modules[engine.__module__.rsplit(".", 1)[0] + ".viewport"].ViewportRender
+    worker = importlib.import_module(engine.__module__.rsplit(".", 1)[0] + ".viewport").ViewportRender
     start, publish = worker.start, worker._publish
 
     def logged_start(self, *args):
@@ -153,7 +156,7 @@ def instrument_engine() -> None:
 draws = []
 """(time, image version, status, image shape) at each viewport draw."""
 events = []
-"""(time, "start" | "publish", image shape) of the viewport worker: where a step's time goes."""
+"""(time, "start" | "publish" | "draw", image shape or the draw's seconds): where a step's time goes."""
 
 
 def wait_for_viewport(since: float):
@@ -324,7 +327,7 @@ def wait_for_image(since: float, full: tuple[int, int]):
             break
         yield 0.02
     seen = [[round(t - since, 3), kind, shape] for t, kind, shape in events if t > since]
-    return first, done, seen[:8]
+    return first, done, seen[:12]
 
 
 def measure_viewport(window, view3d, scene):
