@@ -38,9 +38,13 @@ def table(times: dict) -> str:
     for name, steps in groups.items():
         rows.append(f"| {name} ({len(steps)}) | {_seconds(s['first_image_s'] for s in steps)} "
                     f"| {_seconds(s['full_resolution_s'] for s in steps)} |")
-    rss = [s["rss_mb"] for s in times["orbits"] + times["edits"]]
-    rows += ["", f"Blender's resident memory over the {len(rss)} steps: {mean(rss[:10]):.0f} MB over the first "
-             f"ten, {mean(rss[-10:]):.0f} MB over the last ten."]
+    steps = times["orbits"] + times["edits"]
+    anon, rss = [s["anon_mb"] for s in steps], [s["rss_mb"] for s in steps]
+    rows += ["", f"Blender's anonymous resident memory over the {len(steps)} steps: {mean(anon[:10]):.0f} MB "
+             f"over the first ten, {mean(anon[-10:]):.0f} MB over the last ten (all resident memory: "
+             f"{mean(rss[:10]):.0f} and {mean(rss[-10:]):.0f} MB). One redraw of Blender's window took "
+             f"{times['window_redraw_s']:.2f} s here (software OpenGL): an image is on screen at the "
+             "first redraw after the worker publishes it."]
     return "\n".join(rows)
 
 

@@ -33,7 +33,8 @@ class Shapes:
         self.seen = []
 
     def __call__(self):
-        self.seen.append(self.viewport.latest()[1].shape[:2])
+        image = self.viewport.latest()[1]
+        self.seen.append(None if image is None else image.shape[:2])
 
 
 def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
