@@ -29,7 +29,8 @@ def _seconds(values) -> str:
 def table(times: dict) -> str:
     width, height = times["region"]
     rows = [f"Measured by `make test-blender` in Blender 4.3.2's GUI (Xvfb, Mesa's software OpenGL, the "
-            f"machine's 2 cores shared), Cornell box, kernels cached, a {width}x{height} region, "
+            f"machine's 2 cores shared with other work), Cornell box, kernels compiled before the "
+            f"timed steps, a {width}x{height} region, "
             f"{times['preview_samples']} viewport samples; median (worst):", "",
             "| step | first new image | first full-resolution image |", "|---|---|---|"]
     groups = {"orbit step (3 degrees)": times["orbits"]}

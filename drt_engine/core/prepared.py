@@ -168,14 +168,14 @@ class _Keys:
 
     def __init__(self, scene: SceneData, previous: "PreparedScene | None" = None):
         self.meshes = [id(mesh) for mesh in scene.meshes]
-        self.instances = _digest([(i.mesh, i.matrices) for i in scene.instances])
+        self.instances = _digest(scene.instances)
         known = {} if previous is None else dict(zip(map(id, previous.scene.materials), previous._keys.materials))
         self.materials = [known.get(id(m)) or _digest(m) for m in scene.materials]
         self.images = _digest(scene.images)
         self.lights = _digest([scene.lights, scene.world])
 
 
-def _digest(value) -> str | None:
+def _digest(value) -> str | object:
     """A digest of ``value`` (see content_key); a value it cannot read gets a fresh object, so it
     never equals another and counts as changed."""
     digest = hashlib.blake2b(digest_size=20)
