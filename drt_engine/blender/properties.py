@@ -93,8 +93,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         name="Viewport",
         description="Samples per pixel the viewport's Rendered shading accumulates at full resolution "
         "(after its coarse 1/8, 1/4 and 1/2 resolution images). Fewer than Cycles' 1024 by default: "
-        "a 1280x720 viewport sample of the Cornell box took about 1.3 s on 2 cores, and a distribution "
-        "ray tracer's image settles sooner than a path tracer's",
+        "a distribution ray tracer's image settles sooner than a path tracer's, and each full-resolution "
+        "sample of the viewport costs as much as a final render's",
         default=256,
         min=1,
         soft_max=4096,
