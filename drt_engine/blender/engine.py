@@ -103,11 +103,9 @@ def preview_settings(settings):
                                sample_start=0, sample_end=0)
 
 
-def viewport_settings(settings):
-    """Settings for Rendered shading: few samples, Combined only, no stop rules."""
-    from .viewport import MAX_SAMPLES
-
-    return dataclasses.replace(settings, samples=min(settings.samples, MAX_SAMPLES), passes=("Combined",),
+def viewport_settings(settings, preview_samples: int):
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules."""
+    return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
                                sample_start=0, sample_end=0)
 
@@ -171,6 +169,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         self._view_settings = None
         self._view_key = None  # region size and matrices the running viewport render is for
         self._view_texture = None
+        self._view_meshes = None  # export.geometry.MeshCache: meshes kept between viewport exports
 
     def render(self, depsgraph):
         try:
@@ -273,15 +272,20 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             )
 
     def view_update(self, context, depsgraph):
-        """The scene changed (or the viewport opened): export it and restart the viewport render."""
+        """The scene changed (or the viewport opened): export what changed and restart the
+        viewport render, whose worker updates the prepared scene for the edit."""
         from .export import export_scene
+        from .export.geometry import MeshCache
+        from .export.viewport import edited_geometry
         from .viewport import ViewportRender, weak_redraw
 
         if self._viewport is None:
             self._viewport = ViewportRender(weak_redraw(self))
+            self._view_meshes = MeshCache()
             weakref.finalize(self, self._viewport.stop)  # Blender frees the engine: stop the worker
+        self._view_meshes.forget(edited_geometry(depsgraph.updates))
         try:
-            scene_data = export_scene(depsgraph)
+            scene_data = export_scene(depsgraph, meshes=self._view_meshes)
         except Exception as error:
             if not isinstance(error, DRTError):  # a bug of ours: details in the console
                 print(f"DRT: unexpected error while exporting for the viewport\n{traceback.format_exc()}")
@@ -290,14 +294,15 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self.update_stats("", _one_line(str(error)))
             return
         self._view_scene = scene_data
-        self._view_settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer))
+        self._view_settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer),
+                                                depsgraph.scene.drt.preview_samples)
         self._view_key = None  # view_draw restarts the render with the region's camera
 
     def view_draw(self, context, depsgraph):
         """Draw the newest viewport image; restart the render first if the view changed."""
         import gpu
 
-        from .export.viewport import viewport_camera
+        from .export.viewport import level_cameras, viewport_camera
         from .viewport import ViewportTexture
 
         region, region_data = context.region, context.region_data
@@ -305,8 +310,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             key = (region.width, region.height, tuple(map(tuple, region_data.view_matrix)),
                    tuple(map(tuple, region_data.window_matrix)))
             if key != self._view_key:
-                camera = viewport_camera(region, region_data)
-                self._viewport.start(self._view_scene, camera, self._view_settings)
+                cameras = level_cameras(viewport_camera(region, region_data))
+                self._viewport.start(self._view_scene, cameras, self._view_settings)
                 self._view_key = key
         if self._viewport is None:
             return

@@ -92,6 +92,16 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         min=1,
         soft_max=4096,
     )
+    preview_samples: IntProperty(
+        name="Viewport",
+        description="Samples per pixel the viewport's Rendered shading accumulates at full resolution "
+        "(after its coarse 1/8, 1/4 and 1/2 resolution images). Fewer than Cycles' 1024 by default: "
+        "a distribution ray tracer's image settles sooner than a path tracer's, and each full-resolution "
+        "sample of the viewport costs as much as a final render's",
+        default=256,
+        min=1,
+        soft_max=4096,
+    )
     seed: IntProperty(
         name="Seed",
         description="Seed of every random number. The same settings and seed give the "

@@ -88,8 +88,10 @@ class DRT_PT_sampling(DRTButtonsPanel, bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         drt = context.scene.drt
+        col = layout.column(align=True)
+        col.prop(drt, "preview_samples")
+        col.prop(drt, "samples", text="Render")
         col = layout.column()
-        col.prop(drt, "samples")
         col.prop(drt, "sampling_pattern")
         col.prop(drt, "seed")
         col = layout.column()

@@ -32,6 +32,11 @@ class ProgressUpdate:
     def passes(self) -> dict:
         return self._film.images()
 
+    @property
+    def samples_everywhere(self) -> int:
+        """Samples every pixel has so far: the image has no empty pixel once this is 1."""
+        return int(self._film.count.min()) if self._film.n else 0
+
 
 @dataclass
 class DriveOutcome:

@@ -1,5 +1,6 @@
 """The viewport's worker: a new view of the same scene reuses its prepared scene, a new scene
-prepares again, and each view renders what a render of that camera gives."""
+prepares again, each view shows its coarse levels first and ends with what a render of that
+camera gives."""
 import dataclasses
 import sys
 from pathlib import Path
@@ -8,6 +9,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
+from drt_engine.blender.export.viewport import level_cameras  # noqa: E402
 from drt_engine.blender.viewport import ViewportRender  # noqa: E402
 from drt_engine.core.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
@@ -23,15 +25,31 @@ def finish(viewport):
     return viewport.latest()[1]
 
 
+class Shapes:
+    """Records the shape of every image the worker publishes."""
+
+    def __init__(self):
+        self.viewport = None
+        self.seen = []
+
+    def __call__(self):
+        image = self.viewport.latest()[1]
+        self.seen.append(None if image is None else image.shape[:2])
+
+
 def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
-    viewport = ViewportRender(lambda: None)
+    shapes = Shapes()
+    viewport = shapes.viewport = ViewportRender(shapes)
     base = scene()
     settings = RenderSettings(samples=2, threads=1)
     images, prepared = [], []
     for eye in ((0, -5, 2), (3, -4, 1.5)):
-        camera = Camera(look_at(eye, (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (24, 24))
-        viewport.start(base, camera, settings)
+        camera = Camera(look_at(eye, (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (24, 16))
+        shapes.seen.clear()
+        viewport.start(base, level_cameras(camera), settings)
         images.append(finish(viewport))
+        # one sample at 1/8, 1/4, 1/2 of the size, then the full size (once per round and at the end)
+        assert shapes.seen[:3] == [(2, 3), (4, 6), (8, 12)] and set(shapes.seen[3:]) == {(16, 24)}, shapes.seen
         prepared.append(viewport._prepared[1])
         moved = dataclasses.replace(base, camera=camera)  # prepared anew around the first view's centre
         expected = Renderer(moved, settings, PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes["Combined"]
@@ -39,6 +57,6 @@ def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
     assert prepared[0] is prepared[1]
     assert not np.array_equal(images[0], images[1])
     other = scene()
-    viewport.start(other, other.camera, settings)
+    viewport.start(other, [other.camera], settings)
     finish(viewport)
     assert viewport._prepared[1] is not prepared[0]

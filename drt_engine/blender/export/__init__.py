@@ -13,7 +13,7 @@ import numpy as np
 from ...core.errors import RenderCancelled
 from ...core.scene import SceneData
 from .camera import export_camera
-from .geometry import GeometryExporter
+from .geometry import GeometryExporter, MeshCache
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key
@@ -29,11 +29,13 @@ def export_scene(
     camera_object=None,
     cancel: Callable[[], bool] | None = None,
     frame_set: Callable[[int, float], None] | None = None,
+    meshes: MeshCache | None = None,
 ) -> SceneData:
     """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
 
     With ``frame_set`` (the render engine's) and motion blur on, motion over the
-    shutter is sampled too. Raises ``SceneError`` for a scene that cannot be rendered
+    shutter is sampled too. ``meshes`` (the viewport's) keeps meshes between exports: one
+    found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
     and ``RenderCancelled`` when ``cancel()`` returns True.
     """
     scene = depsgraph.scene
@@ -44,7 +46,7 @@ def export_scene(
     warnings: list[str] = []
     images = ImageTable(warnings)
     materials = MaterialTable(warnings, images)
-    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override)
+    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes)
     lights = []
     light_keys = []
     for count, instance in enumerate(depsgraph.object_instances):

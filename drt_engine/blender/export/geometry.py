@@ -109,6 +109,41 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
     )
 
 
+class MeshCache:
+    """Exported meshes kept from one viewport export to the next, so an edit that leaves a mesh
+    alone (a transform, a material, a light) neither reads it from Blender again nor makes the
+    core rebuild it (core.prepared compares meshes by identity).
+
+    Keyed as GeometryExporter keys meshes (the evaluated datablock, the slots' materials) and
+    the tangent maps its materials need; ``forget`` drops what the depsgraph reports as new
+    geometry, and each export keeps only what it used."""
+
+    def __init__(self):
+        self._meshes: dict = {}  # key -> (Mesh, original object name, mesh name)
+        self._used: set = set()
+
+    def get(self, key):
+        found = self._meshes.get(key)
+        if found is not None:
+            self._used.add(key)
+            return found[0]
+        return None
+
+    def put(self, key, mesh, obj) -> None:
+        self._meshes[key] = (mesh, obj.original.name, obj.data.name if obj.data is not None else "")
+        self._used.add(key)
+
+    def forget(self, names) -> None:
+        """Drop the meshes of objects or mesh datablocks named in ``names``."""
+        names = set(names)
+        self._meshes = {k: v for k, v in self._meshes.items() if v[1] not in names and v[2] not in names}
+
+    def finish(self) -> None:
+        """End of an export: forget the meshes it did not use (deleted or changed objects)."""
+        self._meshes = {k: v for k, v in self._meshes.items() if k in self._used}
+        self._used = set()
+
+
 class GeometryExporter:
     """Collects meshes and instances; a mesh shared by several instances is exported once.
 
@@ -118,8 +153,9 @@ class GeometryExporter:
     the same mesh different materials.
     """
 
-    def __init__(self, materials: MaterialTable, material_override=None):
+    def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None):
         self.materials = materials
+        self.cache = cache
         self.material_override = material_override
         self.meshes: list[Mesh] = []
         self.instances: list[Instance] = []
@@ -152,6 +188,8 @@ class GeometryExporter:
             if obj.original.as_pointer() not in self._meshed:
                 self._place(obj, matrix, ("meta", obj.original.as_pointer()), key)
         self._metaballs.clear()
+        if self.cache is not None:
+            self.cache.finish()
 
     def _place(self, obj, matrix, source, key) -> None:
         slot_materials = self._slot_materials(obj)
@@ -174,6 +212,13 @@ class GeometryExporter:
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
         warnings = self.materials.warnings
+        cache_key = None
+        if self.cache is not None and obj.type != "META":
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)))
+            mesh = self.cache.get(cache_key)
+            if mesh is not None:
+                self.meshes.append(mesh)
+                return len(self.meshes) - 1
         if obj.type == "META":
             try:
                 mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings)
@@ -183,5 +228,7 @@ class GeometryExporter:
             mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings)
         if mesh is None:
             return -1
+        if cache_key is not None:
+            self.cache.put(cache_key, mesh, obj)
         self.meshes.append(mesh)
         return len(self.meshes) - 1

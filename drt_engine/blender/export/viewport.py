@@ -6,24 +6,36 @@ the viewport (blender_camera_from_view in intern/cycles/blender/camera.cpp), the
 window and the clipping range are read off the region's projection
 (``window_matrix``) and the camera placement off the inverse ``view_matrix``, so the
 image lines up with the overlays drawn on top of it. The viewport renders with a
-pinhole (no depth of field).
+pinhole (no depth of field), at the region's size in pixels (HiDPI included: Blender gives
+the region in pixels), after coarse images at fractions of it.
 """
 from __future__ import annotations
 
-import math
+import dataclasses
 
 import numpy as np
 
 from ...core.scene import Camera
 
-MAX_PIXELS = 240 * 180
-"""Pixels the viewport renders at most; the image is stretched to the region when drawn."""
+COARSE_LEVELS = (8, 4, 2)
+"""Divisors of the region's size for the coarse images drawn (stretched) before the full one:
+each one sample, so a new view shows within a fraction of the full image's first sample."""
 
 
-def viewport_resolution(width: int, height: int, max_pixels: int = MAX_PIXELS) -> tuple[int, int]:
-    """The region's size scaled down by one integer factor so it holds at most ``max_pixels``."""
-    factor = max(1, math.ceil(math.sqrt(width * height / max_pixels)))
-    return max(1, width // factor), max(1, height // factor)
+def level_cameras(camera: Camera, divisors=COARSE_LEVELS) -> list[Camera]:
+    """``camera`` at its resolution divided by each of ``divisors`` (at least one pixel a side),
+    then itself: the same window of the scene at coarser pixel grids."""
+    width, height = camera.resolution
+    coarse = [dataclasses.replace(camera, resolution=(max(1, width // d), max(1, height // d)), window=None)
+              for d in divisors]
+    return coarse + [camera]
+
+
+def edited_geometry(updates) -> set[str]:
+    """Names of the datablocks whose geometry ``depsgraph.updates`` reports changed (an edited
+    mesh: its object and its mesh; a moved object reports a transform alone): the meshes the
+    viewport's export must read again (export.geometry.MeshCache.forget)."""
+    return {update.id.name for update in updates if update.is_updated_geometry}
 
 
 def camera_from_matrices(view_matrix, window_matrix, resolution: tuple[int, int]) -> Camera:
@@ -54,6 +66,5 @@ def camera_from_matrices(view_matrix, window_matrix, resolution: tuple[int, int]
 
 
 def viewport_camera(region, region_data) -> Camera:
-    """The camera of one 3D viewport region at the viewport's render resolution."""
-    resolution = viewport_resolution(region.width, region.height)
-    return camera_from_matrices(region_data.view_matrix, region_data.window_matrix, resolution)
+    """The camera of one 3D viewport region at the region's full resolution."""
+    return camera_from_matrices(region_data.view_matrix, region_data.window_matrix, (region.width, region.height))

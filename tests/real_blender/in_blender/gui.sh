@@ -1,11 +1,12 @@
 #!/bin/sh
-# Inside the root: Blender's GUI on a 1600x900 Xvfb screen, driven by gui_driver.py.
+# Inside the root: Blender's GUI on a 1280x720 Xvfb screen (the maximised 3D view's region is the
+# 1280x720 of the timed viewport steps), driven by gui_driver.py.
 #   sh gui.sh BLEND OUTDIR
 # Xvfb picks a free display itself (its abstract socket is shared with the host and other
 # roots) and is killed on every way out; the wrapper's timeout kills the whole group anyway.
 set -eu
 : > "$2/display"
-Xvfb -displayfd 3 -screen 0 1600x900x24 -nolisten tcp 3> "$2/display" > "$2/xvfb.log" 2>&1 &
+Xvfb -displayfd 3 -screen 0 1280x720x24 -nolisten tcp 3> "$2/display" > "$2/xvfb.log" 2>&1 &
 xvfb=$!
 trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null || true' EXIT  # wait: gone before the test looks
 trap 'exit 143' TERM INT HUP  # so the EXIT trap also runs when the wrapper's timeout fires

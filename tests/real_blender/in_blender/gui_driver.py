@@ -4,7 +4,8 @@ blender FILE --python gui_driver.py -- OUTDIR
 
 Selects DRT in the Render Properties, walks the Properties tabs (recording which panels
 poll true), renders with F12's operator into the image editor, switches the 3D viewport
-to Rendered shading (through the camera, after an edit, after orbiting), back to Solid,
+to Rendered shading (through the camera, after an edit, after orbiting; then maximised,
+timed over orbit steps and edits, see ``measure_viewport``), back to Solid,
 shows material previews (the slot icons and a large preview), and quits while the
 viewport renders. DRT's engine class is wrapped to record, from Blender's calls, each
 render (preview or not) and each viewport draw (the viewport render's image version and
@@ -12,7 +13,9 @@ status line), with times. Screenshots of the whole X screen (``import -window ro
 to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on the
 host checks. Blender quits at the end, also after an error (recorded in the state).
 """
+import importlib
 import json
+import math
 import subprocess
 import sys
 import threading
@@ -27,6 +30,13 @@ OUT = Path(sys.argv[sys.argv.index("--") + 1])
 RENDER_TIMEOUT = 120.0
 """Seconds the F12 render and each viewport render may take at most."""
 F12_SIZE = 256
+VIEWPORT_SAMPLES = 4
+"""Viewport samples while the GUI session waits for viewport renders to finish."""
+ORBITS, EDITS = 50, 20
+REDRAWS = 10
+"""Window redraws timed (Blender's redraw_timer) after the steps: what one frame costs in this GUI."""
+ORBIT_DEGREES = 3.0
+"""The timed orbit: steps of this many degrees about the vertical, as a slow drag makes them."""
 TABS = (  # (Properties tab, object to make active first)
     ("RENDER", None),
     ("OUTPUT", None),
@@ -121,18 +131,34 @@ def instrument_engine() -> None:
                                  "size": [self.resolution_x, self.resolution_y], **written})
 
     def logged_view_draw(self, context, depsgraph):
+        started = time.monotonic()
         view_draw(self, context, depsgraph)
         viewport = self._viewport
         if viewport is not None:
             version, image = viewport.latest()
             draws.append((time.monotonic(), version, viewport.status, None if image is None else list(image.shape)))
+            events.append((started, "draw", round(time.monotonic() - started, 3)))
 
     engine.render, engine.view_draw = logged_render, logged_view_draw
     module.write_passes = logged_write_passes
+    worker = importlib.import_module(engine.__module__.rsplit(".", 1)[0] + ".viewport").ViewportRender
+    start, publish = worker.start, worker._publish
+
+    def logged_start(self, *args):
+        events.append((time.monotonic(), "start", None))
+        start(self, *args)
+
+    def logged_publish(self, image, stop, status):
+        events.append((time.monotonic(), "publish", list(image.shape[:2])))
+        publish(self, image, stop, status)
+
+    worker.start, worker._publish = logged_start, logged_publish
 
 
 draws = []
 """(time, image version, status, image shape) at each viewport draw."""
+events = []
+"""(time, "start" | "publish" | "draw", image shape or the draw's seconds): where a step's time goes."""
 
 
 def wait_for_viewport(since: float):
@@ -211,8 +237,10 @@ def steps():
     yield 1.0
 
     # Rendered shading through the camera, then after an edit and after orbiting.
+    scene.drt.preview_samples = VIEWPORT_SAMPLES
     view3d = area_of(window, "VIEW_3D")
     state["viewport_area"] = [view3d.x, view3d.y, view3d.width, view3d.height]
+    state["viewport_region"] = [window_region(view3d).width, window_region(view3d).height]
     space = view3d.spaces.active
     region_3d = space.region_3d
     shot("viewport_solid")
@@ -237,6 +265,7 @@ def steps():
     region_3d.view_distance = 3.0
     yield from wait_for_viewport(since)
     shot("viewport_rendered_orbited")
+    yield from measure_viewport(window, view3d, scene)
     space.shading.type = "SOLID"
     yield 3.0
     state["viewport_threads_solid"] = viewport_threads()
@@ -271,6 +300,89 @@ def steps():
     space.shading.type = "RENDERED"
     yield 0.5
     state["viewport_threads_at_quit"] = viewport_threads()
+
+
+def resident_mb(field: str = "VmRSS") -> float:
+    """Resident memory: VmRSS, or RssAnon (the anonymous part a leak grows; VmRSS also counts
+    file-backed pages such as Blender's own code, which the kernel drops under memory pressure:
+    seen 270 MB less within one step while other processes needed memory)."""
+    with open("/proc/self/status") as status:
+        return next(int(line.split()[1]) / 1024.0 for line in status if line.startswith(field + ":"))
+
+
+STEP_TIMEOUT = 30.0
+"""Seconds one timed orbit step or edit may take to reach its full-resolution image."""
+
+
+def wait_for_image(since: float, full: tuple[int, int]):
+    """Yield until a draw after ``since`` shows an image of the full size ``full`` newer than
+    the draw that restarted the render; returns (seconds to the first newer image, to the
+    full-size one, what happened meanwhile: the restart and the worker's images, in seconds)."""
+    first = done = None
+    while time.monotonic() - since < STEP_TIMEOUT:
+        after = [d for d in draws if d[0] > since]
+        if not after:
+            yield 0.02
+            continue
+        old = after[0][1]  # the first draw restarts the render; older images cannot come after it
+        newer = [d for d in after if d[1] > old and d[3] is not None]
+        first = newer[0][0] - since if newer else None
+        done = next((d[0] - since for d in newer if d[3][:2] == [full[1], full[0]]), None)
+        if done is not None:
+            break
+        yield 0.02
+    seen = [[round(t - since, 3), kind, shape] for t, kind, shape in events if t > since]
+    return first, done, seen[:12]
+
+
+def measure_viewport(window, view3d, scene):
+    """The 3D view maximised: ORBITS orbit steps (the view matrix turned as a user's drag
+    turns it), then EDITS edits (a light's colour, an object moved, in turn), each timed from
+    the change to the first new image drawn and to the first full-resolution one, with the
+    resident memory after each; written to OUTDIR/viewport_times.json."""
+    with bpy.context.temp_override(window=window, area=view3d):
+        bpy.ops.screen.screen_full_area(use_hide_panels=True)
+    yield 2.0
+    view3d = area_of(window, "VIEW_3D")
+    region = window_region(view3d)
+    region_3d = view3d.spaces.active.region_3d
+    full = (region.width, region.height)
+    times = {"region": list(full), "preview_samples": scene.drt.preview_samples, "orbits": [], "edits": []}
+    since = time.monotonic()
+    yield from wait_for_image(since, full)  # the maximised region's own first render
+    shot("viewport_full_resolution")
+    turn = Quaternion((0.0, 0.0, 1.0), math.radians(ORBIT_DEGREES))
+    for step in range(ORBITS):
+        since = time.monotonic()
+        region_3d.view_rotation = turn @ region_3d.view_rotation
+        first, done, seen = yield from wait_for_image(since, full)
+        times["orbits"].append({"first_image_s": first, "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
+                                "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
+        if step == 0:
+            shot("viewport_orbit")
+    light = next(o for o in scene.objects if o.type == "LIGHT")
+    box = next(o for o in scene.objects if o.type == "MESH" and o.name != "Room")
+    for step in range(EDITS):
+        since = time.monotonic()
+        if step % 2:
+            box.location.x += 0.02 if step % 4 == 1 else -0.02
+        else:
+            light.data.color = (1.0, 0.9, 0.8) if step % 4 == 0 else (0.2, 0.4, 1.0)
+        first, done, seen = yield from wait_for_image(since, full)
+        times["edits"].append({"kind": "transform" if step % 2 else "light", "first_image_s": first,
+                               "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
+                               "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
+    with bpy.context.temp_override(window=window, area=view3d, region=region):
+        started = time.monotonic()
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=REDRAWS)
+    times["window_redraw_s"] = round((time.monotonic() - started) / REDRAWS, 3)  # Blender's own frame time here
+    images = [d for d in draws if d[3] is not None]
+    times["last_image_shape"] = images[-1][3] if images else None
+    state["viewport_times"] = times
+    (OUT / "viewport_times.json").write_text(json.dumps(times, indent=1))
+    with bpy.context.temp_override(window=window, area=view3d):
+        bpy.ops.screen.back_to_previous()
+    yield 1.0
 
 
 def wait_for_previews(fits, count: int):
