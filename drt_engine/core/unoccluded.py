@@ -19,8 +19,8 @@ import numpy as np
 
 from .jit import kernel
 from .light_kinds import (
-    AREA, COS_HALF, DISK, DX, DZ, EB, EG, ER, EXX, EXY, EXZ, EYX, EYY, EYZ, EZX, EZY, EZZ, KIND, PX, PY, PZ, POINT,
-    RADIUS, RECT, SIZE_X, SIZE_Y, SOFT, SOLID, SPOT, SPREAD_MODE, SUN, SUN_SCALE, TINY, spot_factor,
+    COS_HALF, DISK, DX, DY, DZ, EB, EG, ER, EXX, EXY, EXZ, EYX, EYY, EYZ, EZX, EZY, EZZ, KIND, POINT, PX, PY, PZ,
+    RADIUS, RECT, SIZE_X, SIZE_Y, SOFT, SOLID, SPOT, SPREAD_MODE, SUN, SUN_SCALE, spot_factor,
 )
 
 
@@ -112,12 +112,186 @@ def _rectangle(table, i, dx, dy, dz, nx, ny, nz):
                           -sx * ux, -sx * uy, -sx * uz, nx, ny, nz)
 
 
+# -- ellipses: the same boundary integral along the rim ----------------------------------------
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+TRAPEZOID_MAX = 512
+"""Points of the periodic trapezoid rule before a whole ellipse falls back to adaptive
+Gauss-Legendre (only points very near the rim need more)."""
+RIM_TOLERANCE = 1e-12
+"""Step error allowed, relative to the integral of the integrand's magnitude."""
+
+
+@kernel(inline="always")
+def _rim(phi, prm):
+    """n . (v x v') / |v|^2 at rim angle phi, v = d + a cos U + b sin V: the integrand of the
+    boundary integral, from the terms ``_ellipse`` precomputes."""
+    a, b, mu, mv, k, dd, du, dv = prm
+    c, s = math.cos(phi), math.sin(phi)
+    q = dd + 2.0 * (a * c * du + b * s * dv) + a * a * c * c + b * b * s * s
+    return (b * c * mv - a * s * mu + k) / max(q, 1e-300)
+
+
+@kernel(inline="always")
+def _gauss(lo, hi, prm):
+    h = 0.5 * (hi - lo)
+    m = lo + h
+    total, size = 0.0, 0.0
+    for j in range(len(_GL_X)):
+        f = _GL_W[j] * _rim(m + h * _GL_X[j], prm)
+        total += f
+        size += abs(f)
+    return total * h, size * h
+
+
+@kernel(inline="always")
+def _adaptive(lo, hi, prm):
+    """Integral of ``_rim`` over [lo, hi] by 8-point Gauss-Legendre steps, each accepted when
+    its two halves agree with it (step length adapted on the way, no stack)."""
+    span = hi - lo
+    if not span > 0:
+        return 0.0
+    _, size = _gauss(lo, hi, prm)
+    tol = RIM_TOLERANCE * max(size, 1e-300)
+    total, x, h = 0.0, lo, 0.25 * span
+    while True:
+        last = h >= hi - x
+        if last:
+            h = hi - x
+        coarse, _ = _gauss(x, x + h, prm)
+        left, _ = _gauss(x, x + 0.5 * h, prm)
+        right, _ = _gauss(x + 0.5 * h, x + h, prm)
+        if abs(left + right - coarse) <= tol * h / span or h <= 1e-13 * span:
+            total += left + right
+            if last:
+                return total
+            x += h
+            h *= 2.0
+        else:
+            h *= 0.5
+
+
+@kernel(inline="always")
+def _periodic(prm):
+    """Integral of ``_rim`` over a whole turn: the periodic trapezoid rule (exponential
+    convergence for an ellipse wholly above the horizon), doubled until it settles."""
+    n = 16
+    step = 2.0 * math.pi / n
+    total, size = 0.0, 0.0
+    for j in range(n):
+        f = _rim(j * step, prm)
+        total += f
+        size += abs(f)
+    previous = total * step
+    while n < TRAPEZOID_MAX:
+        for j in range(n):  # the midpoints of the current rule
+            f = _rim((j + 0.5) * step, prm)
+            total += f
+            size += abs(f)
+        n *= 2
+        step *= 0.5
+        current = total * step
+        if abs(current - previous) <= 1e-10 * size * step:
+            return current
+        previous = current
+    return _adaptive(0.0, 2.0 * math.pi, prm)
+
+
+@kernel(inline="always")
+def _ellipse(table, i, dx, dy, dz, nx, ny, nz):
+    """Projected solid angle of disk or ellipse i whose centre is d from the shading point: half
+    the boundary integral of n . (v x dv) / |v|^2, over the arc above the horizon plus its chord."""
+    a, b = 0.5 * table[i, SIZE_X], 0.5 * table[i, SIZE_Y]
+    ux, uy, uz = table[i, EXX], table[i, EXY], table[i, EXZ]
+    vx, vy, vz = table[i, EYX], table[i, EYY], table[i, EYZ]
+    mx, my, mz = ny * dz - nz * dy, nz * dx - nx * dz, nx * dy - ny * dx  # n x d
+    k = a * b * (nx * table[i, EZX] + ny * table[i, EZY] + nz * table[i, EZZ])
+    prm = (a, b, mx * ux + my * uy + mz * uz, mx * vx + my * vy + mz * vz, k, dx * dx + dy * dy + dz * dz,
+           dx * ux + dy * uy + dz * uz, dx * vx + dy * vy + dz * vz)
+    # height above the horizon along the rim: hc + ha cos(phi) + hb sin(phi)
+    hc, ha, hb = nx * dx + ny * dy + nz * dz, a * (nx * ux + ny * uy + nz * uz), b * (nx * vx + ny * vy + nz * vz)
+    r = math.sqrt(ha * ha + hb * hb)
+    if hc >= r:
+        return 0.5 * _periodic(prm)
+    if hc <= -r:
+        return 0.0
+    mid, half = math.atan2(hb, ha), math.atan2(math.sqrt(max(r * r - hc * hc, 0.0)), -hc)
+    out, back = mid + half, mid - half  # where the rim leaves the upper side, and comes back
+    co, so, cb, sb = math.cos(out), math.sin(out), math.cos(back), math.sin(back)
+    px, py, pz = dx + a * co * ux + b * so * vx, dy + a * co * uy + b * so * vy, dz + a * co * uz + b * so * vz
+    ea, eb = a * (cb - co), b * (sb - so)
+    chord = _edge(px, py, pz, ea * ux + eb * vx, ea * uy + eb * vy, ea * uz + eb * vz, nx, ny, nz)
+    return 0.5 * (_adaptive(back, out, prm) + chord)
+
+
+# -- spheres, facing disks and suns: spherical caps ----------------------------------------------
+@kernel(inline="always")
+def cap(cos_t, sin_t, sin2, cos_s):
+    """Projected solid angle about n of a cap of half angle s (sin^2 s, cos s) whose centre is at
+    angle t (cos t, sin t) from n, clipped by the horizon (Snyder 1996). Written so tiny caps
+    keep their relative precision: atan(z) - z by its series for small z."""
+    sin_s = math.sqrt(sin2)
+    if cos_t >= sin_s:
+        return math.pi * sin2 * cos_t
+    if cos_t <= -sin_s:
+        return 0.0
+    y = min(max(-cos_s * cos_t / max(sin_s * sin_t, 1e-300), -1.0), 1.0)
+    w = sin_t * math.sqrt(max(1.0 - y * y, 0.0))  # sin t sqrt(1 - y^2)
+    base = cos_t * math.atan2(math.sqrt(max(1.0 - y * y, 0.0)), y) * sin2
+    z = sin_s * w / cos_s if cos_s > 0 else math.inf
+    if z < 1e-2:  # atan(z) - cos s sin s w = (atan z - z) + z sin^2 s
+        z2 = z * z
+        return base + z * z2 * (-1.0 / 3.0 + z2 * (1.0 / 5.0 - z2 * (1.0 / 7.0 - z2 / 9.0))) + z * sin2
+    return base + math.atan2(sin_s * w, cos_s) - cos_s * sin_s * w
+
+
+@kernel(inline="always")
+def _cap_about(cx, cy, cz, nx, ny, nz, sin2, cos_s):
+    """``cap`` for a centre direction c (unit) and normal n, the angle between them by atan2."""
+    cos_t = cx * nx + cy * ny + cz * nz
+    qx, qy, qz = cy * nz - cz * ny, cz * nx - cx * nz, cx * ny - cy * nx
+    return cap(cos_t, math.sqrt(qx * qx + qy * qy + qz * qz), sin2, cos_s)
+
+
+@kernel(inline="always")
+def _point(table, i, px, py, pz, nx, ny, nz):
+    """Irradiance per unit of intensity from a point or spot light: a delta with its cone, a
+    sphere of radiance 1 / (pi r^2), or (soft falloff) the disk of that radiance facing p."""
+    dx, dy, dz = table[i, PX] - px, table[i, PY] - py, table[i, PZ] - pz
+    d2 = dx * dx + dy * dy + dz * dz
+    d = math.sqrt(d2)
+    if not d > 0:
+        return 0.0
+    cx, cy, cz = dx / d, dy / d, dz / d
+    r = table[i, RADIUS]
+    if r <= 0:
+        e = max(cx * nx + cy * ny + cz * nz, 0.0) / d2
+        return e * spot_factor(table, i, -cx, -cy, -cz) if table[i, KIND] == SPOT else e
+    if table[i, SOFT] != 0.0:
+        h2 = d2 + r * r
+        return _cap_about(cx, cy, cz, nx, ny, nz, r * r / h2, d / math.sqrt(h2)) / (math.pi * r * r)
+    if d <= r:  # inside the sphere light sampling gives nothing
+        return 0.0
+    return _cap_about(cx, cy, cz, nx, ny, nz, r * r / d2, math.sqrt((d - r) * (d + r)) / d) / (math.pi * r * r)
+
+
+@kernel(inline="always")
+def _sun(table, i, nx, ny, nz):
+    """Irradiance per unit of the sun's irradiance: its direction, or its disk of half angle h
+    (radiance 1 / (pi sin^2 h)) as a cap."""
+    ax, ay, az = -table[i, DX], -table[i, DY], -table[i, DZ]
+    if table[i, SOLID] <= 0:
+        return max(ax * nx + ay * ny + az * nz, 0.0)
+    sin2 = 1.0 / (math.pi * table[i, SUN_SCALE])
+    return _cap_about(ax, ay, az, nx, ny, nz, sin2, table[i, COS_HALF]) * table[i, SUN_SCALE]
+
+
 # -- the contract ----------------------------------------------------------------------------
 @kernel(inline="always")
 def closed_form(table, i):
     """Whether ``unoccluded`` gives light i's exact irradiance: False for a spot light with a
-    radius (the cone weights each sampled ray of the sphere or disk: no closed form) and for
-    area lights with spread (the spread factor varies over the light)."""
+    radius (its cone weights each sampled ray of the sphere or disk differently: no closed form)
+    and for area lights with a spread between 0 and 180 degrees (the spread factor varies over
+    the light). Spread 0 is exact: such a light lights nothing."""
     kind = table[i, KIND]
     if kind == SPOT:
         return table[i, RADIUS] <= 0
@@ -132,11 +306,18 @@ def unoccluded(table, i, px, py, pz, nx, ny, nz):
     in light sampling's units; (0, 0, 0) where ``closed_form`` is False (callers check it)."""
     kind = table[i, KIND]
     e = 0.0
-    if kind == RECT:
+    if kind == RECT or kind == DISK:
         dx, dy, dz = table[i, PX] - px, table[i, PY] - py, table[i, PZ] - pz
         lit = dx * table[i, EZX] + dy * table[i, EZY] + dz * table[i, EZZ] > 0  # the emitting side
         if lit and table[i, SPREAD_MODE] == 0.0:
-            e = max(_rectangle(table, i, dx, dy, dz, nx, ny, nz), 0.0)
+            if kind == RECT:
+                e = max(_rectangle(table, i, dx, dy, dz, nx, ny, nz), 0.0)
+            else:
+                e = max(_ellipse(table, i, dx, dy, dz, nx, ny, nz), 0.0)
+    elif kind == SUN:
+        e = _sun(table, i, nx, ny, nz)
+    elif kind == POINT or (kind == SPOT and table[i, RADIUS] <= 0):
+        e = _point(table, i, px, py, pz, nx, ny, nz)
     return table[i, ER] * e, table[i, EG] * e, table[i, EB] * e
 
 
@@ -165,4 +346,34 @@ def unoccluded_batch(table, rows, pos, normal, out):
     if len(bad):
         raise ValueError(f"lights {bad.tolist()} have no closed-form unoccluded irradiance (check closed_form)")
     _unoccluded_rows(table, rows, pos, normal, out)
+    return out
+
+
+# -- emissive triangles ------------------------------------------------------------------------
+@kernel(inline="always")
+def unoccluded_triangles(vertices, triangles, emission, ids, px, py, pz, nx, ny, nz):
+    """(r, g, b) irradiance at p about n from the two-sided emissive triangles ``ids`` of constant
+    ``emission`` (per triangle): the emissive strategy's unoccluded light, O(len(ids)) per point."""
+    r, g, b = 0.0, 0.0, 0.0
+    for i in ids:
+        v0, v1, v2 = triangles[i, 0], triangles[i, 1], triangles[i, 2]
+        ax, ay, az = vertices[v0, 0] - px, vertices[v0, 1] - py, vertices[v0, 2] - pz
+        e = 0.5 * abs(polygon4(ax, ay, az,
+                               vertices[v1, 0] - vertices[v0, 0], vertices[v1, 1] - vertices[v0, 1],
+                               vertices[v1, 2] - vertices[v0, 2],
+                               vertices[v2, 0] - vertices[v1, 0], vertices[v2, 1] - vertices[v1, 1],
+                               vertices[v2, 2] - vertices[v1, 2], 0.0, 0.0, 0.0, nx, ny, nz))
+        r += emission[i, 0] * e
+        g += emission[i, 1] * e
+        b += emission[i, 2] * e
+    return r, g, b
+
+
+@kernel
+def unoccluded_triangles_batch(vertices, triangles, emission, ids, pos, normal, out):
+    """``unoccluded_triangles`` for each point of a wave into ``out`` (N, 3)."""
+    for j in range(len(pos)):
+        r, g, b = unoccluded_triangles(vertices, triangles, emission, ids, pos[j, 0], pos[j, 1], pos[j, 2],
+                                       normal[j, 0], normal[j, 1], normal[j, 2])
+        out[j, 0], out[j, 1], out[j, 2] = r, g, b
     return out
