@@ -117,9 +117,14 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 TRAPEZOID_MAX = 512
 """Points of the periodic trapezoid rule before a whole ellipse falls back to adaptive
 Gauss-Legendre (only points very near the rim need more)."""
-RIM_TOLERANCE = 1e-10
-"""Step error allowed, relative to the integral of the integrand's magnitude (beside the
-rounding of the step's own sum, which no step length removes)."""
+RIM_TOLERANCE = 1e-8
+"""Difference allowed between a Gauss-Legendre step and its two halves, relative to the integral
+of the integrand's magnitude (beside the rounding of the step's own sum, which no step length
+removes); the halves, which are kept, are some 2^16 times closer."""
+PERIODIC_SETTLED = 1e-6
+"""Change allowed between the trapezoid rule and its doubling, relative to the integral of the
+integrand's magnitude: the error falls geometrically with the points, so the doubled rule's is
+about the square of this."""
 MAX_STEPS = 4096
 
 
@@ -154,14 +159,16 @@ def _adaptive(lo, hi, prm):
     span = hi - lo
     if not span > 0:
         return 0.0
-    _, size = _gauss(lo, hi, prm)
+    coarse, size = _gauss(lo, hi, prm)
     tol = RIM_TOLERANCE * max(size, 1e-300)
-    total, x, h = 0.0, lo, 0.25 * span
+    total, x, h = 0.0, lo, span
+    known = True  # whether ``coarse`` is this step's sum already (a halved step's is the left half)
     for step in range(MAX_STEPS):
         last = h >= hi - x or step == MAX_STEPS - 1  # (the last allowed step takes the rest)
-        if last:
-            h = hi - x
-        coarse, _ = _gauss(x, x + h, prm)
+        if last and h != hi - x:
+            h, known = hi - x, False
+        if not known:
+            coarse, _ = _gauss(x, x + h, prm)
         left, size_l = _gauss(x, x + 0.5 * h, prm)
         right, size_r = _gauss(x + 0.5 * h, x + h, prm)
         settled = abs(left + right - coarse) <= tol * h / span + 1e-13 * (size_l + size_r)
@@ -171,8 +178,10 @@ def _adaptive(lo, hi, prm):
                 return total
             x += h
             h *= 2.0
+            known = False
         else:
             h *= 0.5
+            coarse, known = left, True
     return total
 
 
@@ -180,7 +189,7 @@ def _adaptive(lo, hi, prm):
 def _periodic(prm):
     """Integral of ``_rim`` over a whole turn: the periodic trapezoid rule (exponential
     convergence for an ellipse wholly above the horizon), doubled until it settles."""
-    n = 16
+    n = 8
     step = 2.0 * math.pi / n
     total, size = 0.0, 0.0
     for j in range(n):
@@ -196,7 +205,7 @@ def _periodic(prm):
         n *= 2
         step *= 0.5
         current = total * step
-        if abs(current - previous) <= 1e-10 * size * step:
+        if abs(current - previous) <= PERIODIC_SETTLED * size * step:
             return current
         previous = current
     return _adaptive(0.0, 2.0 * math.pi, prm)
