@@ -18,9 +18,19 @@ from drt_engine.core.unoccluded import closed_forms, unoccluded_batch, unocclude
 REL = 1e-6
 _X, _W = np.polynomial.legendre.leggauss(10)
 _X, _W = 0.5 * (_X + 1.0), 0.5 * _W
-STRIPS = np.concatenate([[0.0], np.geomspace(1e-10, 1.0, 21)])
-"""Radial strips of the fan from the shading point's foot: a peak of width h at the foot
-(a point close to a large light) is resolved at every scale."""
+GRADES = np.geomspace(1e-10, 1.0, 21)
+
+
+def graded(c):
+    """Breakpoints in [0, 1] graded geometrically toward c: the cubature then resolves a peak at
+    c of any width (a shading point close to the light peaks at its foot or nearest rim point)."""
+    return np.unique(np.clip(np.concatenate([[0.0, 1.0, c], c - GRADES, c + GRADES]), 0.0, 1.0))
+
+
+def grid(s_breaks, t_breaks):
+    s0, t0 = np.meshgrid(s_breaks[:-1], t_breaks[:-1], indexing="ij")
+    s1, t1 = np.meshgrid(s_breaks[1:], t_breaks[1:], indexing="ij")
+    return np.column_stack([s0.ravel(), s1.ravel(), t0.ravel(), t1.ravel()])
 
 
 def cubature(f, rects, rel=1e-12):
@@ -54,16 +64,26 @@ def cubature(f, rects, rel=1e-12):
 
 
 def fan(f, pieces, foot):
-    """Integral of f(x, y) over the plane region bounded by ``pieces`` (closed, in order), as the
-    signed sum over the fans from ``foot`` to each piece c(tau), tau in [0, 1]."""
-    rects = np.column_stack([STRIPS[:-1], STRIPS[1:], np.zeros(len(STRIPS) - 1), np.ones(len(STRIPS) - 1)])
+    """Integral of f(x, y) over the convex plane region bounded by ``pieces`` (closed, in order),
+    as the sum over the fans from a centre to each piece c(tau), tau in [0, 1]: the shading
+    point's foot when it is inside (where the integrand peaks), else the region's mean boundary
+    point (no cancelling fans); graded toward the centre, the piece and its point nearest the foot."""
+    s_breaks = np.union1d(graded(0.0), graded(1.0))
+    tau = np.linspace(0.0, 1.0, 4097)
+    rim = np.concatenate([np.column_stack(c(tau[:-1])) for c, _ in pieces])
+    edges = np.roll(rim, -1, axis=0) - rim
+    turns = edges[:, 0] * (foot[1] - rim[:, 1]) - edges[:, 1] * (foot[0] - rim[:, 0])
+    inside = (turns >= 0).all() or (turns <= 0).all()
+    centre = foot if inside else tuple(rim.mean(axis=0))
     total = 0.0
     for c, dc in pieces:
+        cx, cy = c(tau)
+        rects = grid(s_breaks, graded(tau[np.argmin((cx - foot[0]) ** 2 + (cy - foot[1]) ** 2)]))
         def g(s, tau, c=c, dc=dc):
             cx, cy = c(tau)
             dx, dy = dc(tau)
-            rx, ry = cx - foot[0], cy - foot[1]
-            return f(foot[0] + s * rx, foot[1] + s * ry) * s * (rx * dy - ry * dx)
+            rx, ry = cx - centre[0], cy - centre[1]
+            return f(centre[0] + s * rx, centre[1] + s * ry) * s * (rx * dy - ry * dx)
         total += cubature(g, rects)
     return total
 
@@ -195,6 +215,24 @@ def test_area_light_matches_area_cubature(shape, case):
     assert np.allclose(got, want * light.radiance, rtol=REL, atol=0), (got[0], want)
     if clipped:  # the horizon matters here: without the clip the answer is another
         assert abs(plane_reference(light, p, n, clip=False) - want) > 1e-3 * want
+
+
+@pytest.mark.parametrize("shape", ["RECTANGLE", "ELLIPSE"])
+def test_area_light_matches_area_cubature_at_random(shape):
+    """Random orientations, sizes, normals and points, a third of them close to the rim."""
+    rng = np.random.default_rng(3)
+    for k in range(12):
+        w, (sx, sy) = unit(rng.normal(size=3)), np.exp(rng.uniform(-1.0, 1.0, 2))
+        light = area_light(shape, (0.0, 0.0, 0.0), w, sx, sy)
+        u, v = light.matrix[:3, 0], light.matrix[:3, 1]
+        if k % 3 == 0:
+            a, f = rng.uniform(0, 2 * math.pi), rng.uniform(0.95, 1.05)
+            p = f * (0.5 * sx * math.cos(a) * u + 0.5 * sy * math.sin(a) * v) - w * 10 ** rng.uniform(-3, -1)
+        else:
+            p = rng.uniform(-2, 2) * u + rng.uniform(-2, 2) * v - w * rng.uniform(0.01, 2)
+        n = unit(rng.normal(size=3))
+        want = plane_reference(light, p, n)
+        assert np.allclose(closed(light, p, n), want * light.radiance, rtol=REL, atol=1e-300), (k, want)
 
 
 @pytest.mark.parametrize("shape", ["RECTANGLE", "DISK"])
