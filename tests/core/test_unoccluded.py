@@ -6,6 +6,7 @@ existing light sampler's value x cosine over stratified samples (units). Cases a
 be horizon-clipped, grazing, tiny, huge and far from the origin, and the clipped ones are
 checked to differ from their unclipped integral, so dropping the clip fails them."""
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -340,6 +341,41 @@ def test_sun_with_an_angle_matches_cone_cubature(case):
     assert np.allclose(got, want * light.irradiance, rtol=REL, atol=0), (got[0] / light.irradiance[0], want)
     if clipped:
         assert abs(cap_reference(toward, math.sin(half), n, radiance, clip=False) - want) > 1e-3 * want
+
+
+# -- numerics ---------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("light", [
+    area_light("RECTANGLE", (0.0, 0.0, 1.0), (0.0, 0.0, 1.0), 1.0, 0.5),
+    area_light("ELLIPSE", (0.0, 0.0, 1.0), (0.0, 0.0, 1.0), 1.0, 0.5),
+    sphere(0.5, False, (0.0, 0.0, 1.0)), sphere(0.5, True, (0.0, 0.0, 1.0)), sphere(0.0, True, (0.0, 0.0, 1.0)),
+    Light("SUN", frame((0, 0, 0), (0.0, 0.0, 1.0)), irradiance=np.ones(3), angle=0.5),
+    Light("SUN", frame((0, 0, 0), (0.0, 0.0, 1.0)), irradiance=np.ones(3), angle=math.pi),
+], ids=["rectangle", "ellipse", "sphere", "soft falloff disk", "point", "sun", "sun, half the sky"])
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e4])
+def test_finite_and_non_negative_everywhere(light, scale):
+    """Points on the light's plane, inside and on the sphere, at its centre, far from the origin,
+    normals in the light's plane or exactly opposite: never NaN or Inf, never negative."""
+    rng = np.random.default_rng(11)
+    m = light.matrix.copy()
+    m[:3, 3] *= scale
+    light = replace(light, matrix=m, radius=light.radius * scale, size_x=light.size_x * scale,
+                    size_y=light.size_y * scale)
+    k = 6000
+    pos = rng.uniform(-2, 2, (k, 3)) * scale
+    pos[: k // 6, 2] = m[2, 3]  # on the light's plane
+    pos[k // 6: k // 3] = m[:3, 3] + rng.normal(size=(k // 6, 3)) * 0.5 * scale * rng.random((k // 6, 1))
+    pos[k // 3: k // 3 + 10] = m[:3, 3]
+    pos[k // 2:] += 1e5  # far from the origin, and (with the light moved there below) from the light
+    normal = rng.normal(size=(k, 3))
+    normal[::3, 2] = 0.0  # in the light's plane
+    normal[1::7] = (0.0, 0.0, -1.0)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    table = light_table([light])
+    out = np.zeros((k, 3))
+    for shift in (0.0, 1e5):
+        table[0, 1:4] = m[:3, 3] + shift
+        unoccluded_batch(table, np.zeros(k, np.int64), pos, normal, out)
+        assert np.isfinite(out).all() and (out >= 0).all()
 
 
 # -- delta lights ---------------------------------------------------------------------------------------------
