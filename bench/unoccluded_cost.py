@@ -97,6 +97,13 @@ def worst_errors():
         half = angle / 2
         note("sun", t.closed(light, (5.0, 1.0, 0.0), n)[0],
              t.cap_reference(toward, math.sin(half), n, 1.0 / (math.pi * math.sin(half) ** 2)))
+    verts, tris, emission = t.TRIANGLES
+    for p, n in (((0.1, 0.2, 0.0), (0.0, 0.0, 1.0)), ((0.1, 0.2, 0.0), (-0.9, -0.2, 0.3)),
+                 ((0.1, 0.2, 2.0), (0.2, 0.1, -1.0))):
+        out = np.zeros((1, 3))
+        unoccluded_triangles_batch(verts, tris, np.ones_like(emission), np.array([0], np.int64),
+                                   np.array([p], float), t.unit(n)[None], out)
+        note("emissive triangle", out[0, 0], t.triangle_reference(0, p, n))
     print(f"\n{'kind':22s} worst relative error against cubature")
     for kind, err in worst.items():
         print(f"{kind:22s} {err:9.2e}")
