@@ -37,10 +37,13 @@ def pins(version: str) -> dict[str, str]:
 
 
 def ci_runs() -> dict[str, list[str]]:
-    """make target -> its variable assignments, for each ``make`` line of .ci/run."""
+    """make target -> its variable assignments, for each ``make`` line of .ci/run (run as is or
+    through its ``stage`` timer)."""
     runs = {}
     for line in (ROOT / ".ci" / "run").read_text().splitlines():
         words = shlex.split(line, comments=True)
+        if words[:1] == ["stage"]:
+            words = words[1:]
         if words[:1] == ["make"]:
             targets = [w for w in words[1:] if "=" not in w]
             for target in targets:
