@@ -26,7 +26,8 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 import numpy as np  # noqa: E402
 
-from drt_engine.core.adaptive import true_error  # noqa: E402
+from drt_engine.core.adaptive import RELMSE_EPSILON, true_error  # noqa: E402
+from drt_engine.core.ratio import RATIO  # noqa: E402
 from drt_engine.core.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
 from readme import write_block  # noqa: E402
@@ -51,13 +52,40 @@ def reference(name, data, base, samples):
     return image, variance
 
 
+REGIONS = ("no closed-form light", "light wholly seen", "light hidden", "penumbra")
+
+
+def regions(data, run) -> np.ndarray:
+    """Per pixel, which of REGIONS it is in, from the ratio estimator's sums of a 64-sample render:
+    no sample saw a light the ratio takes (D = 0), every sample saw all of it (N = D), none (N = 0)."""
+    renderer = Renderer(data, RenderSettings(samples=64, seed=99, shadow_estimator="RATIO", **run))
+    renderer.render()
+    w, h = data.camera.window_size
+    if RATIO not in renderer.film.sums:
+        return np.zeros((h, w), int)
+    ndu = renderer.film.sums[RATIO].reshape(h, w, -1)
+    n, d = ndu[..., 0:3].sum(axis=2), ndu[..., 3:6].sum(axis=2)
+    return np.where(d == 0, 0, np.where(np.isclose(n, d, rtol=1e-9), 1, np.where(n == 0, 2, 3)))
+
+
+def region_shares(image, truth, region) -> dict:
+    """Each region's share of the image's true relMSE (terms as ``true_error``'s)."""
+    ref, var = truth
+    terms = (((image - ref) ** 2 - var) / (ref ** 2 + RELMSE_EPSILON)).sum(axis=2)
+    total = terms.sum()
+    return {name: float(terms[region == r].sum() / total) for r, name in enumerate(REGIONS)}
+
+
 def measure(name, data, base, spps, seeds, ref_samples) -> dict:
-    """Per estimator and sample count: pooled true relMSE, summed CPU seconds, image-mean bias."""
+    """Per estimator and sample count: pooled true relMSE, summed CPU seconds, image-mean bias, and
+    where in the image the error is (``region_shares``, of the first seed)."""
     truth = reference(name, data, base, ref_samples)
     run = {**base, "passes": ("Combined",), "threads": 1}
     for estimator in ESTIMATORS:  # compile and warm the kernels of both before timing
         Renderer(data, RenderSettings(samples=2, shadow_estimator=estimator, **run)).render()
-    row = {"scene": name, "size": list(data.camera.window_size), "reference_samples": ref_samples, "runs": {}}
+    region = regions(data, run)
+    row = {"scene": name, "size": list(data.camera.window_size), "reference_samples": ref_samples, "runs": {},
+           "pixels": {name: int((region == r).sum()) for r, name in enumerate(REGIONS)}}
     for spp in spps:
         for estimator in ESTIMATORS:
             relmse, cpu, means = [], 0.0, []
@@ -69,7 +97,9 @@ def measure(name, data, base, spps, seeds, ref_samples) -> dict:
                 image = res.passes["Combined"][..., :3].astype(float)
                 relmse.append(true_error(image, *truth)[1])
                 means.append(image.mean())
-            entry = {"relmse": float(np.mean(relmse)), "cpu": cpu,
+                if len(means) == 1:
+                    shares = region_shares(image, truth, region)
+            entry = {"relmse": float(np.mean(relmse)), "cpu": cpu, "error_shares": shares,
                      "bias": float(np.mean(means) / truth[0].mean() - 1.0),
                      "plan": res.stats["plan_summary"]}
             entry["efficiency"] = 1.0 / (entry["relmse"] * cpu)
@@ -79,8 +109,10 @@ def measure(name, data, base, spps, seeds, ref_samples) -> dict:
 
 
 def sample_scenes(width, names):
+    import drt_engine
     from scenes import load, settings
 
+    drt_engine.register()
     for name in names:
         scene, data = load(name, width)
         s = settings(scene)
@@ -88,14 +120,21 @@ def sample_scenes(width, names):
 
 
 def table(rows, spps) -> str:
-    head = "| scene | spp | relMSE MC | relMSE ratio | CPU time ratio/MC | efficiency ratio/MC | ratio bias (image mean) |"
-    lines = [head, "|---|---|---|---|---|---|---|"]
+    head = ("| scene | spp | relMSE MC | relMSE ratio | CPU time ratio/MC | efficiency ratio/MC | ratio bias "
+            "(image mean) | MC error share: wholly lit / penumbra / other | ratio's |")
+    lines = [head, "|---|---|---|---|---|---|---|---|---|"]
+
+    def shares(entry):
+        s = entry["error_shares"]
+        lit, pen = s["light wholly seen"], s["penumbra"]
+        return f"{100 * lit:.0f}% / {100 * pen:.0f}% / {100 * (1 - lit - pen):.0f}%"
+
     for row in rows:
         for spp in spps:
             mc, ra = row["runs"][f"MONTE_CARLO@{spp}"], row["runs"][f"RATIO@{spp}"]
             lines.append(f"| {row['scene']} | {spp} | {mc['relmse']:.2e} | {ra['relmse']:.2e} | "
                          f"{ra['cpu'] / mc['cpu']:.2f} | **{ra['efficiency'] / mc['efficiency']:.2f}x** | "
-                         f"{100 * ra['bias']:+.3f}% |")
+                         f"{100 * ra['bias']:+.3f}% | {shares(mc)} | {shares(ra)} |")
     return "\n".join(lines)
 
 
@@ -103,7 +142,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--width", type=int, default=96, help="sample scenes' width in pixels")
     parser.add_argument("--soft-width", type=int, default=128, help="soft-shadow scene's width in pixels")
-    parser.add_argument("--spp", type=int, nargs="+", default=[16, 64])
+    parser.add_argument("--spp", type=int, nargs="+", default=[4, 16, 64])
     parser.add_argument("--seeds", type=int, default=2)
     parser.add_argument("--reference-samples", type=int, default=1024)
     parser.add_argument("--scenes", nargs="*", default=["cornell_box", "glossy_spheres", "dof_row", "motion_blur"])

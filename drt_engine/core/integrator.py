@@ -19,7 +19,7 @@ from . import dims as D
 from . import microfacet as mf
 from .accel import spawn
 from .film import PixelFilter
-from .ratio import NDU_CHANNELS, RATIO, unoccluded_light
+from .ratio import NDU_CHANNELS, RATIO, add_unoccluded
 from .records import BsdfSample, PathState, Samples, ShadowRays, SurfaceHits
 from .shading import SurfaceContext
 
@@ -367,8 +367,7 @@ class Integrator:
             by_ratio = k in self.ratio and albedo is not None
             if by_ratio:
                 diffuse = hits.throughput * ls.value * f_diff
-                wave.ratio[hits.path, 3:6] += diffuse
-                wave.ratio[hits.path, 6:9] += albedo * unoccluded_light(lights, k, hits.pos, hits.ns)
+                add_unoccluded(lights.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, wave.ratio)
             ok &= mf.max3(contrib) > 0
             sel = np.flatnonzero(ok)
             if len(sel) == 0:

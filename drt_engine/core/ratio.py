@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .unoccluded import closed_forms, unoccluded_batch
+from .jit import kernel
+from .unoccluded import closed_forms, unoccluded
 
 RATIO = "Ratio"
 """Name of the film sums (and of the wave output) of N, D and U."""
@@ -54,15 +55,20 @@ def ratio_strategies(lights, estimator: str) -> list[int]:
             if k not in lights.motions and not delta_light(lights.lights[k]) and closed[k]]
 
 
-def unoccluded_light(lights, k: int, pos: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """(N, 3) E_u of light strategy k at points ``pos`` with unit normals ``normal``: the
-    expectation of the light sample's value times the cosine, unoccluded."""
-    out = np.zeros((len(pos), 3))
-    if len(pos):
-        rows = np.full(len(pos), k, np.int64)
-        unoccluded_batch(lights.table, rows, np.ascontiguousarray(pos, np.float64),
-                         np.ascontiguousarray(normal, np.float64), out)
-    return out
+@kernel
+def add_unoccluded(table, k, pos, normal, path, albedo, diffuse, ndu):
+    """Per hit j of path ``path[j]``: D += ``diffuse[j]`` (throughput x light sample value x the
+    diffuse part, unoccluded) and U += ``albedo[j]`` (throughput x albedo / pi) x E_u, light k's
+    unoccluded light at ``pos[j]`` about the unit normal ``normal[j]`` (core.unoccluded)."""
+    for j in range(len(path)):
+        r, g, b = unoccluded(table, k, pos[j, 0], pos[j, 1], pos[j, 2], normal[j, 0], normal[j, 1], normal[j, 2])
+        p = path[j]
+        ndu[p, 3] += diffuse[j, 0]
+        ndu[p, 4] += diffuse[j, 1]
+        ndu[p, 5] += diffuse[j, 2]
+        ndu[p, 6] += albedo[j, 0] * r
+        ndu[p, 7] += albedo[j, 1] * g
+        ndu[p, 8] += albedo[j, 2] * b
 
 
 def resolve(total: np.ndarray, ndu: np.ndarray) -> np.ndarray:
