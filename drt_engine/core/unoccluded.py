@@ -117,18 +117,27 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 TRAPEZOID_MAX = 512
 """Points of the periodic trapezoid rule before a whole ellipse falls back to adaptive
 Gauss-Legendre (only points very near the rim need more)."""
-RIM_TOLERANCE = 1e-12
-"""Step error allowed, relative to the integral of the integrand's magnitude."""
+RIM_TOLERANCE = 1e-8
+"""Difference allowed between a Gauss-Legendre step and its two halves, relative to the integral
+of the integrand's magnitude (beside the rounding of the step's own sum, which no step length
+removes); the halves, which are kept, are some 2^16 times closer."""
+PERIODIC_SETTLED = 1e-6
+"""Change allowed between the trapezoid rule and its doubling, relative to the integral of the
+integrand's magnitude: the error falls geometrically with the points, so the doubled rule's is
+about the square of this."""
+MAX_STEPS = 4096
 
 
 @kernel(inline="always")
 def _rim(phi, prm):
     """n . (v x v') / |v|^2 at rim angle phi, v = d + a cos U + b sin V: the integrand of the
-    boundary integral, from the terms ``_ellipse`` precomputes."""
-    a, b, mu, mv, k, dd, du, dv = prm
-    c, s = math.cos(phi), math.sin(phi)
-    q = dd + 2.0 * (a * c * du + b * s * dv) + a * a * c * c + b * b * s * s
-    return (b * c * mv - a * s * mu + k) / max(q, 1e-300)
+    boundary integral, from the terms ``_ellipse`` precomputes (|v| from v itself, which keeps
+    its precision when the point is near the rim)."""
+    a, b, mu, mv, k, dx, dy, dz, ux, uy, uz, vx, vy, vz = prm
+    co, si = math.cos(phi), math.sin(phi)
+    c, s = a * co, b * si
+    x, y, z = dx + c * ux + s * vx, dy + c * uy + s * vy, dz + c * uz + s * vz
+    return (b * co * mv - a * si * mu + k) / max(x * x + y * y + z * z, 1e-300)
 
 
 @kernel(inline="always")
@@ -150,31 +159,37 @@ def _adaptive(lo, hi, prm):
     span = hi - lo
     if not span > 0:
         return 0.0
-    _, size = _gauss(lo, hi, prm)
+    coarse, size = _gauss(lo, hi, prm)
     tol = RIM_TOLERANCE * max(size, 1e-300)
-    total, x, h = 0.0, lo, 0.25 * span
-    while True:
-        last = h >= hi - x
-        if last:
-            h = hi - x
-        coarse, _ = _gauss(x, x + h, prm)
-        left, _ = _gauss(x, x + 0.5 * h, prm)
-        right, _ = _gauss(x + 0.5 * h, x + h, prm)
-        if abs(left + right - coarse) <= tol * h / span or h <= 1e-13 * span:
+    total, x, h = 0.0, lo, span
+    known = True  # whether ``coarse`` is this step's sum already (a halved step's is the left half)
+    for step in range(MAX_STEPS):
+        last = h >= hi - x or step == MAX_STEPS - 1  # (the last allowed step takes the rest)
+        if last and h != hi - x:
+            h, known = hi - x, False
+        if not known:
+            coarse, _ = _gauss(x, x + h, prm)
+        left, size_l = _gauss(x, x + 0.5 * h, prm)
+        right, size_r = _gauss(x + 0.5 * h, x + h, prm)
+        settled = abs(left + right - coarse) <= tol * h / span + 1e-13 * (size_l + size_r)
+        if settled or step == MAX_STEPS - 1:
             total += left + right
             if last:
                 return total
             x += h
             h *= 2.0
+            known = False
         else:
             h *= 0.5
+            coarse, known = left, True
+    return total
 
 
 @kernel(inline="always")
 def _periodic(prm):
     """Integral of ``_rim`` over a whole turn: the periodic trapezoid rule (exponential
     convergence for an ellipse wholly above the horizon), doubled until it settles."""
-    n = 16
+    n = 8
     step = 2.0 * math.pi / n
     total, size = 0.0, 0.0
     for j in range(n):
@@ -190,7 +205,7 @@ def _periodic(prm):
         n *= 2
         step *= 0.5
         current = total * step
-        if abs(current - previous) <= 1e-10 * size * step:
+        if abs(current - previous) <= PERIODIC_SETTLED * size * step:
             return current
         previous = current
     return _adaptive(0.0, 2.0 * math.pi, prm)
@@ -205,8 +220,7 @@ def _ellipse(table, i, dx, dy, dz, nx, ny, nz):
     vx, vy, vz = table[i, EYX], table[i, EYY], table[i, EYZ]
     mx, my, mz = ny * dz - nz * dy, nz * dx - nx * dz, nx * dy - ny * dx  # n x d
     k = a * b * (nx * table[i, EZX] + ny * table[i, EZY] + nz * table[i, EZZ])
-    prm = (a, b, mx * ux + my * uy + mz * uz, mx * vx + my * vy + mz * vz, k, dx * dx + dy * dy + dz * dz,
-           dx * ux + dy * uy + dz * uz, dx * vx + dy * vy + dz * vz)
+    prm = (a, b, mx * ux + my * uy + mz * uz, mx * vx + my * vy + mz * vz, k, dx, dy, dz, ux, uy, uz, vx, vy, vz)
     # height above the horizon along the rim: hc + ha cos(phi) + hb sin(phi)
     hc, ha, hb = nx * dx + ny * dy + nz * dz, a * (nx * ux + ny * uy + nz * uz), b * (nx * vx + ny * vy + nz * vz)
     r = math.sqrt(ha * ha + hb * hb)
