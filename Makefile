@@ -8,6 +8,8 @@
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
 #                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
+#   make bench-ratio the ratio estimator against Monte Carlo: efficiency, bias, where the error is
+#                    (bench/ratio_estimator.py: README block, bench/ratio_estimator.json); about 30 minutes
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
 #   make texture-parity  DRT vs Cycles per procedural texture and mode (tools/texture_parity.py: README table)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
@@ -46,7 +48,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-farm texture-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-ratio bench-farm texture-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -112,9 +114,13 @@ scenes: $(STAMP)
 bench: $(STAMP)
 	$(PY) bench/run.py --publish
 	$(PY) bench/throughput.py
+	$(PY) bench/ratio_estimator.py --publish
 
 bench-throughput: $(STAMP)
 	$(PY) bench/throughput.py
+
+bench-ratio: $(STAMP)
+	$(PY) bench/ratio_estimator.py --publish
 
 bench-farm: $(STAMP)
 	$(PY) bench/farm.py

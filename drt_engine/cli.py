@@ -16,7 +16,7 @@ from pathlib import Path
 from .cli_progress import ProgressDisplay
 from .core import merge, parts, report
 from .core.errors import DRTError
-from .core.settings import ADAPTIVE_MODES
+from .core.settings import ADAPTIVE_MODES, SHADOW_ESTIMATORS
 
 EXIT_ERROR = 1
 EXIT_USAGE = 2
@@ -74,10 +74,12 @@ def _float_in(minimum: float, maximum: float = math.inf):
     return parse
 
 
-def _mode(text: str) -> str:
-    if text.upper() not in ADAPTIVE_MODES:
-        raise argparse.ArgumentTypeError(f"must be one of {', '.join(ADAPTIVE_MODES)}, got {text!r}")
-    return text.upper()
+def _one_of(names):
+    def parse(text: str) -> str:
+        if text.upper() not in names:
+            raise argparse.ArgumentTypeError(f"must be one of {', '.join(names)}, got {text!r}")
+        return text.upper()
+    return parse
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -110,8 +112,11 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--adaptive-min-samples", type=_at_least(0), metavar="N",
                         help="samples every pixel takes before adaptive sampling starts, 0 = automatic; "
                         "turns adaptive sampling on (scene.drt.adaptive_min_samples)")
-    render.add_argument("--adaptive-mode", type=_mode, metavar="NOISE|CONTRAST",
+    render.add_argument("--adaptive-mode", type=_one_of(ADAPTIVE_MODES), metavar="NOISE|CONTRAST",
                         help="adaptive sampling mode; turns adaptive sampling on (scene.drt.adaptive_mode)")
+    render.add_argument("--shadow-estimator", type=_one_of(SHADOW_ESTIMATORS), metavar="MONTE_CARLO|RATIO",
+                        help="diffuse direct light of lights with a closed form: per shadow ray, or the "
+                        "analytic light times the pixel's visible fraction (scene.drt.shadow_estimator)")
     farm = render.add_argument_group(
         "render farm", "Split the render over processes or machines: sample ranges of a frame, frames of an "
         "animation. Parts need a fixed sample count (no adaptive sampling, time limit or target error).")
@@ -242,6 +247,8 @@ def _open_scene(args, blend: Path):
     if args.adaptive_mode is not None:
         scene.drt.use_adaptive_sampling = True
         scene.drt.adaptive_mode = args.adaptive_mode
+    if args.shadow_estimator is not None:
+        scene.drt.shadow_estimator = args.shadow_estimator
     return scene
 
 

@@ -68,6 +68,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         adaptive_threshold=drt.adaptive_threshold,
         adaptive_min_samples=drt.adaptive_min_samples,
         adaptive_mode=drt.adaptive_mode,
+        shadow_estimator=drt.shadow_estimator,
         time_limit=drt.time_limit,
         target_error=drt.target_error,
         sample_start=drt.sample_offset,
@@ -137,6 +138,19 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         default=0.0,
         min=0.0,
         soft_max=100.0,
+    )
+    shadow_estimator: EnumProperty(
+        name="Shadow Estimator",
+        description="How the diffuse direct light of area, sphere and sun lights is estimated",
+        items=(
+            ("MONTE_CARLO", "Monte Carlo", "Each shadow ray's light sample counts on its own (unbiased; "
+             "noisy wherever a light is partly or wholly in view)"),
+            ("RATIO", "Ratio", "The light's exact unoccluded light times the fraction of it the pixel's "
+             "shadow rays let through (Heitz et al. 2018): exact where a light is wholly in view or "
+             "hidden, noisy only in penumbrae, with a bias there that vanishes as samples grow; "
+             "lights with no closed form stay Monte Carlo (the render plan names them)"),
+        ),
+        default=RenderSettings.shadow_estimator,
     )
     threads: IntProperty(
         name="Threads",

@@ -146,6 +146,7 @@ class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
         col = layout.column()
         col.prop(drt, "max_depth")
         col.prop(drt, "clamp")
+        col.prop(drt, "shadow_estimator")
 
 
 class DRT_PT_film(DRTButtonsPanel, bpy.types.Panel):

@@ -163,10 +163,12 @@ def box_mean(x: np.ndarray, h: int, w: int, radius: int = 1) -> np.ndarray:
 
 
 def _rgb_blocks(film: Film):
-    """(span, variance of the mean, mean) of the Combined RGB, a block of pixels at a time:
-    whole-film float64 temporaries of an 8K image are GBs."""
+    """(span, variance of the mean, mean) of the Combined RGB as the image shows it (resolved
+    with the ratio estimator), a block of pixels at a time: whole-film float64 temporaries
+    of an 8K image are GBs."""
     for span in film.blocks():
-        yield span, film.variance(span), film.sums["Combined"][span, :3] / np.maximum(film.count[span], 1)[:, None]
+        mean, var = film.rgb_error(span)
+        yield span, var, mean
 
 
 def noise_error(film: Film) -> np.ndarray:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import kernel
+from .ratio import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 from .settings import PASS_CHANNELS
 
 _TABLE = 1024
@@ -135,6 +136,20 @@ def _splat_counts(pixel, sample, combined, replicate, count, count_a, sum_a):
 
 
 @kernel
+def _splat_ratio(pixel, sample, ndu, replicate, total):
+    """The ratio estimator's N, D, U (core.ratio) into the first columns of ``total`` for every
+    sample and into the last ones for class A (chosen as ``_splat_counts`` chooses)."""
+    k = ndu.shape[1]
+    for i in range(len(pixel)):
+        p = pixel[i]
+        a = sample_is_class_a(int(sample[i])) if replicate < 0 else replicate == 1
+        for c in range(k):
+            total[p, c] += ndu[i, c]
+            if a:
+                total[p, k + c] += ndu[i, c]
+
+
+@kernel
 def _extend_range(pixel, combined, lo, hi):
     for i in range(len(pixel)):
         for c in range(3):
@@ -146,16 +161,21 @@ class Film:
     """Sums per pixel of the window: samples, every pass, and Combined RGB over class A.
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
-    (contrast-driven refinement needs them).
+    (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
+    (core.ratio), and Combined is read resolved: its diffuse direct part of the lights
+    with a closed form is U N / D.
     """
 
-    def __init__(self, width: int, height: int, passes: tuple[str, ...], track_range: bool = False):
+    def __init__(self, width: int, height: int, passes: tuple[str, ...], track_range: bool = False,
+                 ratio: bool = False):
         self.width, self.height = width, height
         self.n = width * height
         self.passes = passes
         self.count = np.zeros(self.n)
         self.sums = {name: np.zeros((self.n, len(PASS_CHANNELS[name])))
                      for name in passes if name not in ("Sample Count", "Noise")}
+        if ratio:
+            self.sums[RATIO] = np.zeros((self.n, FILM_CHANNELS))
         self.count_a = np.zeros(self.n)
         self.sum_a = np.zeros((self.n, 3))
         self.lo = np.full((self.n, 3), np.inf) if track_range else None
@@ -167,22 +187,50 @@ class Film:
         if len(pixel) == 0:
             return
         pixel = pixel if pixel.dtype == np.int64 else pixel.astype(np.int64)
-        for name, total in self.sums.items():
-            _splat(pixel, values[name], total)
-        combined = values["Combined"]
+        sample = np.asarray(sample, dtype=np.int64)
         replicate = -1 if replicate is None else int(replicate)
-        _splat_counts(pixel, np.asarray(sample, dtype=np.int64), combined, replicate,
-                      self.count, self.count_a, self.sum_a)
+        for name, total in self.sums.items():
+            if name == RATIO:
+                _splat_ratio(pixel, sample, values[name], replicate, total)
+            else:
+                _splat(pixel, values[name], total)
+        combined = values["Combined"]
+        _splat_counts(pixel, sample, combined, replicate, self.count, self.count_a, self.sum_a)
         if self.lo is not None:
             _extend_range(pixel, combined, self.lo, self.hi)
 
-    def mean(self, name: str) -> np.ndarray:
-        return self.sums[name] / np.maximum(self.count, 1)[:, None]
+    @property
+    def ratio(self) -> bool:
+        return RATIO in self.sums
+
+    def halves(self, span: slice = slice(None)):
+        """(count, count A, Combined RGB summed over all samples, over class A, over class B) of
+        the pixels ``span``, each read resolved with the ratio estimator: the full image's ratio
+        over all its samples, each half's over its own (so the halves stay independent)."""
+        n, na = self.count[span], self.count_a[span]
+        total, total_a = self.sums["Combined"][span, :3], self.sum_a[span]
+        if not self.ratio:
+            return n, na, total, total_a, total - total_a
+        ndu = self.sums[RATIO][span]
+        ndu_a = ndu[:, NDU_CHANNELS:]
+        ndu_all = ndu[:, :NDU_CHANNELS]
+        return (n, na, resolve(total, ndu_all), resolve(total_a, ndu_a),
+                resolve(total - total_a, ndu_all - ndu_a))
+
+    def rgb(self, span: slice = slice(None)) -> np.ndarray:
+        """The Combined RGB mean of the pixels ``span`` (resolved)."""
+        n, _, total, _, _ = self.halves(span)
+        return total / np.maximum(n, 1)[:, None]
 
     def variance(self, span: slice = slice(None)) -> np.ndarray:
         """Per-pixel, per-channel estimate of the squared error of the Combined RGB mean
         (see ``_variance``), of every pixel or of the pixels ``span``."""
-        return _variance(self.count[span], self.count_a[span], self.sums["Combined"][span, :3], self.sum_a[span])
+        return self.rgb_error(span)[1]
+
+    def rgb_error(self, span: slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        """(``rgb``, ``variance``) of the pixels ``span``, read once."""
+        n, na, total, total_a, total_b = self.halves(span)
+        return total / np.maximum(n, 1)[:, None], _variance(n, na, total_a, total_b)
 
     def blocks(self):
         """Slices covering the film a bounded block of pixels at a time."""
@@ -207,25 +255,24 @@ class Film:
         if name == "Sample Count":
             return count[:, None]
         if name == "Noise":
-            return _standard_error(count, self.count_a[span], self.sums["Combined"][span, :3], self.sum_a[span])
-        return self.sums[name][span] / np.maximum(count, 1)[:, None]
+            mean, var = self.rgb_error(span)
+            unknown = ~np.isfinite(var)
+            var[unknown] = mean[unknown] ** 2
+            return np.sqrt(var)
+        mean = self.sums[name][span] / np.maximum(count, 1)[:, None]
+        if name == "Combined" and self.ratio:
+            mean[:, :3] = self.rgb(span)
+        return mean
 
 
-def _variance(n, na, total, total_a):
-    """With n_a samples in class A and n_b in class B, the full mean minus the class A
-    mean has variance Var(mean) * n_b / n_a if the halves are independent estimates;
-    pixels without both classes yet get an infinite estimate."""
+def _variance(n, na, total_a, total_b):
+    """With n_a samples in class A and n_b in class B, independent halves, the full mean
+    (n_a A + n_b B) / n has variance (A - B)^2 n_a n_b / n^2 in expectation (for the ratio
+    estimator to first order); pixels without both classes yet get an infinite estimate."""
     nb = n - na
-    full = total / np.maximum(n, 1)[:, None]
-    half = total_a / np.maximum(na, 1)[:, None]
+    half_a = total_a / np.maximum(na, 1)[:, None]
+    half_b = total_b / np.maximum(nb, 1)[:, None]
     known = (na > 0) & (nb > 0)
-    var = (full - half) ** 2 * (na / np.maximum(nb, 1))[:, None]
+    var = (half_a - half_b) ** 2 * (na * nb / np.maximum(n, 1) ** 2)[:, None]
     var[~known] = np.inf
     return var
-
-
-def _standard_error(n, na, total, total_a):
-    var = _variance(n, na, total, total_a)
-    unknown = ~np.isfinite(var)
-    var[unknown] = (total / np.maximum(n, 1)[:, None])[unknown] ** 2
-    return np.sqrt(var)

@@ -20,6 +20,7 @@ from . import microfacet as mf
 from .accel import spawn
 from .denoising import Features
 from .film import PixelFilter
+from .ratio import NDU_CHANNELS, RATIO, add_unoccluded
 from .records import BsdfSample, PathState, Samples, ShadowRays, SurfaceHits
 from .shading import SurfaceContext
 
@@ -56,20 +57,29 @@ class StepSamples:
 @dataclass
 class WaveOutput:
     """The per-sample values of every pass a wave computes: the wave's accumulator, which the
-    stages add their contributions to (Combined RGB, alpha, the auxiliary passes)."""
+    stages add their contributions to (Combined RGB, alpha, the auxiliary passes, and the
+    ratio estimator's N, D, U when it is used, core.ratio)."""
 
     radiance: np.ndarray
     alpha: np.ndarray
     aux: dict
     features: Features | None = None  # the denoising features' walks, when those passes are on
+    ratio: np.ndarray | None = None
 
     def values(self, clamp: float) -> dict:
-        radiance = self.radiance
+        radiance, ratio = self.radiance, self.ratio
         if clamp > 0:
             peak = mf.max3(radiance)
-            radiance = radiance * np.where(peak > clamp, clamp / np.maximum(peak, _TINY), 1.0)[:, None]
-        radiance = np.where(np.isfinite(radiance), radiance, 0.0)
+            scale = np.where(peak > clamp, clamp / np.maximum(peak, _TINY), 1.0)[:, None]
+            radiance = radiance * scale
+            ratio = None if ratio is None else ratio * scale  # N stays the share of Combined it is
+        finite = np.isfinite(radiance)
+        if ratio is not None:
+            out_ratio = np.where((finite.all(axis=1) & np.isfinite(ratio).all(axis=1))[:, None], ratio, 0.0)
+        radiance = np.where(finite, radiance, 0.0)
         out = {"Combined": np.concatenate([radiance, np.clip(self.alpha, 0.0, 1.0)[:, None]], axis=1)}
+        if ratio is not None:
+            out[RATIO] = out_ratio
         out.update(self.aux)
         return out
 
@@ -86,6 +96,7 @@ class Integrator:
         self.filter = PixelFilter(settings.filter_type, settings.filter_size)
         self.pixel_spread = camera_rays.pixel_spread(self.camera)
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
+        self.ratio = frozenset(plan.ratio)
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
 
@@ -101,7 +112,8 @@ class Integrator:
         times = self.geometry.ray_times(state.time)  # moving parts' transforms, once per camera sample
         n = len(state)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
-                                                        if name in s.passes})
+                                                        if name in s.passes},
+                         ratio=np.zeros((n, NDU_CHANNELS)) if self.ratio else None)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
@@ -144,7 +156,7 @@ class Integrator:
                     # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
                     diffuse = any(lobe.kind == "diffuse" for lobe in shader.lobes)
                     lift = self.geometry.smooth_offset(hits, group.row, ray_times) if diffuse else None
-                    shadows += self._direct(shader, group, u_g, lift)
+                    shadows += self._direct(shader, group, u_g, lift, out)
                 if shader.can_continue and depth < s.max_depth:
                     nxt = self._continue(shader, group, u_g)
                     if nxt is not None:
@@ -343,13 +355,15 @@ class Integrator:
                 yield group.take(sub), u_g.take(sub), shader
 
     # -- next-event estimation ----------------------------------------------------------
-    def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift) -> list[ShadowRays]:
-        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy."""
+    def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
+        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy; for
+        the lights the ratio estimator takes, their D and U go to the wave's sums (core.ratio)."""
         lights = self.lights
         out = []
         time = hits.time if self.timed else None
         sel_lobes = shader.selection(hits.wo_l[:, 2]) if shader.sampled else None
         emissive = lights.light_slots if len(lights.emissive) else -1
+        albedo = self._diffuse_albedo(shader, hits, sel_lobes) if self.ratio else None
         for k in range(lights.strategies):
             u_pick = u.choice[emissive] if emissive >= 0 else None
             # the world is sampled around the shading normal, the one the BSDF's cosine follows
@@ -364,6 +378,10 @@ class Integrator:
             f_diff, f_nd = ls.restrict(f_diff, f_nd, above)
             w_l = _power(ls.pdf, pdf_b)
             contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
+            by_ratio = k in self.ratio and albedo is not None
+            if by_ratio:
+                diffuse = hits.throughput * ls.value * f_diff
+                add_unoccluded(lights.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, wave.ratio)
             ok &= mf.max3(contrib) > 0
             sel = np.flatnonzero(ok)
             if len(sel) == 0:
@@ -374,8 +392,20 @@ class Integrator:
             dist = ls.dist[sel]
             stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
             tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
-            out.append(ShadowRays(hits.path[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel]))
+            out.append(ShadowRays(hits.path[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel],
+                                  diffuse[sel] if by_ratio else np.zeros((len(sel), 3))))
         return out
+
+    @staticmethod
+    def _diffuse_albedo(shader, hits: SurfaceHits, sel_lobes):
+        """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
+        the diffuse part toward the normal, since it is that times the cosine (the layers above
+        attenuate it by factors of wo alone, lobe_kernels.eval_lobes)."""
+        n = len(hits.path)
+        normal = np.zeros((n, 3))
+        normal[:, 2] = 1.0
+        f_diff, _, _ = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes)
+        return hits.throughput * f_diff if (f_diff > 0).any() else None
 
     def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
         """Trace the shadow rays of a depth step and add the unblocked ones' light."""
@@ -390,6 +420,8 @@ class Integrator:
         n = len(out.radiance)
         for c in range(3):
             out.radiance[:, c] += np.bincount(rays.path[visible], weights=rays.contrib[visible, c], minlength=n)
+            if out.ratio is not None:
+                out.ratio[:, c] += np.bincount(rays.path[visible], weights=rays.diffuse[visible, c], minlength=n)
 
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:

@@ -32,7 +32,8 @@ class Merger:
         """Take a part; returns the log entry when the merged samples grew, else None."""
         if self.first is None:
             self.first = part
-            self.film = Film(part.width, part.height, tuple(part.header["passes"]))
+            self.film = Film(part.width, part.height, tuple(part.header["passes"]),
+                             ratio=parts_mod.RATIO in part.header["channels"])
         else:
             parts_mod.check_same(self.first, part, "the first part", name)
         if part.sample_range not in self.ranges:

@@ -23,6 +23,7 @@ import numpy as np
 
 from .errors import DRTError
 from .film import Film
+from .ratio import RATIO
 from .settings import RenderSettings
 
 FORMAT = 1
@@ -111,15 +112,20 @@ def from_film(film: Film, settings: RenderSettings, header: dict) -> Part:
                 {name: total.copy() for name, total in film.sums.items()}, header)
 
 
+def _sum_names(passes, channels: dict) -> list[str]:
+    """The film sums a part holds, in order: its passes', then the ratio estimator's (core.ratio)."""
+    return [name for name in passes if name in channels] + ([RATIO] if RATIO in channels else [])
+
+
 def _channel_names(passes, channels: dict) -> list[str]:
     """One name per float64 column, in ``_arrays`` order: prefix.column."""
     names = ["count.0", "count_a.0", "sum_a.0", "sum_a.1", "sum_a.2"]
-    return names + [f"sum.{name}.{c}" for name in passes if name in channels for c in range(channels[name])]
+    return names + [f"sum.{name}.{c}" for name in _sum_names(passes, channels) for c in range(channels[name])]
 
 
 def _arrays(part: Part) -> list[np.ndarray]:
     """The (n, k) float64 arrays, in ``_channel_names`` order."""
-    sums = [part.sums[name] for name in part.header["passes"] if name in part.sums]
+    sums = [part.sums[name] for name in _sum_names(part.header["passes"], part.sums)]
     return [part.count[:, None], part.count_a[:, None], part.sum_a, *sums]
 
 
@@ -174,7 +180,7 @@ def read(path) -> Part:
         lo, hi = words[:, index[f"{name}.lo"]], words[:, index[f"{name}.hi"]]
         columns.setdefault(name.rsplit(".", 1)[0], []).append(((hi << np.uint64(32)) | lo).view(np.float64))
     array = {prefix: np.stack(cols, axis=1) for prefix, cols in columns.items()}
-    sums = {name: array[f"sum.{name}"] for name in header["passes"] if f"sum.{name}" in array}
+    sums = {name: array[f"sum.{name}"] for name in _sum_names(header["passes"], header["channels"])}
     return Part(spec.width, spec.height, array["count"][:, 0], array["count_a"][:, 0], array["sum_a"], sums, header)
 
 

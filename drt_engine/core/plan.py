@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .motion import Motion
+from .ratio import delta_light, ratio_strategies
 
 RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent")
 
@@ -27,10 +28,13 @@ class RenderPlan:
     strategies: list[str]  # one shadow ray per strategy per shading point, in order
     left_out: list[str] = field(default_factory=list)  # what the scene does not need
     passes: list[str] = field(default_factory=list)
+    ratio: list[int] = field(default_factory=list)  # strategies whose diffuse part the ratio estimator takes
+    monte_carlo: list[str] = field(default_factory=list)  # with RATIO: light strategies left to Monte Carlo
 
     def as_dict(self) -> dict:
         return {"lens": self.lens, "time": self.time, "moving": list(self.moving), "rays": dict(self.rays),
-                "strategies": list(self.strategies), "passes": list(self.passes), "left_out": list(self.left_out)}
+                "strategies": list(self.strategies), "passes": list(self.passes), "left_out": list(self.left_out),
+                "ratio": [self.strategies[k] for k in self.ratio], "monte_carlo": list(self.monte_carlo)}
 
     def summary(self) -> str:
         """One line for Blender's stats, the console and the CLI."""
@@ -39,6 +43,10 @@ class RenderPlan:
         text = f"plan: dims {'+'.join(dims)}; rays {kinds}; {len(self.strategies)} light strategies"
         if self.left_out:
             text += "; left out: " + ", ".join(self.left_out)
+        if self.ratio or self.monte_carlo:
+            text += f"; ratio estimator: {len(self.ratio)} lights"
+            if self.monte_carlo:
+                text += "; Monte Carlo: " + ", ".join(self.monte_carlo)
         return text
 
 
@@ -65,7 +73,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
 
     strategies = []
     for light in lights.lights[:lights.light_slots] if not lights.selecting else []:
-        strategies.append(f"{light.kind.lower()} {light.name}".strip() + (" (delta)" if _delta(light) else ""))
+        strategies.append(f"{light.kind.lower()} {light.name}".strip() + (" (delta)" if delta_light(light) else ""))
     if lights.selecting:
         strategies += [f"chosen light slot {k}" for k in range(lights.light_slots)]
     if len(lights.emissive):
@@ -84,15 +92,13 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     dropped = len(scene.lights) - len(lights.lights)
     if dropped:
         left_out.append(f"{dropped} lights of zero power")
-    return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes))
+    ratio = ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] else []
+    by_ratio = settings.shadow_estimator == "RATIO"
+    monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
+    return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo)
 
 
 def _deforms(mesh) -> bool:
     steps = mesh.motion_vertices
     return steps is not None and not np.allclose(steps, steps[:1])  # as accel.Geometry decides
 
-
-def _delta(light) -> bool:
-    if light.kind in ("POINT", "SPOT"):
-        return light.radius <= 0
-    return light.kind == "SUN" and light.angle <= 0

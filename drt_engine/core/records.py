@@ -111,13 +111,15 @@ class BsdfSample:
 
 @dataclass
 class ShadowRays:
-    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked."""
+    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked, and
+    the share of that the ratio estimator takes (its N; zero for other lights, core.ratio)."""
 
     path: np.ndarray
     origins: np.ndarray
     dirs: np.ndarray
     tmax: np.ndarray
     contrib: np.ndarray
+    diffuse: np.ndarray
 
     def __len__(self):
         return len(self.path)

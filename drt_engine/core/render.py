@@ -66,7 +66,7 @@ class Renderer:
         self.integrator = Integrator(prepared, scene, settings, self.plan)
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
-        self.film = Film(w, h, settings.passes, track_range=contrast)
+        self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio))
 
     @property
     def rays(self) -> dict:

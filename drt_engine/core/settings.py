@@ -8,6 +8,8 @@ from .errors import SettingsError
 SAMPLING_PATTERNS = ("GRID", "JITTERED", "SOBOL")
 FILTER_TYPES = ("BOX", "GAUSSIAN", "BLACKMAN_HARRIS")
 ADAPTIVE_MODES = ("NOISE", "CONTRAST")
+SHADOW_ESTIMATORS = ("MONTE_CARLO", "RATIO")
+"""How the diffuse direct light of lights with a closed form is estimated (core.ratio)."""
 
 PASSES = (
     "Combined",  # RGBA
@@ -54,6 +56,7 @@ class RenderSettings:
     adaptive_threshold: float = 0.01
     adaptive_min_samples: int = 0
     adaptive_mode: str = "NOISE"
+    shadow_estimator: str = "MONTE_CARLO"
     time_limit: float = 0.0
     target_error: float = 0.0
     sample_start: int = 0  # first sample id of this render's range (a farm part renders one range)
@@ -70,6 +73,9 @@ class RenderSettings:
             raise ValueError(f"unknown filter type {self.filter_type!r}")
         if self.adaptive_mode not in ADAPTIVE_MODES:
             raise ValueError(f"unknown adaptive mode {self.adaptive_mode!r}")
+        if self.shadow_estimator not in SHADOW_ESTIMATORS:
+            raise SettingsError(f"unknown shadow estimator {self.shadow_estimator!r} "
+                                f"(one of {', '.join(SHADOW_ESTIMATORS)})")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         unknown = set(self.passes) - set(PASSES)

@@ -54,7 +54,8 @@ def test_help():
     result = run_cli("render", "--help", timeout=60)
     assert result.returncode == 0
     for option in ("--samples", "--seed", "--frame", "--resolution", "--engine-threads", "-o", "--time-limit",
-                   "--target-error", "--adaptive-threshold", "--adaptive-min-samples", "--adaptive-mode"):
+                   "--target-error", "--adaptive-threshold", "--adaptive-min-samples", "--adaptive-mode",
+                   "--shadow-estimator"):
         assert option in result.stdout
     assert result.stderr == ""
 
@@ -105,13 +106,14 @@ def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
     out = tmp_path / "out.exr"
     result = run_cli("render", blend, "-o", out, "--resolution", "128x96", "--samples", 32, "--time-limit", 60,
                      "--target-error", 0, "--adaptive-threshold", 0.05, "--adaptive-min-samples", 8,
-                     "--adaptive-mode", "noise")
+                     "--adaptive-mode", "noise", "--shadow-estimator", "ratio")
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     assert result.stderr == ""
     report = json.loads((tmp_path / "out.drt.json").read_text())
     assert report["file"] == str(blend)
     settings = report["settings"]
     assert settings["use_adaptive_sampling"] and settings["adaptive_mode"] == "NOISE"
+    assert settings["shadow_estimator"] == "RATIO"
     assert settings["time_limit"] == 60 and settings["samples"] == 32
     assert settings["adaptive_threshold"] == pytest.approx(0.05) and settings["adaptive_min_samples"] == 8
     assert report["scene"]["resolution"] == [128, 96] and report["scene"]["triangles"] == 2
@@ -134,7 +136,8 @@ def test_every_render_writes_its_report_and_plot(bl, blend, tmp_path):
 
 @pytest.mark.parametrize("option, value", [("--time-limit", "-1"), ("--target-error", "abc"),
                                            ("--adaptive-threshold", "2"), ("--adaptive-threshold", "nan"),
-                                           ("--adaptive-min-samples", "-4"), ("--adaptive-mode", "FAST")])
+                                           ("--adaptive-min-samples", "-4"), ("--adaptive-mode", "FAST"),
+                                           ("--shadow-estimator", "EXACT")])
 def test_bad_stop_rule_values(blend, tmp_path, option, value):
     out = tmp_path / "o.exr"
     assert_one_line_error(run_cli("render", blend, "-o", out, option, value), option)

@@ -101,12 +101,14 @@ def test_scene_settings_defaults(drt):
     assert drt_settings.adaptive_threshold == pytest.approx(0.01)
     assert drt_settings.adaptive_min_samples == 0
     assert drt_settings.adaptive_mode == "NOISE"
+    assert drt_settings.shadow_estimator == "MONTE_CARLO"
     assert drt_settings.time_limit == 0.0
     assert drt_settings.target_error == 0.0
     rna = properties.DRTSceneSettings.bl_rna.properties
     assert {i.identifier for i in rna["sampling_pattern"].enum_items} == {"GRID", "JITTERED", "SOBOL"}
     assert {i.identifier for i in rna["filter_type"].enum_items} == {"BOX", "GAUSSIAN", "BLACKMAN_HARRIS"}
     assert {i.identifier for i in rna["adaptive_mode"].enum_items} == {"NOISE", "CONTRAST"}
+    assert {i.identifier for i in rna["shadow_estimator"].enum_items} == {"MONTE_CARLO", "RATIO"}
     assert rna["samples"].hard_min == 1
     drt_settings.samples = 0
     assert drt_settings.samples == 1

@@ -1,5 +1,6 @@
 """Same settings and seed give the same image bit for bit, whatever the thread count."""
 import numpy as np
+import pytest
 
 from drt_engine.core.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
@@ -17,13 +18,15 @@ def scene():
     return SceneData(cam, meshes, [Instance(i, np.eye(4)) for i in range(3)], mats, [light], World(np.full(3, 0.05)))
 
 
-def render(threads, seed=0, pattern="SOBOL"):
-    s = RenderSettings(samples=8, seed=seed, threads=threads, sampling_pattern=pattern, passes=PASSES)
+def render(threads, seed=0, pattern="SOBOL", estimator="MONTE_CARLO"):
+    s = RenderSettings(samples=8, seed=seed, threads=threads, sampling_pattern=pattern, passes=PASSES,
+                       shadow_estimator=estimator)
     return Renderer(scene(), s).render().passes
 
 
-def test_bit_identical_for_one_and_two_threads():
-    a, b = render(1), render(2)
+@pytest.mark.parametrize("estimator", ["MONTE_CARLO", "RATIO"])
+def test_bit_identical_for_one_and_two_threads(estimator):
+    a, b = render(1, estimator=estimator), render(2, estimator=estimator)
     for name in a:
         assert np.array_equal(a[name], b[name]), name
 

@@ -7,6 +7,7 @@ import pytest
 from drt_engine.core import merge, parts, report
 from drt_engine.core.adaptive import image_error
 from drt_engine.core.errors import SettingsError
+from drt_engine.core.ratio import RATIO
 from drt_engine.core.render import Renderer
 from drt_engine.core.settings import PASSES, RenderSettings
 from test_determinism import scene
@@ -15,13 +16,13 @@ SAMPLES = 12
 RELATIVE = 1e-6
 
 
-def result_settings(pattern, start=0, end=0, seed=3):
+def result_settings(pattern, start=0, end=0, seed=3, estimator="MONTE_CARLO"):
     return RenderSettings(samples=SAMPLES, seed=seed, threads=1, sampling_pattern=pattern, passes=PASSES,
-                          sample_start=start, sample_end=end)
+                          sample_start=start, sample_end=end, shadow_estimator=estimator)
 
 
-def render_part(pattern, start=0, end=0, seed=3):
-    settings = result_settings(pattern, start, end, seed)
+def render_part(pattern, start=0, end=0, seed=3, estimator="MONTE_CARLO"):
+    settings = result_settings(pattern, start, end, seed, estimator)
     data = scene()
     renderer = Renderer(data, settings)
     result = renderer.render()
@@ -37,10 +38,12 @@ def close(a, b, scale=None):
     return np.all(np.abs(a - b) <= RELATIVE * scale + 1e-300)
 
 
-@pytest.mark.parametrize("pattern", ["SOBOL", "GRID"])
-def test_merged_ranges_equal_the_whole_render(pattern, tmp_path):
-    whole, result = render_part(pattern)
-    pieces = [render_part(pattern, a, b)[0] for a, b in ((5, 12), (0, 2), (2, 5))]
+@pytest.mark.parametrize("pattern, estimator", [("SOBOL", "MONTE_CARLO"), ("GRID", "MONTE_CARLO"),
+                                                ("SOBOL", "RATIO"), ("GRID", "RATIO")])
+def test_merged_ranges_equal_the_whole_render(pattern, estimator, tmp_path):
+    whole, result = render_part(pattern, estimator=estimator)
+    assert (RATIO in whole.sums) == (estimator == "RATIO")  # the ratio estimator's sums travel too
+    pieces = [render_part(pattern, a, b, estimator=estimator)[0] for a, b in ((5, 12), (0, 2), (2, 5))]
     for i, piece in enumerate(pieces):  # through the file: the float64 sums are stored losslessly
         parts.write(tmp_path / f"{i}.exr", piece)
     merger = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(3)], ["A", "B", "C"])
@@ -56,7 +59,7 @@ def test_merged_ranges_equal_the_whole_render(pattern, tmp_path):
     # the same error estimate as the whole render's
     assert image_error(film) == pytest.approx((result.stats["rmse"], result.stats["relmse"]), rel=RELATIVE)
     merged = merger.report(1.0)
-    assert merged["settings"] == report.report_dict(result_settings(pattern), {}, [])["settings"]
+    assert merged["settings"] == report.report_dict(result_settings(pattern, estimator=estimator), {}, [])["settings"]
     assert merged["stats"]["relmse"] == pytest.approx(result.stats["relmse"], rel=RELATIVE)
     assert merged["stats"]["rays"] == result.stats["rays"]
     assert [e["samples"] for e in merged["log"]] == [2 * 576, 5 * 576, 12 * 576]  # as ranges 0:2, 2:5, 5:12 merge
