@@ -15,8 +15,10 @@ from pathlib import Path
 from statistics import mean, median
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from bench.readme import write_block  # noqa: E402
 TIMES = ROOT / "out" / "ui" / "viewport_times.json"
-BEGIN, END = "<!-- viewport times: begin -->", "<!-- viewport times: end -->"
 
 
 def _seconds(values) -> str:
@@ -59,12 +61,7 @@ def main():
     text = table(json.loads(args.times.read_text()))
     print(text)
     if args.publish:
-        readme = ROOT / "README.md"
-        body = readme.read_text()
-        if BEGIN not in body or END not in body:
-            sys.exit("error: README.md has no viewport-times markers")
-        head, rest = body.split(BEGIN, 1)
-        readme.write_text(head + BEGIN + "\n" + text + "\n" + END + rest.split(END, 1)[1])
+        write_block("viewport-times", text)
 
 
 if __name__ == "__main__":

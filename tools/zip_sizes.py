@@ -10,7 +10,9 @@ import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-BEGIN, END = "<!-- zip sizes: begin -->", "<!-- zip sizes: end -->"
+sys.path.insert(0, str(ROOT))
+
+from bench.readme import write_block  # noqa: E402
 NOTES = {"macos_arm64": " (PyPI has no embreex 4.4 wheel for Intel Macs)"}
 
 
@@ -36,12 +38,7 @@ def main():
     text = table(args.dist)
     print(text)
     if args.publish:
-        readme = ROOT / "README.md"
-        body = readme.read_text()
-        if BEGIN not in body or END not in body:
-            sys.exit("error: README.md has no zip-size markers")
-        head, rest = body.split(BEGIN, 1)
-        readme.write_text(head + BEGIN + "\n" + text + "\n" + END + rest.split(END, 1)[1])
+        write_block("zip-sizes", text)
 
 
 if __name__ == "__main__":
