@@ -69,6 +69,13 @@ def _shared_panels() -> list[type]:
     return list(dict.fromkeys(panels))
 
 
+def split(layout):
+    """``layout`` in Blender's property-split style (labels left, no keyframe dots)."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    return layout
+
+
 class DRTButtonsPanel:
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
@@ -79,14 +86,17 @@ class DRTButtonsPanel:
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
 
+    def split_layout(self):
+        """The panel's layout in Blender's property-split style (labels left, no keyframe dots)."""
+        layout = split(self.layout)
+        return layout
+
 
 class DRT_PT_sampling(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Sampling"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         drt = context.scene.drt
         col = layout.column(align=True)
         col.prop(drt, "preview_samples")
@@ -107,9 +117,7 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
         self.layout.prop(context.scene.drt, "use_adaptive_sampling", text="")
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         drt = context.scene.drt
         layout.active = drt.use_adaptive_sampling
         col = layout.column()
@@ -126,9 +134,7 @@ class DRT_PT_sampling_range(DRTButtonsPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         drt = context.scene.drt
         col = layout.column()
         col.prop(drt, "sample_offset", text="Offset")
@@ -139,9 +145,7 @@ class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         drt = context.scene.drt
         col = layout.column()
         col.prop(drt, "max_depth")
@@ -153,9 +157,7 @@ class DRT_PT_film(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Film"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         scene = context.scene
         col = layout.column()
         col.prop(scene.drt, "filter_type")
@@ -171,9 +173,7 @@ class DRT_PT_motion_blur(DRTButtonsPanel, bpy.types.Panel):
         self.layout.prop(context.scene.render, "use_motion_blur", text="")
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         render = context.scene.render
         layout.active = render.use_motion_blur
         col = layout.column()
@@ -187,9 +187,7 @@ class DRT_PT_performance(DRTButtonsPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         layout.prop(context.scene.drt, "threads")
 
 
@@ -198,9 +196,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
     bl_context = "view_layer"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = split(self.layout)
         view_layer = context.view_layer
         col = layout.column(heading="Data", align=True)
         col.prop(view_layer, "use_pass_z")
