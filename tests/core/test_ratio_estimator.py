@@ -1,12 +1,9 @@
-"""The ratio estimator (shadow_estimator RATIO, core.ratio) on the soft-shadow scene of bench/soft_shadow.py.
+"""The ratio estimator (shadow_estimator RATIO, core.ratio) on the soft-shadow scene (scenes.soft_shadow_scene).
 
 Exact where the light is wholly in view; no bias against a converged Monte Carlo reference
 beyond the noise (image mean and 4x4 blocks); an error estimate (Noise pass, error log) that
 tracks the true error as tests/blender/test_adaptive_calibration.py asks of Monte Carlo.
 """
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -16,9 +13,9 @@ from drt_engine.core.ratio import FILM_CHANNELS, NDU_CHANNELS, RATIO
 from drt_engine.core.render import Renderer
 from drt_engine.core.scene import Light
 from drt_engine.core.settings import RenderSettings
+import scenes
 from scenes import translation
 
-ROOT = Path(__file__).resolve().parents[2]
 WIDTH = 48
 REFERENCE_SAMPLES = 1024
 BIAS_SAMPLES, BIAS_SEEDS = 16, 8
@@ -26,10 +23,7 @@ CAP, SEEDS, FACTOR, RELMSE_FROM = 64, range(4), 1.5, 16  # as the Blender calibr
 
 
 def soft_shadow_scene(width):
-    spec = importlib.util.spec_from_file_location("soft_shadow", ROOT / "bench" / "soft_shadow.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    scene, base = module.soft_shadow_scene(width)
+    scene, base = scenes.soft_shadow_scene(width)
     return scene, dict(base, threads=1)
 
 
