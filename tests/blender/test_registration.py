@@ -147,6 +147,7 @@ def test_settings_from_scene(drt):
         filter_type="GAUSSIAN", filter_size=2.25, passes=("Combined", "Depth", "Env", "Noise"),
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,
         adaptive_mode="CONTRAST", time_limit=12.0, target_error=pytest.approx(0.02),
+        weighted_denoising_normal=bpy.app.version >= (5, 2, 0),  # as this Blender's Cycles writes it
     )
     view_layer.use_pass_z = view_layer.use_pass_environment = view_layer.drt.use_pass_noise = False
     assert properties.settings_from_scene(scene, view_layer).passes == ("Combined",)
