@@ -393,7 +393,7 @@ class Integrator:
             stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
             tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
             out.append(ShadowRays(hits.path[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel],
-                                  diffuse[sel] if by_ratio else np.zeros((len(sel), 3))))
+                                  diffuse[sel] if by_ratio else np.zeros((len(sel), 3)) if self.ratio else None))
         return out
 
     @staticmethod

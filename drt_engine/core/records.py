@@ -15,9 +15,13 @@ def _take(record, rows):
 
 
 def _concat(records: list):
-    """One record of the rows of ``records`` (of one type), in order."""
-    return type(records[0])(**{f.name: np.concatenate([getattr(r, f.name) for r in records])
-                               for f in fields(records[0])})
+    """One record of the rows of ``records`` (of one type), in order; a field that none of
+    them has (None: nobody asked for it) stays None."""
+    def joined(name):
+        parts = [getattr(r, name) for r in records]
+        return None if parts[0] is None else np.concatenate(parts)
+
+    return type(records[0])(**{f.name: joined(f.name) for f in fields(records[0])})
 
 
 @dataclass
@@ -119,7 +123,7 @@ class ShadowRays:
     dirs: np.ndarray
     tmax: np.ndarray
     contrib: np.ndarray
-    diffuse: np.ndarray
+    diffuse: np.ndarray | None  # None when no light of the render is the ratio estimator's
 
     def __len__(self):
         return len(self.path)
