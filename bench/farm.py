@@ -34,8 +34,8 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from drt_engine.core import parts  # noqa: E402
-from drt_engine.core.film import Film  # noqa: E402
+from drt_engine.core.film import parts  # noqa: E402
+from drt_engine.core.film.film import Film  # noqa: E402
 
 SCENE = ROOT / "sample_scenes" / "cornell_box.blend"
 MARK_BEGIN, MARK_END = "<!-- farm: begin -->", "<!-- farm: end -->"

@@ -28,8 +28,8 @@ def measure() -> dict:
 
     import drt_engine
     from drt_engine.blender import engine as engine_module
-    from drt_engine.core import prepared as prepared_module
-    from drt_engine.core import render as render_module
+    from drt_engine.core.render import prepared as prepared_module
+    from drt_engine.core.render import render as render_module
 
     drt_engine.register()
     bpy.ops.wm.open_mainfile(filepath=str(ROOT / "sample_scenes" / "cornell_box.blend"), load_ui=False)

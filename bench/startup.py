@@ -22,8 +22,8 @@ SCRIPT = """
 import sys, time
 sys.path[:0] = [{root!r}, {root!r} + '/bench']
 t0 = time.perf_counter()
-from drt_engine.core import jit
-from drt_engine.core.render import Renderer
+from drt_engine.core.base import jit
+from drt_engine.core.render.render import Renderer
 imported = time.perf_counter() - t0
 first_run = jit.first_run()
 import drt_engine

@@ -33,16 +33,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402
 import numpy as np  # noqa: E402
-
-import drt_engine  # noqa: E402
-from drt_engine.core import camera as camera_rays  # noqa: E402
-from drt_engine.core.prepared import PreparedScene  # noqa: E402
-from drt_engine.core.render import WAVE, Renderer  # noqa: E402
 from readme import write_block  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 from startup import describe, measure  # noqa: E402
+
+import drt_engine  # noqa: E402
+from drt_engine.core.geometry import camera as camera_rays  # noqa: E402
+from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
+from drt_engine.core.render.render import WAVE, Renderer  # noqa: E402
 
 TARGET_RATIO = 0.35
 TARGET_SPEEDUP = 1.6
@@ -126,7 +125,7 @@ import resource, sys
 sys.path[:0] = [{root!r}, {root!r} + '/bench']
 sys.argv = ["x"]
 from scenes import load, settings
-from drt_engine.core.render import Renderer
+from drt_engine.core.render.render import Renderer
 import drt_engine
 drt_engine.register()
 scene, data = load({name!r}, 1920, 1080)

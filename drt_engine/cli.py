@@ -14,8 +14,9 @@ import time
 from pathlib import Path
 
 from .cli_progress import ProgressDisplay
-from .core import merge, parts, report
 from .core.errors import DRTError
+from .core.film import parts
+from .core.render import merge, report
 from .core.settings import ADAPTIVE_MODES, SHADOW_ESTIMATORS
 
 EXIT_ERROR = 1

@@ -15,8 +15,15 @@ import re
 import time
 from pathlib import Path
 
-from .cli import CLIError, _open_scene, check_splittable, done_line, write_merged_report, write_output
-from .core import merge, report
+from .cli import (
+    CLIError,
+    _open_scene,
+    check_splittable,
+    done_line,
+    write_merged_report,
+    write_output,
+)
+from .core.render import merge, report
 
 LOCALHOST = "127.0.0.1"
 

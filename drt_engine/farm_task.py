@@ -22,7 +22,7 @@ from pathlib import Path
 
 import embreex  # noqa: F401  (a worker without it must fail the check, not the first task)
 
-from .core import parts
+from .core.film import parts
 
 ROOT = Path(__file__).resolve().parents[1]
 _files_lock = threading.Lock()

@@ -1,7 +1,7 @@
 """Everything that touches Blender: settings, panels, the RenderEngine and the scene export."""
 import bpy
 
-from ..core import jit
+from ..core.base import jit
 from . import engine, properties, ui
 
 _modules = (properties, engine, ui)

@@ -14,8 +14,9 @@ import weakref
 import bpy
 import numpy as np
 
-from ..core import jit, report
+from ..core.base import jit
 from ..core.errors import DRTError, RenderCancelled
+from ..core.render import report
 from . import part_files
 from .properties import enabled_passes, pass_layout, settings_from_scene
 
@@ -71,7 +72,7 @@ so the next frame reuses the Embree scenes, lights and materials when only the c
 def prepared_for(scene_data, layer: str, keep: bool):
     """(scene data, prepared scene or None) for a final render: the kept prepared scene when the
     content is the same, else None (the Renderer prepares it), kept for the next frame if ``keep``."""
-    from ..core.prepared import PreparedScene, content_key
+    from ..core.render.prepared import PreparedScene, content_key
 
     if not keep:
         persistent.pop(layer, None)
@@ -183,7 +184,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, _one_line(f"DRT internal error: {type(error).__name__}: {error}"))
 
     def _render(self, depsgraph):
-        from ..core.render import Renderer
+        from ..core.render.render import Renderer
         from .export import export_scene
 
         scene = depsgraph.scene

@@ -12,8 +12,8 @@ import os
 
 import bpy
 
-from ..core import parts
 from ..core.errors import DRTError
+from ..core.film import parts
 
 collect = False
 """True: keep every final render's part in ``last_parts`` instead of writing part files."""

@@ -5,7 +5,13 @@ transparency, filter width and motion blur are read from ``scene.render`` so DRT
 Cycles share one set of knobs.
 """
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import (
+    BoolProperty,
+    EnumProperty,
+    FloatProperty,
+    IntProperty,
+    PointerProperty,
+)
 
 from ..core.settings import PASS_CHANNELS, PASSES, RenderSettings
 

@@ -93,7 +93,7 @@ class ViewportRender:
         scene's updated for the edit (core.prepared.PreparedScene.update rebuilds only what
         changed), else a new one (under a lock: a stale worker and a new one never prepare the
         same scene twice)."""
-        from ..core.prepared import PreparedScene
+        from ..core.render.prepared import PreparedScene
 
         with self._prepare_lock:
             if self._prepared is None:
@@ -103,7 +103,7 @@ class ViewportRender:
             return self._prepared[1]
 
     def _run(self, scene_data, cameras, settings, stop: threading.Event) -> None:
-        from ..core.render import Renderer
+        from ..core.render.render import Renderer
         from .engine import done_line, stats_line
 
         try:

@@ -60,7 +60,6 @@ from typing import Callable
 import bpy
 import numpy as np
 import pytest
-
 import render_helpers as rh
 from datablocks import new_material, new_world
 

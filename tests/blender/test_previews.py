@@ -4,7 +4,7 @@ import bpy
 import numpy as np
 
 from drt_engine.blender import engine as engine_module
-from drt_engine.core import prepared as prepared_module
+from drt_engine.core.render import prepared as prepared_module
 
 
 def _render_previews(materials):

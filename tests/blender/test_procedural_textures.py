@@ -9,9 +9,8 @@ is checked the same way on an emissive sphere.
 """
 from __future__ import annotations
 
-import pytest
-
 import procedural_scenes as ps
+import pytest
 import render_helpers as rh
 from export_helpers import render_export
 

@@ -11,13 +11,13 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-
-from drt_engine.core.render import Renderer
-from drt_engine.core.settings import RenderSettings
-from drt_engine.core.textures import MAGENTA, srgb_to_linear
 import render_helpers as rh
 from datablocks import new_material, new_world
 from export_helpers import add_object, empty_scene, render_export
+
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.settings import RenderSettings
+from drt_engine.core.shading.textures import MAGENTA, srgb_to_linear
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 from textured_scenes import write_image  # noqa: E402
@@ -134,7 +134,7 @@ def test_reading_a_file_without_openimageio_is_magenta_with_a_reason(monkeypatch
     import builtins
 
     from drt_engine.core.scene import TextureImage
-    from drt_engine.core.textures import read_pixels
+    from drt_engine.core.shading.textures import read_pixels
 
     real_import = builtins.__import__
 
@@ -245,8 +245,8 @@ def test_environment_texture_world_with_mapping_and_strength(tmp_path):
     data = render_export(scene)
     assert data.world.program is not None and not data.world.visible_camera and not data.world.visible_glossy
     assert data.world.visible_diffuse and data.world.visible_transmission
-    from drt_engine.core.environment import Environment
-    from drt_engine.core.textures import Texture, equirect_uv
+    from drt_engine.core.lights.environment import Environment
+    from drt_engine.core.shading.textures import Texture, equirect_uv
     environment = Environment(data.world, [Texture(i) for i in data.images])
     d = np.array([[1.0, 0.2, 0.3], [-0.3, -0.9, -0.2]])
     d /= np.linalg.norm(d, axis=1, keepdims=True)

@@ -10,8 +10,8 @@ import pytest
 from drt_engine.blender.export import export_scene
 from drt_engine.blender.export.geometry import MeshCache
 from drt_engine.blender.export.viewport import edited_geometry
-from drt_engine.core.prepared import PreparedScene
-from drt_engine.core.render import Renderer
+from drt_engine.core.render.prepared import PreparedScene
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import RenderSettings
 
 

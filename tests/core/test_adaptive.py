@@ -9,13 +9,21 @@ import time
 
 import numpy as np
 import pytest
-
-from drt_engine.core import adaptive
-from drt_engine.core.film import Film
-from drt_engine.core.render import Renderer
-from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
-from drt_engine.core.settings import RenderSettings
 from scenes import translation
+
+from drt_engine.core.film.film import Film
+from drt_engine.core.render import adaptive
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import (
+    Camera,
+    Closure,
+    Instance,
+    Light,
+    Material,
+    Mesh,
+    SceneData,
+)
+from drt_engine.core.settings import RenderSettings
 
 RES = 24
 EMISSION = 0.5

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from drt_engine.core import microfacet as mf
-from drt_engine.core.bsdf import MaterialShader
+from drt_engine.core.bsdf import microfacet as mf
+from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Closure, Material
 
 RNG = np.random.default_rng(7)
@@ -156,7 +156,7 @@ def test_glass_glossy_colour_is_its_fresnel_reflectance():
 def test_roughness_grid_tables_match_exact_tables(metallic):
     """Shaders built per texture value interpolate their albedo tables in roughness; the lobe
     weights they give stay within 0.5% of the exact tables' for view cosines above 0.1."""
-    from drt_engine.core.bsdf import Tables
+    from drt_engine.core.bsdf.shader import Tables
 
     mu = np.linspace(0.1, 1.0, 40)
     for r in (0.03, 0.11, 0.4):

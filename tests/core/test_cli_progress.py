@@ -4,7 +4,7 @@ import io
 import pytest
 
 from drt_engine.cli_progress import ProgressDisplay, progress_text, time_left
-from drt_engine.core.render import ProgressUpdate
+from drt_engine.core.render.render import ProgressUpdate
 
 
 class Terminal(io.StringIO):

@@ -1,11 +1,19 @@
 """Same settings and seed give the same image bit for bit, whatever the thread count."""
 import numpy as np
 import pytest
-
-from drt_engine.core.render import Renderer
-from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
-from drt_engine.core.settings import PASSES, RenderSettings
 from scenes import look_at, plane, uv_sphere
+
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import (
+    Camera,
+    Closure,
+    Instance,
+    Light,
+    Material,
+    SceneData,
+    World,
+)
+from drt_engine.core.settings import PASSES, RenderSettings
 
 
 def scene():
@@ -43,7 +51,7 @@ def test_another_seed_gives_another_image():
 
 def test_bit_identical_when_waves_are_split_over_threads(monkeypatch):
     """Waves this small are traced whole; with a tiny piece size each is split across the threads."""
-    from drt_engine.core import render as render_module
+    from drt_engine.core.render import render as render_module
 
     monkeypatch.setattr(render_module, "_MIN_PIECE", 64)
     one, two, three = render(1), render(2), render(3)
@@ -52,8 +60,9 @@ def test_bit_identical_when_waves_are_split_over_threads(monkeypatch):
 
 
 def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
-    from drt_engine.core.scene import TextureImage
     from textured_scenes import environment_world, image_program
+
+    from drt_engine.core.scene import TextureImage
 
     base = scene()
     rng = np.random.default_rng(4)

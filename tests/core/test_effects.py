@@ -1,11 +1,11 @@
 """Depth of field and motion blur measured against their geometric predictions."""
 import numpy as np
 import pytest
+from scenes import plane, translation
 
-from drt_engine.core.render import Renderer
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, translation
 
 GLOW = Material("glow", [Closure("EMISSION", emission=(1.0, 1.0, 1.0))])
 
@@ -49,8 +49,8 @@ def test_circle_of_confusion_radius(z, focus):
 @pytest.mark.parametrize("blades, rotation", [(6, 0.0), (5, 0.3)])
 def test_blades_give_a_uniformly_filled_regular_polygon(blades, rotation):
     """Aperture samples fill the polygon (corners at the aperture radius) uniformly."""
-    from drt_engine.core.camera import aperture_point
-    from drt_engine.core.sampling import Sampler
+    from drt_engine.core.geometry.camera import aperture_point
+    from drt_engine.core.sampling.sampler import Sampler
     cam = Camera(np.eye(4)[None], (-1, 1, -1, 1), (4, 4), aperture_radius=2.0, blades=blades,
                  blade_rotation=rotation)
     n = 1 << 14

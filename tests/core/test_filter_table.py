@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from drt_engine.core.film import PixelFilter
+from drt_engine.core.film.film import PixelFilter
 
 
 @pytest.mark.parametrize("kind", ["BOX", "GAUSSIAN", "BLACKMAN_HARRIS"])

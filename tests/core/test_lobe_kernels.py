@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from drt_engine.core import lobe_kernels as lk
-from drt_engine.core import microfacet as mf
-from drt_engine.core.bsdf import MaterialShader
+from drt_engine.core.bsdf import lobes as lk
+from drt_engine.core.bsdf import microfacet as mf
+from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Closure, Material
 
 RNG = np.random.default_rng(5)

@@ -6,11 +6,11 @@ found it; a perfect mirror shows light bodies at the radiance Cycles gives them.
 """
 import numpy as np
 import pytest
+from scenes import plane, top_camera, translation
 
-from drt_engine.core.render import Renderer
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, top_camera, translation
 
 L = 2.0
 
@@ -84,7 +84,7 @@ def _tiled_lights(n_side, size=4000.0, height=1.5):
 @pytest.mark.parametrize("roughness", [0.0, 0.3])
 def test_lights_chosen_by_contribution_stay_unbiased_under_mis(monkeypatch, roughness):
     """The huge sky split into 25 tiles and only 2 tiles sampled per point: still L."""
-    from drt_engine.core import lights as lights_module
+    from drt_engine.core.lights import collection as lights_module
     monkeypatch.setattr(lights_module, "SELECT_ABOVE", 4)
     monkeypatch.setattr(lights_module, "SELECT_SLOTS", 2)
     scene = glossy_plane_scene(roughness, _tiled_lights(5))
@@ -93,7 +93,7 @@ def test_lights_chosen_by_contribution_stay_unbiased_under_mis(monkeypatch, roug
 
 
 def test_lights_chosen_by_contribution_light_a_diffuse_plane_like_all_lights(monkeypatch):
-    from drt_engine.core import lights as lights_module
+    from drt_engine.core.lights import collection as lights_module
     rng = np.random.default_rng(5)
     lights = [Light("POINT", translation(*rng.uniform([-3, -3, 0.5], [3, 3, 2])), intensity=rng.uniform(0.5, 2, 3))
               for _ in range(12)]

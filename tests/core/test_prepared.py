@@ -4,14 +4,14 @@ import dataclasses
 
 import numpy as np
 import pytest
-
-from drt_engine.core import dims as D
-from drt_engine.core.prepared import PreparedScene
-from drt_engine.core.render import Renderer
-from drt_engine.core.scene import Camera, Light
-from drt_engine.core.settings import PASSES, RenderSettings
 from scenes import look_at, translation
 from test_determinism import scene
+
+from drt_engine.core.render.prepared import PreparedScene
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.sampling import dims as D
+from drt_engine.core.scene import Camera, Light
+from drt_engine.core.settings import PASSES, RenderSettings
 
 
 def camera(eye):
@@ -56,7 +56,7 @@ def test_adding_a_light_leaves_every_other_strategy_dimension_and_the_path_dimen
 
 
 def test_the_content_key_ignores_the_camera_and_sees_any_other_change():
-    from drt_engine.core.prepared import content_key
+    from drt_engine.core.render.prepared import content_key
 
     base = scene()
     key = content_key(base)

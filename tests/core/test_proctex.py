@@ -14,9 +14,9 @@ import struct
 import numpy as np
 import pytest
 
-from drt_engine.core import proctex
-from drt_engine.core.proctex import hash as h
-from drt_engine.core.proctex.noise import snoise
+from drt_engine.core.shading import proctex
+from drt_engine.core.shading.proctex import hash as h
+from drt_engine.core.shading.proctex.noise import snoise
 
 N = 400
 
@@ -174,7 +174,7 @@ def test_brick_mortar_and_tint_by_hand():
 
 
 def test_box_weights_pick_a_face_and_blend_to_one():
-    from drt_engine.core.shadernodes import box_weights
+    from drt_engine.core.shading.nodes import box_weights
     faces = np.array([[0.9, 0.1, 0.2], [-0.1, -0.8, 0.3], [0.2, 0.1, -0.7]])
     np.testing.assert_array_equal(box_weights(faces, 0.0), np.eye(3))
     centre = np.full((1, 3), 1 / np.sqrt(3))
@@ -192,7 +192,7 @@ def test_box_weights_pick_a_face_and_blend_to_one():
 def test_shader_programs_evaluate_the_texture_ops():
     """A program of coordinate -> Voronoi (as the export compiles a node) gives the kernel's values."""
     from drt_engine.core.scene import Program
-    from drt_engine.core.shadernodes import DirectionContext, Evaluator
+    from drt_engine.core.shading.nodes import DirectionContext, Evaluator
     dirs = np.random.default_rng(8).normal(size=(50, 3))
     program = Program()
     coord = program.add("coord", name="generated")

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from drt_engine.core import camera as camera_rays
-from drt_engine.core.accel import Geometry
-from drt_engine.core.motion import Motion, invert_frame
-from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 from scenes import plane, translation, uv_sphere
+
+from drt_engine.core.geometry import camera as camera_rays
+from drt_engine.core.geometry.accel import Geometry
+from drt_engine.core.geometry.motion import Motion, invert_frame
+from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -70,7 +70,7 @@ def test_rigid_hits_lie_on_the_triangle_where_it_was_at_the_rays_time():
     # the offset clears the float32 error of the hit, and spawned origins leave on the ray's side
     scale = geo.offset_scale(hits.prim, pos)
     assert (scale > 1e-7).all() and (scale < 1e-3).all()
-    from drt_engine.core.accel import spawn
+    from drt_engine.core.geometry.accel import spawn
     up = spawn(pos, ng, -dirs, scale)
     assert np.allclose(up - pos, ng * scale[:, None])
 
@@ -113,9 +113,9 @@ def test_lens_rays_of_one_image_point_meet_on_the_plane_in_focus():
 
 _SCRIPT = """
 import numpy as np
-from drt_engine.core import camera as camera_rays
-from drt_engine.core.film import PixelFilter
-from drt_engine.core.sampling import Sampler
+from drt_engine.core.geometry import camera as camera_rays
+from drt_engine.core.film.film import PixelFilter
+from drt_engine.core.sampling.sampler import Sampler
 from drt_engine.core.scene import Camera
 rng = np.random.default_rng(5)
 px, sm = rng.integers(0, 1 << 20, 300), rng.integers(0, 64, 300)
@@ -129,7 +129,7 @@ cam = Camera(m, (-0.4, 0.4, -0.3, 0.3), (40, 30), aperture_radius=0.1, blades=5)
 r = camera_rays.generate(cam, rng.random(300) * 40, rng.random(300) * 30, rng.random((300, 2)), rng.random(300))
 out["camera"] = np.concatenate([r.origins.ravel(), r.directions.ravel(), r.tmax])
 import sys; sys.path.insert(0, "tests/core")
-from drt_engine.core.accel import Geometry
+from drt_engine.core.geometry.accel import Geometry
 from drt_engine.core.scene import Closure, Instance, Material, SceneData
 from scenes import plane, uv_sphere
 scene = SceneData(camera=None, meshes=[uv_sphere(1.0, segments=8, rings=6), plane(4.0, z=-1.0)],

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from drt_engine.core.sampling import Sampler
+from drt_engine.core.sampling.sampler import Sampler
 
 
 def cells_hit(u, n):

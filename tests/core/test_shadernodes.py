@@ -2,7 +2,12 @@
 import numpy as np
 
 from drt_engine.core.scene import Program
-from drt_engine.core.shadernodes import DirectionContext, Evaluator, hsv_to_rgb, rgb_to_hsv
+from drt_engine.core.shading.nodes import (
+    DirectionContext,
+    Evaluator,
+    hsv_to_rgb,
+    rgb_to_hsv,
+)
 
 N = 5
 

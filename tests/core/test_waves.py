@@ -1,7 +1,7 @@
 """Waves: bounded in size, every requested (pixel, sample) exactly once, sample-major order."""
 import numpy as np
 
-from drt_engine.core import driver
+from drt_engine.core.render import driver
 
 
 def test_waves_are_bounded_complete_and_sample_major(monkeypatch):

@@ -4,9 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
-
 import blender_scenes as bs
+import numpy as np
 from core_cases import Camera, Closure, Instance, Material, SceneData, render
 from scenes import plane, translation
 
@@ -96,7 +95,7 @@ def test_four_by_four_through_blender(drt, tmp_path):
 BIG = """
 import resource, sys, numpy as np
 sys.path[:0] = [{root!r}, {core!r}]
-from drt_engine.core.render import Renderer
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 from drt_engine.core.settings import RenderSettings
 from scenes import plane, translation
@@ -153,7 +152,7 @@ def test_clip_start_1e_6_and_clip_end_1e9(drt, tmp_path):
 def test_focus_distance_zero_gives_finite_rays():
     """Focus 0 with an open aperture: clamped at 1e-5 as Cycles does (before, every lens ray left
     in the lens plane and started at an infinite distance)."""
-    from drt_engine.core import camera as camera_rays
+    from drt_engine.core.geometry import camera as camera_rays
 
     cam = Camera(translation(0, 0, 5)[None], (-0.36, 0.36, -0.36, 0.36), (4, 4), aperture_radius=0.01,
                  focus_distance=0.0)

@@ -12,7 +12,6 @@ import time
 import numpy as np
 import OpenImageIO as oiio
 import pytest
-
 from blender_env import REPO, check_output
 
 UI_OUT = REPO / "out" / "ui"

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.shadernodes import LUMINANCE
+from ...core.base.colour import LUMINANCE
 
 CONSTANT_NODES = ("ShaderNodeRGB", "ShaderNodeValue")
 

@@ -10,11 +10,12 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-from ...core import proctex
-from ...core import shadernodes as sn
+from ...core.base.colour import LUMINANCE
 from ...core.scene import Program, TextureImage
-from ...core.textures import MAGENTA, openimageio_available
-from .nodes import LUMINANCE, Issues, follow
+from ...core.shading import nodes as sn
+from ...core.shading import proctex
+from ...core.shading.textures import MAGENTA, openimageio_available
+from .nodes import Issues, follow
 
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
                      "Generic Data")

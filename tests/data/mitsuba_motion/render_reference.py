@@ -17,8 +17,8 @@ which the original ``*_ref_rgb_var.exr`` files show.)
 import sys
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import mitsuba as mi
+import numpy as np
 
 mi.set_variant("scalar_rgb")
 

@@ -1,0 +1,109 @@
+"""Compiled kernels: the one decorator for DRT's per-ray loops, and where their machine code lives.
+
+Every kernel is a Numba ``njit`` function compiled on first call and cached on disk, so only
+the first render after an install pays for compiling. Kernels release the GIL and run
+serially: the renderer splits a wave into one piece per thread itself (pieces in a thread
+pool, Embree calls between them), so no Numba threading layer is ever started and two renders
+in one process (viewport during F12, a material preview) cannot contend for one.
+
+Numba checks a cached kernel against its own source file only, not against the files of the
+kernels it calls: a kernel cached before ``microfacet.py`` changed would be loaded stale. So
+the cache lives in a folder named by a fingerprint of all of DRT's core sources (every file
+under ``core/``, subpackages included), Numba and
+Python (``_fingerprint``); a changed source means a new folder, and older folders are removed
+once the new one is complete.
+
+The cache's base folder must be chosen before the modules that define kernels are imported:
+the Blender layer calls ``use_cache_dir`` with the extension's user folder; the CLI and the
+tests get the user's cache folder (``default_cache_dir``), and ``NUMBA_CACHE_DIR`` overrides
+both. A read-only package folder is never written to.
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import sys
+from pathlib import Path
+
+import numba
+
+_STAMP = "compiled"  # written into a cache folder once a render has filled it
+
+
+def default_cache_dir() -> Path:
+    """The user's cache folder for DRT's kernels (XDG on Linux, Library/Caches, LOCALAPPDATA)."""
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Caches"
+    else:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return base / "drt" / "kernels"
+
+
+def _fingerprint() -> str:
+    """What decides whether cached kernels can be loaded: DRT's core sources, Numba, Python."""
+    h = hashlib.sha256(f"{numba.__version__} {sys.version_info[:2]} {sys.platform}".encode())
+    core = Path(__file__).resolve().parents[1]
+    for source in sorted(core.rglob("*.py")):
+        h.update(str(source.relative_to(core)).encode())
+        h.update(source.read_bytes())
+    return f"py{sys.version_info[0]}{sys.version_info[1]}-{h.hexdigest()[:16]}"
+
+
+_FINGERPRINT = _fingerprint()
+_base = Path(os.environ.get("NUMBA_CACHE_DIR") or default_cache_dir())
+
+
+def _apply() -> None:
+    numba.config.CACHE_DIR = str(_base / _FINGERPRINT)
+
+
+def use_cache_dir(path) -> None:
+    """Cache compiled kernels under ``path``/kernels (call before kernel modules are imported)."""
+    global _base
+    _base = Path(path) / "kernels"
+    _apply()
+
+
+def cache_dir() -> Path:
+    return Path(numba.config.CACHE_DIR)
+
+
+_apply()
+
+
+def kernel(fn=None, **options):
+    """``@kernel``: compile ``fn`` with Numba, cached on disk, GIL released, NumPy's float rules.
+
+    ``error_model="numpy"`` makes a division by zero give inf/nan as NumPy does (no Python
+    exception from inside a loop, and no check per division); kernels guard their divisions.
+    """
+    opts = {"cache": True, "nogil": True, "error_model": "numpy"}
+    opts.update(options)
+    if fn is None:
+        return lambda f: numba.njit(**opts)(f)
+    return numba.njit(**opts)(fn)
+
+
+def first_run() -> bool:
+    """True until a render has compiled this version's kernels into the cache folder."""
+    return not (cache_dir() / _STAMP).exists()
+
+
+def mark_compiled() -> None:
+    """Record that this version's kernels are in the cache and remove the folders of older versions
+    for the same Python (other Pythons' folders belong to other Blenders or venvs and stay; best
+    effort: a read-only cache folder only means the message shows again)."""
+    try:
+        folder = cache_dir()
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / _STAMP).touch()
+        for old in folder.parent.iterdir():
+            same_python = re.fullmatch(re.escape(_FINGERPRINT.split("-")[0]) + r"-[0-9a-f]{16}", old.name)
+            if old != folder and old.is_dir() and same_python:
+                shutil.rmtree(old, ignore_errors=True)
+    except OSError:
+        pass

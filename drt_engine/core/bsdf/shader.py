@@ -1,0 +1,532 @@
+"""Materials as sums of lobes: Lambert, GGX reflection, dielectric (glass), transparent.
+
+A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
+with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
+the layer below weighted by one minus the albedo of the layer above. Energy terms
+(directional albedo, multiple-scattering compensation) are tabulated per material.
+
+Directions are in the local shading frame with ``wo`` always in the upper hemisphere
+(the caller flips the frame to the side the ray arrived from; glass inverts its IOR).
+The diffuse lobe is evaluated for light sampling only: as in Cook's distribution ray
+tracing (and Cycles with diffuse bounces 0) no rays continue from it.
+
+Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
+sampling, pdf, lobe choice, pass colours) is ``lobe_kernels``, compiled, over the flat
+arrays ``MaterialShader`` packs the lobes into.
+"""
+from __future__ import annotations
+
+import copy
+import threading
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..scene import Closure, Material
+from . import lobes as lk
+from . import microfacet as mf
+
+
+@dataclass(eq=False)
+class Lobe:
+    """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
+    arrays of ``lobe_kernels``."""
+    kind: str  # "diffuse" | "reflect" | "glass" | "transparent"
+    weight: np.ndarray  # constant RGB weight
+    layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
+    albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
+    alpha: float = 0.0
+    fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
+    fresnel_kind: int = lk.F_TINT  # the same Fresnel for the kernels (lobe_kernels.fresnel)
+    fresnel_eta: float = 1.0
+    f0: np.ndarray = field(default_factory=lambda: np.ones(3))  # Fresnel colour: tint or metal f0
+    eta: float = 1.5  # glass: n_inside / n_outside
+    tint_r: np.ndarray = field(default_factory=lambda: np.ones(3))
+    tint_t: np.ndarray = field(default_factory=lambda: np.ones(3))
+    refract_only: bool = False
+    table: tuple | None = None  # (mu, E rgb): total albedo of the lobe, for lobe selection
+    layer_table: tuple | None = None  # (mu, E rgb): albedo as Cycles estimates it for layering and GlossCol
+    ms: tuple | None = None  # (mu, factor, E_avg): multiple-scattering compensation of f
+    f82: np.ndarray | None = None  # metal: F82 tint
+    source: int = 0  # index of the closure the lobe comes from
+    role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent"
+    affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
+
+    @property
+    def delta(self) -> bool:
+        """Sampled as a delta distribution: smooth, or an interface that barely bends light.
+
+        Refraction spreads directions by about alpha·|eta - 1|: at IOR 1 a rough glass is
+        no interface at all (the Walter model's half vector degenerates there), so it
+        becomes a straight pass-through whatever its roughness.
+        """
+        if self.kind == "transparent":
+            return True
+        if self.kind == "glass" and self.alpha_t < mf.DELTA_ALPHA:
+            return True
+        return self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA
+
+    @property
+    def alpha_t(self) -> float:
+        """Spread of the refracted directions of a glass lobe (alpha scaled by the bend)."""
+        return self.alpha * min(1.0, abs(self.eta - 1.0))
+
+
+def _alpha(roughness: float) -> float:
+    return float(np.clip(roughness, 0.0, 1.0)) ** 2
+
+
+def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
+    return lambda c: mf.fresnel_dielectric(c, eta)[:, None] * tint
+
+
+ROUGHNESS_GRID = 32
+"""Shaders built per texel value tabulate their albedos at roughness (k / ROUGHNESS_GRID)^2
+(dense where albedos change fast; cached across shaders) and interpolate in between; below
+the second level (roughness 0.004) they are exact. Measured: lobe weights (layering and
+multiple-scattering factors) within 0.1% of the exact tables' for view cosines above 0.2,
+0.5% above 0.1 and 1.7% at 0.02 (test_bsdf)."""
+_GRID_TABLES: dict = {}
+_EXACT_TABLES: dict = {}
+_EXACT_TABLES_MAX = 512
+_EXACT_LOCK = threading.Lock()
+"""Exact tables by (Fresnel key, alpha), kept across shaders and renders (a material preview
+or a re-render builds the same lobes again; computing a table cost about 50 ms, measured in
+bench/preview_times.py); read-only, oldest dropped first past the cap (each is a few kB)."""
+
+
+class Tables:
+    """Directional albedo tables of reflect lobes: exact, or interpolated in roughness from a
+    cached grid (``grid``), which makes a shader per texture value cheap to build."""
+
+    def __init__(self, grid: bool = False):
+        self.grid = grid
+
+    def albedo(self, alpha: float, fresnel, key) -> tuple[np.ndarray, np.ndarray]:
+        s = max(float(alpha), 0.0) ** 0.25 * ROUGHNESS_GRID  # sqrt(roughness) in grid units
+        if not self.grid or s < 2.0:
+            return _exact_table(key, float(alpha), fresnel)
+        k = min(int(np.floor(s)), ROUGHNESS_GRID - 1)
+        t = s - k
+        lo = self._grid(key, k, fresnel)
+        hi = self._grid(key, k + 1, fresnel)
+        return lo[0], (1.0 - t) * lo[1] + t * hi[1]
+
+    def white(self, alpha: float):
+        return self.albedo(alpha, lambda c: np.ones_like(c), ("white",))
+
+    def f82(self, alpha: float, f82: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(mu, E_A, E_B): albedos of the two parts of the F82 Fresnel f0 A(c) + B(c), each
+        linear in 1 - f82, from four tables that do not depend on the tint."""
+        a0, a1, b0, b1 = _F82_TERMS
+        mu, ea0 = self.albedo(alpha, a0, ("f82 a0",))
+        ea1 = self.albedo(alpha, a1, ("f82 a1",))[1]
+        eb0 = self.albedo(alpha, b0, ("f82 b0",))[1]
+        eb1 = self.albedo(alpha, b1, ("f82 b1",))[1]
+        s = 1.0 - np.asarray(f82, float)
+        return mu, ea0[:, None] - ea1[:, None] * s, eb0[:, None] - eb1[:, None] * s
+
+    @staticmethod
+    def _grid(key, k, fresnel):
+        found = _GRID_TABLES.get((key, k))
+        if found is None:
+            found = _GRID_TABLES[(key, k)] = mf.directional_albedo((k / ROUGHNESS_GRID) ** 4, fresnel)
+        return found
+
+
+def _exact_table(key, alpha: float, fresnel):
+    """``mf.directional_albedo(alpha, fresnel)``, kept by (key, alpha): a key names its Fresnel."""
+    if key is None:
+        return mf.directional_albedo(alpha, fresnel)
+    found = _EXACT_TABLES.get((key, alpha))
+    if found is None:
+        mu, e = mf.directional_albedo(alpha, fresnel)
+        e.setflags(write=False)
+        found = (mu, e)
+        with _EXACT_LOCK:  # a viewport's worker may prepare a scene meanwhile
+            if len(_EXACT_TABLES) >= _EXACT_TABLES_MAX:
+                _EXACT_TABLES.pop(next(iter(_EXACT_TABLES)))
+            _EXACT_TABLES[(key, alpha)] = found
+    return found
+
+
+EXACT = Tables()
+
+
+def _reflect_lobe(weight, alpha, fresnel, layers=(), multiscatter=True, tables=EXACT, key=None, tint=None,
+                  table=None, fresnel_kind=lk.F_TINT, fresnel_eta=1.0, f0=None) -> Lobe:
+    """A GGX reflection lobe with Fresnel ``fresnel`` (for the kernels: ``fresnel_kind``,
+    ``fresnel_eta`` and the colour ``f0``) times a constant ``tint`` (its albedo table is the
+    untinted one times the tint, so lobes differing in tint share tables); ``table`` (mu, E)
+    when the caller has it."""
+    mu, e = table if table is not None else tables.albedo(alpha, fresnel, key)
+    f0 = np.ones(3) if f0 is None else np.asarray(f0, float)
+    if tint is not None:
+        untinted = fresnel
+        e = e * tint
+        f0 = f0 * tint
+        fresnel = lambda c: untinted(c) * tint  # noqa: E731
+    lobe = Lobe("reflect", np.asarray(weight, float), layers=list(layers), alpha=alpha, fresnel=fresnel,
+                fresnel_kind=fresnel_kind, fresnel_eta=fresnel_eta, f0=f0)
+    _, e1 = tables.white(float(alpha))
+    if multiscatter:
+        # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
+        # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
+        e_avg = _cosine_average(mu, e1)
+        f_avg = _cosine_average(mu, np.asarray(fresnel(mu)).mean(axis=-1))
+        f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg))
+        factor = 1.0 + f_ms * (1.0 - e1) / np.maximum(e1, 1e-3)
+        lobe.ms = (mu, factor, e_avg)
+        e = e * factor[:, None]
+        lobe.layer_table = (mu, e)
+    else:
+        # Cycles' albedo estimate for plain GGX is the lobe-averaged Fresnel, without the
+        # energy masking loses (measured: diffuse weight 0.9595 under a 0.5-rough, IOR 1.5 layer)
+        lobe.layer_table = (mu, e / np.maximum(e1, 1e-6)[:, None])
+    lobe.table = (mu, e)
+    return lobe
+
+
+def _affine(lobe: Lobe, a: Callable, b: Callable, tables: Tables, key, parts=None) -> tuple:
+    """Tables of a reflect lobe whose Fresnel is p A(c) + B(c) for a per-hit colour p
+    (``parts`` (mu, E_A, E_B) when the caller has them)."""
+    if parts is not None:
+        mu, ea, eb = parts
+    else:
+        mu, ea = tables.albedo(lobe.alpha, a, key + ("A",))
+        _, eb = tables.albedo(lobe.alpha, b, key + ("B",))
+    _, e1 = tables.white(float(lobe.alpha))
+    fa = np.broadcast_to(a(mu), (len(mu), 3))
+    fb = np.broadcast_to(b(mu), (len(mu), 3))
+    a_avg = np.array([_cosine_average(mu, fa[:, k]) for k in range(3)])
+    b_avg = np.array([_cosine_average(mu, fb[:, k]) for k in range(3)])
+    return np.broadcast_to(ea, (len(mu), 3)), np.broadcast_to(eb, (len(mu), 3)), e1, a_avg, b_avg
+
+
+def _f82_term(kind):
+    def term(c):
+        c = np.clip(c, 0.0, 1.0)
+        bump = c * (1.0 - c) ** 6 / mf.F82_M
+        return {"a0": 1.0 - (1.0 - c) ** 5, "a1": (1.0 - mf.F82_K) * bump, "b0": (1.0 - c) ** 5,
+                "b1": mf.F82_K * bump}[kind]
+    return term
+
+
+_F82_TERMS = tuple(_f82_term(k) for k in ("a0", "a1", "b0", "b1"))
+"""mf.fresnel_f82 before clipping is f0 (a0 - (1 - f82) a1) + b0 - (1 - f82) b1."""
+
+
+def _f82_parts(f82: np.ndarray) -> tuple[Callable, Callable]:
+    """mf.fresnel_f82 (before clipping) as f0 A(c) + B(c), over arrays of cosines."""
+    k = mf.F82_K
+    scale = (1.0 - f82) / mf.F82_M
+
+    def a(c):
+        c = np.clip(c, 0.0, 1.0)[:, None]
+        return 1.0 - (1.0 - c) ** 5 - (1.0 - k) * scale * c * (1.0 - c) ** 6
+
+    def b(c):
+        c = np.clip(c, 0.0, 1.0)[:, None]
+        return (1.0 - c) ** 5 - k * scale * c * (1.0 - c) ** 6
+
+    return a, b
+
+
+def _f82_fresnel(f0: np.ndarray, f82: np.ndarray) -> Callable:
+    """mf.fresnel_f82 over arrays of cosines (for the tables)."""
+    a, b = _f82_parts(f82)
+    return lambda c: np.clip(f0 * a(c) + b(c), 0.0, 1.0)
+
+
+def _cosine_average(mu: np.ndarray, values: np.ndarray) -> float:
+    """2 * integral of values(mu) mu dmu over [0, 1] (trapezoids, held constant below mu[0])."""
+    x = np.concatenate([[0.0], mu])
+    y = 2.0 * x * np.concatenate([values[:1], values])
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)))
+
+
+def _layer_under(upper: Lobe, tint: np.ndarray | None = None) -> tuple:
+    """Attenuation of what lies below ``upper``, 1 - max albedo(mu_o), times a tint: as
+    (max albedo over mu, tint), a term of a lobe's ``layers``."""
+    return upper.layer_table[1].max(axis=1), np.ones(3) if tint is None else np.asarray(tint, float)
+
+
+def _key(*parts):
+    return tuple(tuple(np.round(np.atleast_1d(p), 9).tolist()) if not isinstance(p, str) else p for p in parts)
+
+
+def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
+    lobes = []
+    w = c.weight
+    base_layers = []
+    if c.coat_weight > 0:
+        coat_ior = max(c.coat_ior, 1.0 + 1e-4)
+        coat = _reflect_lobe(w * c.coat_weight, _alpha(c.coat_roughness), _dielectric_fresnel(coat_ior, np.ones(3)),
+                             tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
+                             fresnel_kind=lk.F_DIELECTRIC, fresnel_eta=coat_ior)
+        coat.role = "coat"
+        lobes.append(coat)
+        tint = 1.0 + c.coat_weight * (np.clip(c.coat_tint, 0, None) - 1.0)
+        base_layers = [_layer_under(coat, tint)]
+    alpha = _alpha(c.roughness)
+    base = np.clip(c.color, 0.0, 1.0)
+    metallic = float(np.clip(c.metallic, 0, 1))
+    transmission = float(np.clip(c.transmission, 0, 1))
+    if metallic > 0:
+        f82 = np.clip(c.specular_tint, 0, 1)
+        table = None
+        if tables.grid:  # tint-independent tables; exact but for the clipping of mf.fresnel_f82
+            mu, ea, eb = tables.f82(alpha, f82)
+            table = (mu, base * ea + eb)
+        metal = _reflect_lobe(w * metallic, alpha, _f82_fresnel(base, f82), base_layers, c.multiscatter, tables,
+                              _key("f82", base, f82), table=table, fresnel_kind=lk.F_F82, f0=base)
+        metal.role, metal.f82 = "metal", f82
+        lobes.append(metal)
+    dielectric = 1.0 - metallic
+    ior = max(float(c.ior), 1e-5)  # IOR below 1 is a valid medium (a bubble), as in Cycles
+    if dielectric * transmission > 0:
+        lobes.append(Lobe("glass", w * dielectric * transmission, layers=list(base_layers), alpha=alpha, eta=ior,
+                          tint_r=np.clip(c.specular_tint, 0, None), tint_t=np.sqrt(base), role="glass"))
+    opaque = dielectric * (1.0 - transmission)
+    if opaque > 0:
+        level = max(float(c.specular_ior_level), 0.0)
+        f0 = mf.f0_from_ior(ior) * 2.0 * level
+        spec_tint = np.clip(c.specular_tint, 0, None)
+        diffuse_layers = list(base_layers)
+        if f0 > 0:
+            eta = mf.ior_from_f0(f0)
+            spec = _reflect_lobe(w * opaque, alpha, _dielectric_fresnel(eta, np.ones(3)), base_layers,
+                                 c.multiscatter, tables, _key("dielectric", eta, np.ones(3)), spec_tint,
+                                 fresnel_kind=lk.F_DIELECTRIC, fresnel_eta=eta)
+            spec.role = "spec"
+            lobes.append(spec)
+            diffuse_layers.append(_layer_under(spec))
+        lobes.append(Lobe("diffuse", w * opaque, layers=diffuse_layers, albedo=base, role="diffuse"))
+    return lobes
+
+
+def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
+    lobes = []
+    for i, c in enumerate(material.closures):
+        if not np.any(c.weight > 0):
+            continue
+        if c.kind == "PRINCIPLED":
+            new = _principled_lobes(c, tables)
+        elif c.kind == "DIFFUSE":
+            new = [Lobe("diffuse", c.weight, albedo=np.clip(c.color, 0, 1), role="diffuse")]
+        elif c.kind == "GLOSSY":
+            tint = np.clip(c.color, 0, 1)
+            new = [_reflect_lobe(c.weight, _alpha(c.roughness), lambda x: np.ones((len(x), 3)),
+                                 multiscatter=c.multiscatter, tables=tables, key=("unit rgb",), tint=tint)]
+            new[0].role = "glossy"
+        elif c.kind in ("GLASS", "REFRACTION"):
+            tint = np.clip(c.color, 0, 1)
+            new = [Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1e-5),
+                        tint_r=tint, tint_t=tint, refract_only=c.kind == "REFRACTION", role="bsdf_glass")]
+        elif c.kind == "TRANSPARENT":
+            new = [Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1), role="transparent")]
+        else:
+            new = []
+        for lobe in new:
+            lobe.source = i
+        lobes += new
+    return lobes
+
+
+_KINDS = {"diffuse": lk.DIFFUSE, "reflect": lk.REFLECT, "glass": lk.GLASS, "transparent": lk.TRANSPARENT}
+
+
+def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lobes as ``lobe_kernels``' flat arrays: constants (L, P), tables (L, T, len(MU_TABLE))
+    and the per-hit part for a constant shader (1, L, H)."""
+    n_mu = len(mf.MU_TABLE)
+    lp = np.zeros((len(lobes), lk.P))
+    lt = np.zeros((len(lobes), lk.T, n_mu))
+    hp = np.zeros((1, len(lobes), lk.H))
+    for l, lobe in enumerate(lobes):
+        row = lp[l]
+        row[lk.P_KIND] = _KINDS[lobe.kind]
+        row[lk.P_DELTA] = lobe.delta
+        row[lk.P_ALPHA], row[lk.P_ALPHA_T], row[lk.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
+        row[lk.P_REFRACT_ONLY] = lobe.refract_only
+        row[lk.P_FRESNEL], row[lk.P_ETA_F] = lobe.fresnel_kind, lobe.fresnel_eta
+        row[lk.P_F82:lk.P_F82 + 3] = 1.0 if lobe.f82 is None else lobe.f82
+        row[lk.P_LAYERS] = len(lobe.layers)
+        for t, (emax, tint) in enumerate(lobe.layers):
+            lt[l, lk.T_UNDER + t] = emax
+            row[lk.P_LAYER_TINT + 3 * t:lk.P_LAYER_TINT + 3 * t + 3] = tint
+        row[lk.P_SAMPLED] = sampled.index(lobe) if lobe in sampled else -1
+        row[lk.P_WEIGHT:lk.P_WEIGHT + 3] = lobe.weight
+        if lobe.table is not None:
+            assert np.array_equal(lobe.table[0], mf.MU_TABLE)  # every table is over MU_TABLE
+            lt[l, lk.T_E:lk.T_E + 3] = np.broadcast_to(lobe.table[1], (n_mu, 3)).T
+            lt[l, lk.T_LAYER_E:lk.T_LAYER_E + 3] = np.broadcast_to(lobe.layer_table[1], (n_mu, 3)).T
+        if lobe.ms is not None:
+            row[lk.P_MS], row[lk.P_E_AVG] = 1.0, lobe.ms[2]
+            lt[l, lk.T_MS] = lobe.ms[1]
+        if lobe.delta and lobe.kind in ("reflect", "glass"):
+            lt[l, lk.T_WHITE] = mf.white_albedo(float(lobe.alpha))[1]
+        if lobe.affine is not None:
+            ea, eb, e1, a_avg, b_avg = lobe.affine
+            row[lk.P_AFFINE] = 1.0
+            lt[l, lk.T_EA:lk.T_EA + 3], lt[l, lk.T_EB:lk.T_EB + 3], lt[l, lk.T_E1] = ea.T, eb.T, e1
+            row[lk.P_A_AVG:lk.P_A_AVG + 3], row[lk.P_B_AVG:lk.P_B_AVG + 3] = a_avg, b_avg
+        h = hp[0, l]
+        h[lk.H_SCALE:lk.H_SCALE + 3] = 1.0
+        h[lk.H_COLOUR:lk.H_COLOUR + 3] = lobe.albedo
+        h[lk.H_TINT_R:lk.H_TINT_R + 3] = lobe.tint_r
+        h[lk.H_TINT_T:lk.H_TINT_T + 3] = lobe.tint_t
+        h[lk.H_F0:lk.H_F0 + 3] = lobe.f0
+    return lp, lt, hp
+
+
+def _floats(a):
+    """``a`` as the kernels take it (one compiled version per layout: keep to C-contiguous)."""
+    return np.ascontiguousarray(a, np.float64)
+
+
+def _bools(a):
+    return np.ascontiguousarray(a, np.bool_)
+
+
+class MaterialShader:
+    """Evaluates and samples one material's lobes for batches of local directions.
+
+    The lobes are packed once into flat arrays (see ``lobe_kernels``) and every method is one
+    compiled loop over the batch. A shader built with ``varying`` closures (closure index ->
+    names of inputs that vary per hit) is bound to the hits of one call with ``bind``, which
+    gives it a per-hit row of those inputs; methods then take ``rows``, the hits' positions in
+    that binding (None: all of them, in order).
+    """
+
+    def __init__(self, material: Material, varying: dict | None = None, tables: Tables = EXACT):
+        self.material = material
+        self.lobes = lobes_of(material, tables)
+        self.emission = material.emission
+        self.sampled = [lobe for lobe in self.lobes if lobe.kind != "diffuse"]
+        self.has_glass = any(lobe.kind == "glass" for lobe in self.lobes)
+        for lobe in self.lobes:
+            names = (varying or {}).get(lobe.source, ())
+            if "color" in names and lobe.role == "metal":
+                parts = tables.f82(lobe.alpha, lobe.f82) if tables.grid else None
+                lobe.affine = _affine(lobe, *_f82_parts(lobe.f82), tables, _key("f82", lobe.f82), parts)
+            elif "color" in names and lobe.role == "glossy":
+                lobe.affine = _affine(lobe, lambda c: np.ones((len(c), 3)), lambda c: np.zeros((len(c), 3)), tables,
+                                      ("glossy",))
+        self.lp, self.lt, self.hp = _pack(self.lobes, self.sampled)
+        self.mu = np.ascontiguousarray(mf.MU_TABLE, np.float64)
+        self.bound = False
+
+    @property
+    def can_continue(self) -> bool:
+        return bool(self.sampled)
+
+    def bind(self, values: dict) -> "MaterialShader":
+        """A copy whose lobes take per-hit values: ``values[closure index]`` maps "weight" and
+        "color" to (N, 3) arrays (the shader was built with those set to one)."""
+        n = len(next(v for d in values.values() for v in d.values()))
+        hp = np.repeat(self.hp, n, axis=0)
+        for l, lobe in enumerate(self.lobes):
+            v = values.get(lobe.source, {})
+            if "weight" in v:
+                hp[:, l, lk.H_SCALE:lk.H_SCALE + 3] = v["weight"]
+            color = v.get("color")
+            if color is None:
+                continue
+            base = np.clip(color, 0.0, 1.0)
+            if lobe.role in ("diffuse", "transparent"):
+                hp[:, l, lk.H_COLOUR:lk.H_COLOUR + 3] = base
+            elif lobe.role == "glass":
+                hp[:, l, lk.H_TINT_T:lk.H_TINT_T + 3] = np.sqrt(base)
+            elif lobe.role == "bsdf_glass":
+                hp[:, l, lk.H_TINT_T:lk.H_TINT_T + 3] = base
+                hp[:, l, lk.H_TINT_R:lk.H_TINT_R + 3] = base
+            elif lobe.affine is not None:
+                hp[:, l, lk.H_F0:lk.H_F0 + 3] = base
+        bound = copy.copy(self)
+        bound.hp, bound.bound = hp, True
+        return bound
+
+    def _rows(self, n, rows) -> np.ndarray:
+        """Row of ``hp`` each of n rays reads."""
+        if not self.bound:
+            return np.zeros(n, np.int64)
+        return np.arange(n, dtype=np.int64) if rows is None else np.ascontiguousarray(rows, np.int64)
+
+    # -- lobe selection ---------------------------------------------------------------
+    def selection(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
+        """(N, L) probabilities of continuing through each non-diffuse lobe."""
+        out = np.zeros((len(mu_o), len(self.sampled)))
+        lk.selection_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        return out
+
+    # -- evaluation -----------------------------------------------------------------
+    def evaluate(self, wo: np.ndarray, wi: np.ndarray, above: np.ndarray, inside: np.ndarray, sel=None,
+                 rows=None):
+        """BSDF times |cos| for light sampling.
+
+        ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived
+        from the back of the surface (glass sees the inverse IOR). Returns (diffuse part,
+        non-diffuse part, density of continuing in direction wi through the non-diffuse
+        lobes, for multiple importance sampling). ``sel``: ``selection(wo[:, 2])`` when the
+        caller has it already (it depends on wo only, so every light strategy shares it).
+        """
+        n = len(wo)
+        if sel is None:
+            sel = self.selection(wo[:, 2], rows)
+        f_diff = np.empty((n, 3))
+        f_nd = np.empty((n, 3))
+        pdf = np.empty(n)
+        lk.evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
+                         _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
+        return f_diff, f_nd, pdf
+
+    # -- sampling -------------------------------------------------------------------
+    def sample(self, wo: np.ndarray, u_select: np.ndarray, u2: np.ndarray, inside: np.ndarray, rows=None):
+        """Continue through one non-diffuse lobe chosen by its albedo.
+
+        Returns (wi, weight = f |cos| / pdf, pdf (0 for delta), delta flag, valid flag,
+        pass-through flag: the transparent lobe was taken).
+        For non-delta lobes the weight and pdf are those of the whole non-diffuse
+        mixture (one-sample MIS over lobes), which multiple importance sampling with
+        light sampling requires.
+        """
+        n = len(wo)
+        wi = np.empty((n, 3))
+        weight = np.empty((n, 3))
+        pdf = np.empty(n)
+        delta = np.empty(n, bool)
+        valid = np.empty(n, bool)
+        passthrough = np.empty(n, bool)
+        lk.sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
+                       _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
+                       len(self.sampled))
+        return wi, weight, pdf, delta, valid, passthrough
+
+    # -- albedo passes --------------------------------------------------------------
+    def colors(self, mu_o: np.ndarray, rows=None):
+        """(diffuse colour, glossy colour) as the DiffCol / GlossCol passes show them."""
+        n = len(mu_o)
+        diff = np.empty((n, 3))
+        gloss = np.empty((n, 3))
+        lk.colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
+        return diff, gloss
+
+    def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
+        """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles
+        splits its closures for the Denoising Albedo pass (``lobe_kernels.denoising_albedos``)."""
+        n = len(mu_o)
+        diff = np.empty((n, 3))
+        spec = np.empty((n, 3))
+        take = np.empty(n, bool)
+        lk.denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
+                          diff, spec, take)
+        return diff, spec, take
+
+    def lobe_weights(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
+        """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,
+        per-hit scale) times its multiple-scattering factor, what the albedo tables decide."""
+        out = np.empty((len(mu_o), len(self.lobes), 3))
+        lk.weights_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        return out

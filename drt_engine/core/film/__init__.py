@@ -1,0 +1,1 @@
+"""Filtered sums per pixel in two replicates, the passes, denoising features and farm parts."""

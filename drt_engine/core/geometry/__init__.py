@@ -1,0 +1,1 @@
+"""Where rays meet the scene: Embree scenes, motion, the camera's rays."""

@@ -1,0 +1,154 @@
+"""Primary rays: the pixel filter's offset, the image window, the thin lens (perspective
+and orthographic).
+
+Rays start at the near clipping plane and stop at the far one, as Blender's camera
+clips; ``depth_per_t`` converts distance along a ray into depth along the view axis.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..base.jit import kernel
+from ..base.vectors import unit
+from ..base.warps import concentric_disk
+from ..scene import Camera
+from .motion import Motion, frame_at
+
+FOCUS_MIN = 1e-5
+"""Nearest focus distance, as Cycles clamps it: at 0 every lens ray would leave sideways."""
+
+
+@dataclass
+class CameraRays:
+    origins: np.ndarray
+    directions: np.ndarray
+    tmax: np.ndarray
+    t_start: np.ndarray  # distance from the eye to the near plane along the ray
+    depth_per_t: np.ndarray
+
+
+def lens_table(camera: Camera) -> np.ndarray:
+    """The camera's numbers as one flat array for ``camera_ray`` (made once per call: a few floats)."""
+    w, h = camera.resolution
+    left, right, bottom, top = camera.frame
+    return np.array([camera.type != "PERSP", w, h, left, right, bottom, top, camera.aperture_radius,
+                     max(camera.aperture_ratio, 1e-6), camera.blades, camera.blade_rotation,
+                     max(camera.focus_distance, FOCUS_MIN), camera.clip_start, camera.clip_end], np.float64)
+
+
+@kernel
+def aperture_sample(lens, u0, u1):
+    """Uniform point on the aperture: a disk, or a regular polygon with ``blades`` sides."""
+    blades = int(lens[9])
+    if blades >= 3:
+        k = min(int(u0 * blades), blades - 1)
+        su = math.sqrt(u0 * blades - k)  # reuse the leftover of the choice, keeping stratification
+        a0 = lens[10] + 2 * math.pi * k / blades
+        a1 = a0 + 2 * math.pi / blades
+        b1, b2 = su * (1 - u1), su * u1  # uniform in the triangle (centre, corner k, corner k+1)
+        x, y = b1 * math.cos(a0) + b2 * math.cos(a1), b1 * math.sin(a0) + b2 * math.sin(a1)
+    else:
+        x, y = concentric_disk(u0, u1)
+    return x * lens[7] / lens[8], y * lens[7]
+
+
+@kernel
+def camera_ray(lens, m, px, py, u0, u1, use_lens):
+    """The ray through image point (px, py) (pixels, y from the bottom), through lens point (u0, u1)
+    when ``use_lens``, carried to the world by m (3, 4).
+
+    Returns origin on the near plane, unit direction, the distance to the far plane, the
+    distance from the eye to the near plane, and depth per unit distance along the ray.
+    """
+    sx = lens[3] + (px / lens[1]) * (lens[4] - lens[3])
+    sy = lens[5] + (py / lens[2]) * (lens[6] - lens[5])
+    focus = lens[11]
+    if lens[0] == 0.0:  # perspective: from the eye (or a point of the lens) toward the plane in focus
+        ox, oy, oz = 0.0, 0.0, 0.0
+        dx, dy, dz = unit(sx, sy, -1.0)
+        if use_lens:
+            ox, oy = aperture_sample(lens, u0, u1)
+            f = focus / -dz
+            dx, dy, dz = unit(dx * f - ox, dy * f - oy, dz * f)
+    else:
+        # as Cycles: the ray leaves a point of the aperture around its own image point
+        # and passes where the pinhole ray crosses the plane in focus
+        ox, oy, oz = sx, sy, 0.0
+        dx, dy, dz = 0.0, 0.0, -1.0
+        if use_lens:
+            ax, ay = aperture_sample(lens, u0, u1)
+            ox, oy = sx + ax, sy + ay
+            dx, dy, dz = unit(sx - ox, sy - oy, -focus)
+    axial = -dz
+    t_start = lens[12] / axial
+    t_end = lens[13] / axial
+    wx = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3]
+    wy = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3]
+    wz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3]
+    vx, vy, vz = unit(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
+                       m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
+    return (wx + vx * t_start, wy + vy * t_start, wz + vz * t_start, vx, vy, vz,
+            max(t_end - t_start, 0.0), t_start, axial)
+
+
+@kernel
+def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens, time, out):
+    """Camera rays into out (N, 9); a moving camera's frame at each ray's time, its scale dropped."""
+    m = matrix.copy()
+    for i in range(len(px)):
+        if moving:
+            frame_at(translation, quat, stretch, time[i], m)
+            for c in range(3):
+                length = math.sqrt(m[0, c] * m[0, c] + m[1, c] * m[1, c] + m[2, c] * m[2, c])
+                for r in range(3):
+                    m[r, c] /= length
+        u0, u1 = (u[i, 0], u[i, 1]) if use_lens else (0.0, 0.0)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5], out[i, 6], out[i, 7], out[i, 8] = \
+            camera_ray(lens, m, px[i], py[i], u0, u1, use_lens)
+
+
+@kernel
+def _aperture_points(lens, u, out):
+    for i in range(len(u)):
+        out[i, 0], out[i, 1] = aperture_sample(lens, u[i, 0], u[i, 1])
+
+
+def aperture_point(camera: Camera, u: np.ndarray) -> np.ndarray:
+    """Uniform points on the aperture (N, 2) for sample values u (N, 2)."""
+    out = np.empty((len(u), 2))
+    _aperture_points(lens_table(camera), np.asarray(u, np.float64), out)
+    return out
+
+
+def moves(camera: Camera) -> bool:
+    return Motion(camera.matrices).moving
+
+
+def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | None,
+             time: np.ndarray | None = None) -> CameraRays:
+    """Rays through continuous image coordinates (px, py) in pixels, y from the bottom,
+    at shutter fractions ``time`` when the camera moves."""
+    n = len(px)
+    motion = Motion(camera.matrices)
+    moving = time is not None and motion.moving
+    use_lens = lens is not None and camera.aperture_radius > 0
+    out = np.empty((n, 9))
+    _rays(lens_table(camera), np.ascontiguousarray(camera.matrix[:3]), *motion.table, moving,
+          np.asarray(px, np.float64), np.asarray(py, np.float64),
+          np.asarray(lens, np.float64) if use_lens else np.zeros((0, 2)), use_lens,
+          np.asarray(time, np.float64) if moving else np.zeros(0), out)
+    return CameraRays(out[:, :3], out[:, 3:6], out[:, 6], out[:, 7], out[:, 8])
+
+
+def pixel_spread(camera: Camera) -> tuple[float, float]:
+    """A pixel's footprint width as a + b t at distance t along a camera ray: (a, b).
+
+    Perspective: b is the pixel's angle; orthographic: a is its size. Texture lookups
+    filter over this footprint (projected onto the surface)."""
+    w = camera.resolution[0]
+    left, right, _, _ = camera.frame
+    size = abs(right - left) / w
+    return (0.0, size) if camera.type == "PERSP" else (size, 0.0)

@@ -1,0 +1,477 @@
+"""The distribution ray tracing integrator: one wave of camera samples, stage after stage.
+
+Each depth step intersects all live rays at once, adds what they see (emission, lights,
+world, each weighted by multiple importance sampling against light sampling), estimates
+direct light at every hit with one shadow ray per light strategy, and continues each path
+through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
+Stages pass named records (core.records); every random number comes from the sampler the
+caller hands to ``trace``, at the dimensions core.dims lays out.
+"""
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..base import vectors as vec
+from ..base.constants import TINY
+from ..film.denoising import Features
+from ..film.film import PixelFilter
+from ..film.ratio_sums import NDU_CHANNELS, RATIO
+from ..geometry import camera as camera_rays
+from ..geometry.accel import spawn
+from ..sampling import dims as D
+from ..shading.surface import SurfaceContext
+from .ratio import add_unoccluded
+from .records import BsdfSample, PathState, Samples, ShadowRays, SurfaceHits
+
+_MISS_DEPTH = 1e10  # Blender's depth for the background
+_AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
+        ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"))
+
+
+def _power(a, b):
+    """Power heuristic weight of strategy a against b (densities per solid angle)."""
+    a2 = np.where(np.isinf(a), 1.0, a * a)
+    b2 = np.where(np.isinf(a), 0.0, b * b)
+    return a2 / np.maximum(a2 + b2, TINY)
+
+
+@dataclass
+class StepSamples:
+    """The sample values the hits of one depth step use, one row per hit: per light strategy
+    k the point on the light (``point[k]``, (N, 2)) and the choice of light or triangle
+    (``choice[k]``, or None), valid where the material casts shadow rays; the lobe direction
+    (N, 2) and lobe choice (N,), valid where the path continues."""
+
+    point: list
+    choice: list
+    lobe: np.ndarray
+    lobe_choice: np.ndarray
+
+    def take(self, rows) -> "StepSamples":
+        return StepSamples([p[rows] for p in self.point], [None if c is None else c[rows] for c in self.choice],
+                           self.lobe[rows], self.lobe_choice[rows])
+
+
+@dataclass
+class WaveOutput:
+    """The per-sample values of every pass a wave computes: the wave's accumulator, which the
+    stages add their contributions to (Combined RGB, alpha, the auxiliary passes, and the
+    ratio estimator's N, D, U when it is used, core.ratio)."""
+
+    radiance: np.ndarray
+    alpha: np.ndarray
+    aux: dict
+    features: Features | None = None  # the denoising features' walks, when those passes are on
+    ratio: np.ndarray | None = None
+
+    def values(self, clamp: float) -> dict:
+        radiance, ratio = self.radiance, self.ratio
+        if clamp > 0:
+            peak = vec.max3(radiance)
+            scale = np.where(peak > clamp, clamp / np.maximum(peak, TINY), 1.0)[:, None]
+            radiance = radiance * scale
+            ratio = None if ratio is None else ratio * scale  # N stays the share of Combined it is
+        finite = np.isfinite(radiance)
+        if ratio is not None:
+            out_ratio = np.where((finite.all(axis=1) & np.isfinite(ratio).all(axis=1))[:, None], ratio, 0.0)
+        radiance = np.where(finite, radiance, 0.0)
+        out = {"Combined": np.concatenate([radiance, np.clip(self.alpha, 0.0, 1.0)[:, None]], axis=1)}
+        if ratio is not None:
+            out[RATIO] = out_ratio
+        out.update(self.aux)
+        return out
+
+
+class Integrator:
+    """Traces waves of one scene's camera over its prepared scene (core.prepared) with one settings."""
+
+    def __init__(self, prepared, scene, settings, plan):
+        self.prepared = prepared
+        self.geometry, self.lights = prepared.geometry, prepared.lights
+        self.camera, self.settings, self.plan = scene.camera, settings, plan
+        self.film_transparent = scene.film_transparent
+        self.timed = plan.time
+        self.filter = PixelFilter(settings.filter_type, settings.filter_size)
+        self.pixel_spread = camera_rays.pixel_spread(self.camera)
+        self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
+        self.ratio = frozenset(plan.ratio)
+        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
+        self._rays_lock = threading.Lock()
+
+    def _count(self, kind, n):
+        with self._rays_lock:
+            self.rays[kind] += int(n)
+
+    # -- one wave ---------------------------------------------------------------------
+    def trace(self, samples: Samples, sampler) -> dict:
+        """Per-sample values of every pass for the camera samples of one wave."""
+        s = self.settings
+        state, cam = self._camera_rays(samples, sampler)
+        times = self.geometry.ray_times(state.time)  # moving parts' transforms, once per camera sample
+        n = len(state)
+        out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
+                                                        if name in s.passes},
+                         ratio=np.zeros((n, NDU_CHANNELS)) if self.ratio else None)
+        if "Depth" in out.aux:
+            out.aux["Depth"][:] = _MISS_DEPTH
+        if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
+            out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
+        for depth in range(s.max_depth + 1):
+            if len(state) == 0:
+                break
+            ray_times = times[state.path]
+            hits = self.geometry.intersect(state.origins, state.dirs, state.tmax, ray_times)
+            light_t, light_id, light_le = self.lights.intersect(state.origins, state.dirs,
+                                                                np.minimum(hits.t, state.tmax), state.time)
+            # a light hidden from the camera is not there for camera rays: they go on past it
+            hidden = state.straight & ~self.lights.camera_visible[np.maximum(light_id, 0)]
+            light_id = np.where(hidden, -1, light_id)
+            on_light = light_id >= 0
+            self._lights_hit(state.take(np.flatnonzero(on_light)), light_t[on_light], light_id[on_light],
+                             light_le[on_light], out)
+            self._escaped(state.take(np.flatnonzero(~hits.hit & ~on_light)), out)
+            rows = np.flatnonzero(hits.hit & ~on_light)
+            if len(rows) == 0:
+                break
+            if len(self.prepared.shaders) > 1:
+                # hits ordered by material (stably): each material's hits are one slice, so its
+                # arrays are views, and per path nothing changes (groups keep their order)
+                rows = rows[np.argsort(self.geometry.material[hits.prim[rows]], kind="stable")]
+            surf = self._surface(state, hits, rows, ray_times)
+            self._emission_seen(surf, state, hits, out)
+            if depth == 0:
+                self._first_hit_passes(surf, cam, hits.t[rows], out)
+            u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
+                           depth < s.max_depth)
+            shadows, continued = [], []
+            for group, u_g, shader in self._bind_materials(surf, u, hits):
+                if depth == 0:
+                    self._colors(group, shader, out)
+                if out.features is not None:
+                    out.features.surface(group, shader)
+                if self.lights.strategies and shader.lobes:
+                    # the terminator lift is for diffuse shading over coarse facets (measured on
+                    # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
+                    diffuse = any(lobe.kind == "diffuse" for lobe in shader.lobes)
+                    lift = self.geometry.smooth_offset(hits, group.row, ray_times) if diffuse else None
+                    shadows += self._direct(shader, group, u_g, lift, out)
+                if shader.can_continue and depth < s.max_depth:
+                    nxt = self._continue(shader, group, u_g)
+                    if nxt is not None:
+                        continued.append(nxt)
+            self._resolve_shadows(shadows, times, out)
+            if not continued:
+                break
+            state = PathState.concat(continued)
+        return out.values(s.clamp)
+
+    # -- camera ---------------------------------------------------------------------
+    def _camera_rays(self, samples: Samples, sampler):
+        """The wave's camera rays as the first path state (path = row in the wave)."""
+        n = len(samples.index)
+        w = self.camera.window_size[0]
+        x0, y0 = self.camera.window[:2]
+        off = self.filter.offset(sampler.get2d(samples.pixel, samples.sample, D.PIXEL))
+        px = (samples.index % w + x0) + 0.5 + off[:, 0]
+        py = (samples.index // w + y0) + 0.5 + off[:, 1]
+        lens = sampler.get2d(samples.pixel, samples.sample, D.LENS) if self.plan.lens else None
+        # the shutter is a dimension only when something moves
+        time = sampler.get(samples.pixel, samples.sample, D.TIME) if self.timed else np.zeros(n)
+        cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
+        self._count("camera", n)
+        state = PathState(np.arange(n), cam.origins, cam.directions, cam.tmax, np.ones((n, 3)), np.full(n, np.inf),
+                          np.zeros((n, 3)), np.zeros((n, 3)), np.ones(n, bool), time)
+        return state, cam
+
+    # -- what rays see ----------------------------------------------------------------
+    def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
+        """Lights hit directly: always by reflected and refracted rays, by the camera if asked."""
+        if len(rays) == 0:
+            return
+        contrib = le
+        smooth = np.flatnonzero(~np.isinf(rays.prev_pdf))
+        if len(smooth):
+            pl = np.zeros(len(smooth))
+            for li in np.unique(light_id[smooth]):
+                sel = light_id[smooth] == li
+                k = smooth[sel]
+                pl[sel] = self.lights.pdf(li, rays.origins[k], rays.dirs[k], t[k], rays.time[k])
+            contrib = contrib.copy()
+            contrib[smooth] *= _power(rays.prev_pdf[smooth], pl)[:, None]
+        out.radiance[rays.path] += rays.throughput * contrib
+        if out.features is not None:
+            out.features.emitted(rays.path, contrib)
+        if self.film_transparent:
+            direct = rays.straight
+            out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
+
+    def _escaped(self, rays: PathState, out: WaveOutput):
+        """Escaped rays see the world (and, after a bounce, the suns)."""
+        if len(rays) == 0:
+            return
+        lights = self.lights
+        st = rays.straight
+        world = lights.world_radiance(rays.dirs, st, rays.prev_normal)
+        if "Env" in out.aux:
+            out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
+        if self.film_transparent:
+            out.alpha[rays.path[st]] -= rays.throughput[st].mean(axis=1)
+            keep = np.flatnonzero(~st)
+            rays, world = rays.take(keep), world[keep]
+        if len(rays) and lights.world_seen:
+            weight = np.ones(len(rays))
+            smooth = np.flatnonzero(~np.isinf(rays.prev_pdf))
+            if len(smooth) and lights.world is not None:
+                weight[smooth] = _power(rays.prev_pdf[smooth],
+                                        lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
+            out.radiance[rays.path] += rays.throughput * world * weight[:, None]
+            if out.features is not None:
+                out.features.emitted(rays.path, world * weight[:, None])
+        bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
+        if len(bounced):
+            sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
+            weight = np.where(np.isinf(bounced.prev_pdf), 1.0, _power(bounced.prev_pdf, pdf_sun))
+            out.radiance[bounced.path] += bounced.throughput * sun * weight[:, None]
+            if out.features is not None:
+                out.features.emitted(bounced.path, sun * weight[:, None])
+
+    def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
+        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
+        pos, ng, ns = self.geometry.surface(hits, rows, ray_times)
+        prim = hits.prim[rows]
+        wo = -state.dirs[rows]
+        inside = vec.dot(wo, ng) < 0
+        flip = np.where(inside, -1.0, 1.0)[:, None]
+        ng_o, ns_o = ng * flip, ns * flip
+        bad = vec.dot(wo, ns_o) <= 1e-6
+        ns_o[bad] = ng_o[bad]
+        tangent, bitangent = _frame(ns_o)
+        return SurfaceHits(state.path[rows], rows, prim, self.geometry.material[prim], pos, ng_o, ns_o, tangent,
+                           bitangent, wo, _to_local(wo, tangent, bitangent, ns_o), inside,
+                           self.geometry.offset_scale(prim, pos), state.throughput[rows], state.straight[rows],
+                           state.time[rows], ns)
+
+    def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
+        """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
+        glows = self.prepared.glows
+        glowing = np.flatnonzero(glows[surf.prim]) if len(glows) else np.zeros(0, np.int64)
+        if len(glowing) == 0:
+            return
+        prim = surf.prim[glowing]
+        hit = surf.row[glowing]
+        emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing])
+        weight = np.ones(len(glowing))
+        prev_pdf = state.prev_pdf[hit]
+        smooth = np.flatnonzero(~np.isinf(prev_pdf))
+        if len(smooth):
+            pl = self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]], hits.t[hit[smooth]])
+            weight[smooth] = _power(prev_pdf[smooth], pl)
+        e = surf.throughput[glowing] * emission * weight[:, None]
+        out.radiance[surf.path[glowing]] += e
+        if out.features is not None:
+            out.features.emitted(surf.path[glowing], emission * weight[:, None])
+        if "Emit" in out.aux:
+            first = surf.straight[glowing]
+            out.aux["Emit"][surf.path[glowing[first]]] += e[first]
+
+    def _first_hit_passes(self, surf: SurfaceHits, cam, t, out: WaveOutput):
+        aux = out.aux
+        if "Depth" in aux:
+            aux["Depth"][surf.path, 0] = (cam.t_start[surf.path] + t) * cam.depth_per_t[surf.path]
+        if "Normal" in aux:
+            aux["Normal"][surf.path] = surf.normal
+        if "Position" in aux:
+            aux["Position"][surf.path] = surf.pos
+
+    def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
+        """The diffuse and glossy colour passes of the camera's own hits."""
+        aux = out.aux
+        if "DiffCol" in aux or "GlossCol" in aux:
+            diff, gloss = shader.colors(group.wo_l[:, 2])
+            if "DiffCol" in aux:
+                aux["DiffCol"][group.path] = diff
+            if "GlossCol" in aux:
+                aux["GlossCol"][group.path] = gloss
+
+    # -- sample values of one depth step ------------------------------------------------
+    def _draw(self, depth, pixel, sample, mat, sampler, bounce) -> StepSamples:
+        """Every sample value the hits of one depth step use, drawn in one call per dimension
+        for all materials at once (values are per (pixel, sample, dimension), so drawing them
+        together gives the very numbers drawing per material would)."""
+        n = len(pixel)
+        lights = self.lights
+        lit = np.flatnonzero(self.prepared.lit[mat]) if lights.strategies else np.zeros(0, np.int64)
+        whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats gathering
+
+        def subset(get, dim, shape):
+            if whole:
+                return get(pixel, sample, dim)
+            values = np.zeros(shape)
+            values[lit] = get(pixel[lit], sample[lit], dim)
+            return values
+
+        point, choice = [], []
+        if len(lit):
+            emissive = lights.light_slots if len(lights.emissive) else -1
+            for k in range(lights.strategies):
+                point.append(subset(sampler.get2d, self.light_dims.point(depth, k), (n, 2)))
+                chooses = k == emissive or (lights.selecting and k < lights.light_slots)
+                choice.append(subset(sampler.get, self.light_dims.choice(depth, k), n) if chooses else None)
+        go = np.flatnonzero(self.prepared.continues[mat]) if bounce else np.zeros(0, np.int64)
+        lobe, lobe_choice = np.zeros((n, 2)), np.zeros(n)
+        if len(go):
+            lobe[go] = sampler.get2d(pixel[go], sample[go], D.lobe(depth))
+            lobe_choice[go] = sampler.get(pixel[go], sample[go], D.lobe_choice(depth))
+        return StepSamples(point, choice, lobe, lobe_choice)
+
+    def _bind_materials(self, surf: SurfaceHits, u: StepSamples, hits):
+        """(hits, their samples, shader) per material: a slice of
+        the hits (sorted by material) for a constant material, index arrays of hits sharing one
+        bound shader for a material with varying inputs (see core.shading); a program's normal
+        replaces the shading normal and frame of its hits in the records it yields."""
+        starts = np.concatenate([[0], np.flatnonzero(np.diff(surf.mat)) + 1])
+        for a, b in zip(starts, np.append(starts[1:], len(surf.mat))):
+            g = slice(int(a), int(b))  # the hits of material mat[a]
+            group, u_g = surf.take(g), u.take(g)
+            shading = self.prepared.shading[surf.mat[a]]
+            if not shading.varying:
+                yield group, u_g, shading.shader
+                continue
+            hu, hv = hits.u[group.row], hits.v[group.row]
+            bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
+            width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
+            ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo)
+            groups, normal = shading.bind(ctx)
+            if normal is not None:
+                ng, wo = group.ng, group.wo
+                ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, group.ns)
+                ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
+                tangent, bitangent = _frame(ns)
+                group = replace(group, ns=ns, tangent=tangent, bitangent=bitangent,
+                                wo_l=_to_local(wo, tangent, bitangent, ns))
+            for sub, shader in groups:
+                yield group.take(sub), u_g.take(sub), shader
+
+    # -- next-event estimation ----------------------------------------------------------
+    def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
+        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy; for
+        the lights the ratio estimator takes, their D and U go to the wave's sums (core.ratio)."""
+        lights = self.lights
+        out = []
+        time = hits.time if self.timed else None
+        sel_lobes = shader.selection(hits.wo_l[:, 2]) if shader.sampled else None
+        emissive = lights.light_slots if len(lights.emissive) else -1
+        albedo = self._diffuse_albedo(shader, hits, sel_lobes) if self.ratio else None
+        for k in range(lights.strategies):
+            u_pick = u.choice[emissive] if emissive >= 0 else None
+            # the world is sampled around the shading normal, the one the BSDF's cosine follows
+            ls = lights.sample(k, hits.pos, hits.ns, u.point[k], u_pick, u.choice[k] if lights.selecting else None,
+                               time)
+            ok = vec.max3(ls.value) > 0
+            if not ok.any():
+                continue
+            wi_l = _to_local(ls.wi, hits.tangent, hits.bitangent, hits.ns)
+            above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
+            f_diff, f_nd, pdf_b = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
+            f_diff, f_nd = ls.restrict(f_diff, f_nd, above)
+            w_l = _power(ls.pdf, pdf_b)
+            contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
+            by_ratio = k in self.ratio and albedo is not None
+            if by_ratio:
+                diffuse = hits.throughput * ls.value * f_diff
+                add_unoccluded(lights.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, wave.ratio)
+            ok &= vec.max3(contrib) > 0
+            sel = np.flatnonzero(ok)
+            if len(sel) == 0:
+                continue
+            scale = hits.scale[sel]
+            lift_s = np.zeros((len(sel), 3)) if lift is None else lift[sel]
+            origin = _shadow_origin(hits.pos[sel], hits.ng[sel], ls.wi[sel], wi_l[sel, 2], lift_s, scale)
+            dist = ls.dist[sel]
+            stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
+            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
+            out.append(ShadowRays(hits.path[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel],
+                                  diffuse[sel] if by_ratio else np.zeros((len(sel), 3)) if self.ratio else None))
+        return out
+
+    @staticmethod
+    def _diffuse_albedo(shader, hits: SurfaceHits, sel_lobes):
+        """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
+        the diffuse part toward the normal, since it is that times the cosine (the layers above
+        attenuate it by factors of wo alone, lobe_kernels.eval_lobes)."""
+        n = len(hits.path)
+        normal = np.zeros((n, 3))
+        normal[:, 2] = 1.0
+        f_diff, _, _ = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes)
+        return hits.throughput * f_diff if (f_diff > 0).any() else None
+
+    def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
+        """Trace the shadow rays of a depth step and add the unblocked ones' light."""
+        if not shadows:
+            return
+        rays = ShadowRays.concat(shadows)
+        self._count("shadow", len(rays))
+        blocked = self.geometry.occluded(rays.origins, rays.dirs, rays.tmax, times[rays.path])
+        # area lights are not geometry: a nearer area light does not block (lights cast shadows
+        # of each other's bodies in Cycles only when they are meshes, so it does not here)
+        visible = ~blocked
+        n = len(out.radiance)
+        for c in range(3):
+            out.radiance[:, c] += np.bincount(rays.path[visible], weights=rays.contrib[visible, c], minlength=n)
+            if out.ratio is not None:
+                out.ratio[:, c] += np.bincount(rays.path[visible], weights=rays.diffuse[visible, c], minlength=n)
+
+    # -- continuation through a non-diffuse lobe ------------------------------------
+    def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
+        """The paths of these hits continued through one sampled lobe (None if none goes on)."""
+        bs = BsdfSample(*shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside))
+        new_thr = hits.throughput * bs.weight
+        sel = np.flatnonzero(bs.valid & (vec.max3(new_thr) > 0))
+        wi = _to_world(bs.wi_l[sel], hits.tangent[sel], hits.bitangent[sel], hits.ns[sel])
+        # a sampled direction on the wrong side of the geometric surface would leak light
+        transmit = bs.wi_l[sel, 2] < 0
+        geo_ok = (vec.dot(wi, hits.ng[sel]) < 0) == transmit
+        sel, wi, transmit = sel[geo_ok], wi[geo_ok], transmit[geo_ok]
+        if len(sel) == 0:
+            return None
+        passthrough = bs.passthrough[sel]
+        origin = spawn(hits.pos[sel], hits.ng[sel], wi, hits.scale[sel])
+        self._count("refraction", (transmit & ~passthrough).sum())
+        self._count("reflection", (~transmit).sum())
+        self._count("transparent", passthrough.sum())
+        n = len(sel)
+        return PathState(hits.path[sel], origin, wi, np.full(n, np.inf), new_thr[sel],
+                         np.where(bs.delta[sel], np.inf, bs.pdf[sel]), hits.ng[sel], hits.ns[sel],
+                         hits.straight[sel] & passthrough, hits.time[sel])
+
+
+TERMINATOR_CUTOFF = 0.1
+"""Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
+terminator geometry offset)."""
+
+
+def _shadow_origin(pos, ng, wi, cos_shading, lift, scale):
+    """Shadow-ray origin: on the side of the surface the shading normal puts wi, lifted by
+    ``lift`` toward the smooth surface near the terminator (Cycles' rule, faded in by the
+    cosines) so that light the shading normal sees is not cut off by the flat facet."""
+    cos_geo = vec.dot(ng, wi)
+    c = TERMINATOR_CUTOFF
+    amount = np.where(cos_shading < c, np.clip(2.0 - (cos_geo + cos_shading) / c, 0.0, 1.0),
+                      np.clip(1.0 - cos_geo / c, 0.0, 1.0))
+    amount = np.where(cos_shading > 0, amount, 0.0)
+    side = np.where(cos_shading > 0, 1.0, -1.0)[:, None] * ng
+    return spawn(pos + lift * amount[:, None], ng, side, scale)
+
+
+_frame = vec.orthonormal_basis
+
+
+def _to_local(v, t, b, n):
+    return np.stack([vec.dot(v, t), vec.dot(v, b), vec.dot(v, n)], axis=1)
+
+
+def _to_world(v, t, b, n):
+    return v[:, :1] * t + v[:, 1:2] * b + v[:, 2:] * n

@@ -1,0 +1,104 @@
+"""The render plan: what a scene needs, decided before any ray is traced.
+
+The renderer asks the plan which sample dimensions to draw (lens only with an
+aperture, shutter time only when something moves), and the plan lists which ray
+kinds can occur (from the lobes materials really have: zero-weight closures have no
+lobe), which light strategies cast shadow rays, and which passes are computed. The
+report shows it so a user sees what was left out, and tests hold the tracer to it:
+a kind the plan leaves out is never traced.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.motion import Motion
+from .ratio import delta_light, ratio_strategies
+
+RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent")
+
+
+@dataclass
+class RenderPlan:
+    lens: bool  # thin-lens dimension drawn (aperture > 0)
+    time: bool  # shutter dimension drawn (something moves)
+    moving: list[str]  # what moves over the shutter: objects, lights, the camera
+    rays: dict[str, bool]  # ray kind -> can occur
+    strategies: list[str]  # one shadow ray per strategy per shading point, in order
+    left_out: list[str] = field(default_factory=list)  # what the scene does not need
+    passes: list[str] = field(default_factory=list)
+    ratio: list[int] = field(default_factory=list)  # strategies whose diffuse part the ratio estimator takes
+    monte_carlo: list[str] = field(default_factory=list)  # with RATIO: light strategies left to Monte Carlo
+
+    def as_dict(self) -> dict:
+        return {"lens": self.lens, "time": self.time, "moving": list(self.moving), "rays": dict(self.rays),
+                "strategies": list(self.strategies), "passes": list(self.passes), "left_out": list(self.left_out),
+                "ratio": [self.strategies[k] for k in self.ratio], "monte_carlo": list(self.monte_carlo)}
+
+    def summary(self) -> str:
+        """One line for Blender's stats, the console and the CLI."""
+        kinds = ", ".join(k for k in RAY_KINDS if self.rays[k])
+        dims = ["pixel"] + (["lens"] if self.lens else []) + (["time"] if self.time else [])
+        text = f"plan: dims {'+'.join(dims)}; rays {kinds}; {len(self.strategies)} light strategies"
+        if self.left_out:
+            text += "; left out: " + ", ".join(self.left_out)
+        if self.ratio or self.monte_carlo:
+            text += f"; ratio estimator: {len(self.ratio)} lights"
+            if self.monte_carlo:
+                text += "; Monte Carlo: " + ", ".join(self.monte_carlo)
+        return text
+
+
+def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
+    """The plan for one scene (SceneData), its settings and the renderer's built parts."""
+    camera = scene.camera
+    lens = camera.aperture_radius > 0
+    moving = [inst.name or f"instance {i}" for i, inst in enumerate(scene.instances)
+              if Motion(inst.matrices).moving or _deforms(scene.meshes[inst.mesh])]
+    moving += [f"light {light.name or i}" for i, light in enumerate(lights.lights) if i in lights.motions]
+    camera_moves = Motion(camera.matrices).moving
+    if camera_moves:
+        moving.append("camera")
+    time = geometry.moving or lights.moving or camera_moves
+
+    used = {int(m) for m in np.unique(geometry.material)}
+    kinds = {lobe.kind for m in used for lobe in shaders[m].lobes}
+    bounces = settings.max_depth > 0
+    rays = {"camera": True,
+            "shadow": lights.strategies > 0 and bool(kinds),
+            "reflection": bounces and bool(kinds & {"reflect", "glass"}),
+            "refraction": bounces and "glass" in kinds,
+            "transparent": bounces and "transparent" in kinds}
+
+    strategies = []
+    for light in lights.lights[:lights.light_slots] if not lights.selecting else []:
+        strategies.append(f"{light.kind.lower()} {light.name}".strip() + (" (delta)" if delta_light(light) else ""))
+    if lights.selecting:
+        strategies += [f"chosen light slot {k}" for k in range(lights.light_slots)]
+    if len(lights.emissive):
+        strategies.append(f"emissive triangles ({len(lights.emissive)})")
+    if lights.world is not None:
+        strategies.append("world")
+
+    left_out = []
+    if not lens:
+        left_out.append("lens (aperture 0)")
+    if not time:
+        left_out.append("time (nothing moves)")
+    left_out += [f"{k} rays" for k in RAY_KINDS if not rays[k]]
+    if lights.world is None:
+        left_out.append("world sampling (black world)")
+    dropped = len(scene.lights) - len(lights.lights)
+    if dropped:
+        left_out.append(f"{dropped} lights of zero power")
+    ratio = ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] else []
+    by_ratio = settings.shadow_estimator == "RATIO"
+    monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
+    return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo)
+
+
+def _deforms(mesh) -> bool:
+    steps = mesh.motion_vertices
+    return steps is not None and not np.allclose(steps, steps[:1])  # as accel.Geometry decides
+

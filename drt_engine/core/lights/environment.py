@@ -1,0 +1,142 @@
+"""The world as a light: radiance per direction from its shader program, importance sampled.
+
+The program (an Environment Texture through Mapping, times strength, or anything the
+evaluator runs) is tabulated once on an equirectangular grid; each cell's luminance is
+the largest of the radiance at its centre and just inside its corners (a filtered lookup
+spreads a bright texel into the cells around it, which must not be starved of samples;
+a Closest lookup does not, and the inset points then see the cell's own texel).
+Luminance times sin(theta) gives a piecewise-constant density over the sphere (marginal
+over rows, conditional over columns), sampled by inverting the two CDFs with the light's
+2D sample. The radiance itself is always the program's at the
+exact direction, so the table only shapes the density (any table is unbiased).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..base.colour import LUMINANCE
+from ..base.jit import kernel
+from ..scene import World
+from ..shading.nodes import DirectionContext, Evaluator
+from ..shading.textures import Texture, equirect_direction
+
+MAX_WIDTH = 1024
+MIN_WIDTH = 64
+CELL_POINTS = ((0.5, 0.5), (0.05, 0.05), (0.95, 0.05), (0.05, 0.95), (0.95, 0.95))
+"""Where in each table cell the radiance is looked up (the cell's luminance is the largest)."""
+UNIFORM_SHARE = 0.01
+"""Share of the density spread uniformly over the sphere, so no direction with radiance
+has zero density (the table is evaluated at cell centres only)."""
+
+
+class Environment:
+    def __init__(self, world: World, textures: list[Texture]):
+        self.world = world
+        self.textures = textures
+        widths = [textures[n.params["image"]].size[0] for n in world.program.nodes if n.op == "environment"]
+        w = int(np.clip(max(widths, default=MIN_WIDTH), MIN_WIDTH, MAX_WIDTH))
+        h = max(w // 2, 1)
+        self.w, self.h = w, h
+        lum = self._cell_luminance(w, h)
+        v = (np.arange(h) + 0.5) / h
+        sin_t = np.cos((v - 0.5) * np.pi)[:, None]  # sin of the polar angle at the row centre
+        weight = lum * sin_t
+        total = weight.sum()
+        self.mean_radiance = float((lum * sin_t).sum() / max(sin_t.sum() * w, 1e-300))
+        if total <= 0:
+            weight = np.broadcast_to(sin_t, (h, w)).copy()
+            total = weight.sum()
+        cell = (1.0 - UNIFORM_SHARE) * weight / total + UNIFORM_SHARE * sin_t / (sin_t.sum() * w)
+        self.cell = np.ascontiguousarray(cell)  # probability of each cell
+        rows = cell.sum(axis=1)
+        self.row_cdf = np.concatenate([[0.0], np.cumsum(rows)])
+        self.row_cdf /= self.row_cdf[-1]
+        cond = cell / np.maximum(rows[:, None], 1e-300)
+        self.col_cdf = np.concatenate([np.zeros((h, 1)), np.cumsum(cond, axis=1)], axis=1)
+        self.col_cdf = np.ascontiguousarray(self.col_cdf / self.col_cdf[:, -1:])
+        self.cell_area = (2 * np.pi / w) * (np.pi / h)  # in (phi, theta)
+
+    def _cell_luminance(self, w, h, rows_per_chunk=64):
+        lum = np.zeros((h, w))
+        cols = np.arange(w)
+        for r0 in range(0, h, rows_per_chunk):
+            rows = np.arange(r0, min(r0 + rows_per_chunk, h))
+            cc, rr = (x.ravel() for x in np.meshgrid(cols, rows))
+            best = np.zeros(len(cc))
+            for du, dv in CELL_POINTS:
+                dirs = equirect_direction(np.stack([(cc + du) / w, (rr + dv) / h], axis=1))
+                best = np.maximum(best, self.radiance(dirs) @ LUMINANCE)
+            lum[rows] = best.reshape(len(rows), w)
+        return lum
+
+    def radiance(self, dirs: np.ndarray) -> np.ndarray:
+        ev = Evaluator(self.world.program, DirectionContext(dirs), self.textures)
+        return np.asarray(ev(self.world.color), float)
+
+    def sample(self, u: np.ndarray):
+        """Directions and their solid-angle densities for 2D samples u (N, 2)."""
+        return _sample_batch(self.row_cdf, self.col_cdf, self.cell, self.cell_area, np.asarray(u, np.float64))
+
+    def pdf(self, dirs: np.ndarray) -> np.ndarray:
+        return _pdf_batch(self.cell, self.cell_area, np.asarray(dirs, np.float64))
+
+
+@kernel(inline="always")
+def direction_at(u, v):
+    """Scalar form of ``textures.equirect_direction``: the unit direction at (u, v)."""
+    phi = (0.5 - u) * 2 * math.pi
+    elevation = (v - 0.5) * math.pi
+    c = math.cos(elevation)
+    return c * math.cos(phi), c * math.sin(phi), math.sin(elevation)
+
+
+@kernel(inline="always")
+def map_direction(row_cdf, col_cdf, u0, u1):
+    """The direction the table gives the 2D sample u: a row by the marginal CDF, a column by
+    that row's conditional CDF, then uniform within the cell (in u, v)."""
+    h = len(row_cdf) - 1
+    w = col_cdf.shape[1] - 1
+    row = min(max(np.searchsorted(row_cdf, u0, side="right") - 1, 0), h - 1)
+    lo, hi = row_cdf[row], row_cdf[row + 1]
+    fv = min(max((u0 - lo) / max(hi - lo, 1e-300), 0.0), 1.0)
+    col = min(max(np.searchsorted(col_cdf[row], u1, side="right") - 1, 0), w - 1)
+    clo, chi = col_cdf[row, col], col_cdf[row, col + 1]
+    fu = min(max((u1 - clo) / max(chi - clo, 1e-300), 0.0), 1.0)
+    return direction_at((col + fu) / w, (row + fv) / h)
+
+
+@kernel(inline="always")
+def map_pdf(cell, cell_area, dx, dy, dz):
+    """Solid-angle density of ``map_direction`` at direction d: the cell's probability over its
+    solid angle (cell_area in (phi, theta) times sin theta); the cell from the scalar form of
+    ``textures.equirect_uv``."""
+    h, w = cell.shape
+    horizontal = math.sqrt(dx * dx + dy * dy)
+    u = -math.atan2(dy, dx) / (2 * math.pi) + 0.5
+    v = math.atan2(dz, horizontal) / math.pi + 0.5
+    col = min(max(int(u * w), 0), w - 1)
+    row = min(max(int(v * h), 0), h - 1)
+    sin_t = max(horizontal / max(math.sqrt(dx * dx + dy * dy + dz * dz), 1e-300), 1e-12)
+    return cell[row, col] / (cell_area * sin_t)
+
+
+@kernel
+def _sample_batch(row_cdf, col_cdf, cell, cell_area, u):
+    n = len(u)
+    dirs = np.empty((n, 3))
+    pdf = np.empty(n)
+    for j in range(n):
+        dx, dy, dz = map_direction(row_cdf, col_cdf, u[j, 0], u[j, 1])
+        dirs[j, 0], dirs[j, 1], dirs[j, 2] = dx, dy, dz
+        pdf[j] = map_pdf(cell, cell_area, dx, dy, dz)
+    return dirs, pdf
+
+
+@kernel
+def _pdf_batch(cell, cell_area, dirs):
+    pdf = np.empty(len(dirs))
+    for j in range(len(dirs)):
+        pdf[j] = map_pdf(cell, cell_area, dirs[j, 0], dirs[j, 1], dirs[j, 2])
+    return pdf

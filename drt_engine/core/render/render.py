@@ -1,0 +1,151 @@
+"""A render of one SceneData with one RenderSettings: the prepared scene, the progressive
+driver and the integrator put together, and the waves split over the render's threads.
+
+Every random number is drawn from the sampler handed to the integrator with the camera
+sample's own (pixel, sample id): sample k of a pixel comes from replicate k % 2 (see
+adaptive.replicate_samplers), so the film's two halves are independent estimates.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..base import jit
+from ..errors import SceneError
+from ..film.film import Film
+from ..integrator.integrator import Integrator
+from ..integrator.plan import make_plan
+from ..integrator.records import Samples
+from ..sampling.sampler import Sampler
+from ..scene import SceneData
+from ..settings import RenderSettings
+from ..validate import validate_camera
+from . import adaptive
+from .driver import WAVE, ProgressUpdate, drive
+from .prepared import PreparedScene
+
+__all__ = ["WAVE", "ProgressUpdate", "RenderResult", "Renderer", "PreparedScene"]
+
+_MIN_PIECE = 1 << 12  # fewest camera samples in one thread's piece of a wave (smaller waves stay whole)
+
+
+@dataclass
+class RenderResult:
+    passes: dict
+    stats: dict
+    cancelled: bool = False
+    warnings: list = field(default_factory=list)
+    log: list = field(default_factory=list)  # report.ErrorLog entries, one per step
+
+
+class Renderer:
+    """Renders one SceneData with one RenderSettings.
+
+    ``prepared`` (core.prepared.PreparedScene) reuses the Embree scenes, lights and materials
+    built for the same scene with another camera; without it they are built here.
+    """
+
+    def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None):
+        if scene.camera is None:
+            raise SceneError("the scene has no camera")
+        if prepared is None:
+            prepared = PreparedScene(scene)
+        elif not prepared.serves(scene):
+            raise ValueError("the prepared scene was made for another scene")
+        else:
+            validate_camera(scene.camera)
+        self.prepared = prepared
+        self.scene, self.settings, self.camera = scene, settings, scene.camera
+        self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
+        self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
+        self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
+        self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
+        self.timed = self.plan.time
+        self.integrator = Integrator(prepared, scene, settings, self.plan)
+        w, h = self.camera.window_size
+        contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
+        self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio))
+
+    @property
+    def rays(self) -> dict:
+        return self.integrator.rays
+
+    @property
+    def warnings(self) -> list:
+        return self.prepared.warnings
+
+    def render(self, progress=None) -> RenderResult:
+        """Render progressively (core.driver) and return the passes, stats and error log."""
+        s = self.settings
+        first_id, end_id = s.sample_range()
+        cap = end_id - first_id  # samples a pixel takes here: ids first_id.. of the full set
+        replicas = adaptive.replicate_samplers(s.sampling_pattern, self.sampler.samples, s.seed)
+        compiling = jit.first_run()
+        pool = ThreadPoolExecutor(self.threads, thread_name_prefix="DRT") if self.threads > 1 else None
+
+        def trace(pixel, sample):
+            sample = sample + first_id
+            samples = Samples(pixel, self._seed_pixels(pixel), sample)
+            if replicas is None:
+                self._trace(samples, self.sampler, None, pool)
+                return
+            for r, sampler in enumerate(replicas):
+                sel = np.flatnonzero((sample & 1) == r)
+                if len(sel):
+                    half = samples.take(sel)
+                    self._trace(Samples(half.index, half.pixel, half.sample >> 1), sampler, r, pool)
+
+        try:
+            outcome = drive(s, self.film, cap, trace, self.rays, progress)
+        finally:
+            if pool is not None:
+                pool.shutdown(wait=True)
+        if compiling and outcome.stopped != "cancelled":
+            jit.mark_compiled()
+        return self._result(outcome)
+
+    def _seed_pixels(self, index):
+        """Ids in the whole image of the window's pixels ``index``: they seed the samples, so a
+        border render draws the numbers the full render does."""
+        w = self.camera.window_size[0]
+        x0, y0 = self.camera.window[:2]
+        return ((index % w + x0) + (index // w + y0) * self.camera.resolution[0]).astype(np.uint32)
+
+    def _trace(self, samples: Samples, sampler, replicate, pool):
+        """Trace a wave, split into one contiguous piece per thread, and add it to the film.
+
+        Every path depends only on its own (pixel, sample) and Embree answers each ray alone,
+        so the pieces give the values one piece would, and the film receives them in the
+        same order in one call: the image is bit-identical for any thread count. Each piece
+        runs the whole loop (kernels, NumPy's array loops and Embree release the GIL).
+        """
+        n = len(samples)
+        pieces = min(self.threads, max(1, n // _MIN_PIECE))
+        if pieces == 1:
+            values = self.integrator.trace(samples, sampler)
+        else:
+            bounds = np.linspace(0, n, pieces + 1).astype(np.int64)
+            jobs = [pool.submit(self.integrator.trace, samples.take(slice(a, b)), sampler)
+                    for a, b in zip(bounds[:-1], bounds[1:])]
+            parts = [job.result() for job in jobs]
+            values = {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
+        self.film.add(samples.index, values, samples.sample, replicate=replicate)
+
+    def _result(self, outcome) -> RenderResult:
+        s, film = self.settings, self.film
+        n_pix = film.n
+        last = outcome.log.last or {}
+        stats = {"samples": int(film.count.max()) if n_pix else 0, "samples_requested": self.sampler.samples,
+                 "samples_mean": float(film.count.mean()) if n_pix else 0.0,
+                 "elapsed": outcome.elapsed, "cpu": outcome.log.cpu(), "rays": dict(self.rays),
+                 "threads": self.threads, "triangles": self.geometry.triangle_count,
+                 "light_strategies": self.lights.strategies, "stopped_by": outcome.stopped,
+                 "rmse": last.get("rmse"), "relmse": last.get("relmse"),
+                 "adaptive_threshold": outcome.threshold if s.use_adaptive_sampling else None,
+                 "adaptive_first_test": outcome.first if s.use_adaptive_sampling else None,
+                 "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
+        return RenderResult(film.images(), stats, outcome.stopped == "cancelled", list(self.warnings),
+                            outcome.log.entries)

@@ -1,0 +1,1 @@
+"""Shader programs (Blender's node graphs compiled), textures and procedural textures."""

@@ -1,0 +1,506 @@
+"""Shader programs evaluated over all hits of a material at once.
+
+A ``Program`` (core.scene) is Blender's node graph compiled by the export into a list
+of operations; this module evaluates the outputs a material asks for, vectorised over
+the hits. Each operation follows Cycles' SVM definition of its node (svm_math_util.h,
+svm_color_util.h, svm_checker.h, svm_ramp.h, svm_mapping_util.h, svm_normal_map.h,
+svm_bump.h; the procedural textures in core.proctex). Scalars are (N,) arrays, colours and vectors (N, 3).
+
+Coordinates come from a context (``SurfaceContext`` for hits, ``DirectionContext`` for
+the world). A context can be shifted by a small world-space offset: that gives image
+lookups their footprint (the texture coordinates a pixel's footprint covers) and Bump
+its height gradient, both by evaluating the coordinate subgraph again.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..base import vectors as vec
+from ..base.colour import LUMINANCE
+from ..base.constants import TINY
+from ..base.vectors import orthonormal_basis
+from ..scene import Program
+from . import proctex
+from .textures import Texture, equirect_uv
+
+"""Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
+
+
+def _safe_div(a, b):
+    return np.where(b != 0, a / np.where(b != 0, b, 1.0), 0.0)
+
+
+def _fmod(a, b):
+    return np.where(b != 0, np.fmod(a, np.where(b != 0, b, 1.0)), 0.0)
+
+
+def _safe_pow(a, b):
+    ok = (a >= 0) | (np.floor(b) == b)
+    return np.where(ok, np.power(np.where(ok, a, 1.0), b), 0.0)
+
+
+def _wrap(v, lo, hi):
+    r = hi - lo
+    return np.where(r != 0, v - r * np.floor(_safe_div(v - lo, r)), lo)
+
+
+def _math(op, a, b, c):
+    with np.errstate(all="ignore"):
+        table = {
+            "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
+            "DIVIDE": lambda: _safe_div(a, b), "MULTIPLY_ADD": lambda: a * b + c,
+            "POWER": lambda: _safe_pow(a, b),
+            "LOGARITHM": lambda: np.where((a > 0) & (b > 0), _safe_div(np.log(np.maximum(a, TINY)),
+                                                                        np.log(np.maximum(b, TINY))), 0.0),
+            "SQRT": lambda: np.where(a > 0, np.sqrt(np.maximum(a, 0)), 0.0),
+            "INVERSE_SQRT": lambda: np.where(a > 0, 1.0 / np.sqrt(np.maximum(a, TINY)), 0.0),
+            "ABSOLUTE": lambda: np.abs(a), "EXPONENT": lambda: np.exp(a),
+            "MINIMUM": lambda: np.minimum(a, b), "MAXIMUM": lambda: np.maximum(a, b),
+            "LESS_THAN": lambda: (a < b).astype(float), "GREATER_THAN": lambda: (a > b).astype(float),
+            "SIGN": lambda: np.sign(a), "COMPARE": lambda: (np.abs(a - b) <= np.maximum(c, 1e-5)).astype(float),
+            "ROUND": lambda: np.floor(a + 0.5), "FLOOR": lambda: np.floor(a), "CEIL": lambda: np.ceil(a),
+            "TRUNC": lambda: np.trunc(a), "FRACT": lambda: a - np.floor(a), "MODULO": lambda: _fmod(a, b),
+            "FLOORED_MODULO": lambda: np.where(b != 0, a - np.floor(_safe_div(a, b)) * b, 0.0),
+            "WRAP": lambda: _wrap(a, c, b), "SNAP": lambda: np.floor(_safe_div(a, b)) * b,
+            "PINGPONG": lambda: np.where(b != 0, np.abs(_fract_div(a - b, 2 * b) * 2 * b - b), 0.0),
+            "SINE": lambda: np.sin(a), "COSINE": lambda: np.cos(a), "TANGENT": lambda: np.tan(a),
+            "ARCSINE": lambda: np.arcsin(np.clip(a, -1, 1)), "ARCCOSINE": lambda: np.arccos(np.clip(a, -1, 1)),
+            "ARCTANGENT": lambda: np.arctan(a), "ARCTAN2": lambda: np.arctan2(a, b),
+            "SINH": lambda: np.sinh(a), "COSH": lambda: np.cosh(a), "TANH": lambda: np.tanh(a),
+            "RADIANS": lambda: np.radians(a), "DEGREES": lambda: np.degrees(a),
+        }
+        return table[op]()
+
+
+def _fract_div(a, b):
+    q = _safe_div(a, b)
+    return q - np.floor(q)
+
+
+MATH_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT",
+            "INVERSE_SQRT", "ABSOLUTE", "EXPONENT", "MINIMUM", "MAXIMUM", "LESS_THAN", "GREATER_THAN",
+            "SIGN", "COMPARE", "ROUND", "FLOOR", "CEIL", "TRUNC", "FRACT", "MODULO", "FLOORED_MODULO",
+            "WRAP", "SNAP", "PINGPONG", "SINE", "COSINE", "TANGENT", "ARCSINE", "ARCCOSINE", "ARCTANGENT",
+            "ARCTAN2", "SINH", "COSH", "TANH", "RADIANS", "DEGREES")
+
+
+def _normalize(v):
+    """Unit vectors, and 0 where the length is not positive (a NaN input gives 0, as in Cycles)."""
+    length = vec.norm(v)[:, None]
+    return np.where(length > 0, v / np.maximum(length, TINY), 0.0)
+
+
+def _vector_math(op, a, b, c, s):
+    """(vector, value) of Cycles' svm_vector_math."""
+    with np.errstate(all="ignore"):
+        vec = {
+            "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
+            "DIVIDE": lambda: _safe_div(a, b), "MULTIPLY_ADD": lambda: a * b + c,
+            "CROSS_PRODUCT": lambda: np.cross(a, b),
+            "PROJECT": lambda: _safe_div(vec.dot(a, b), vec.dot(b, b))[:, None] * b,
+            "REFLECT": lambda: a - 2 * vec.dot(_normalize(b), a)[:, None] * _normalize(b),
+            "SCALE": lambda: a * s[:, None], "NORMALIZE": lambda: _normalize(a), "ABSOLUTE": lambda: np.abs(a),
+            "MINIMUM": lambda: np.minimum(a, b), "MAXIMUM": lambda: np.maximum(a, b),
+            "FLOOR": lambda: np.floor(a), "CEIL": lambda: np.ceil(a), "FRACTION": lambda: a - np.floor(a),
+            "MODULO": lambda: _fmod(a, b), "WRAP": lambda: _wrap(a, c, b),
+            "SNAP": lambda: np.floor(_safe_div(a, b)) * b,
+            "SINE": lambda: np.sin(a), "COSINE": lambda: np.cos(a), "TANGENT": lambda: np.tan(a),
+        }
+        val = {
+            "DOT_PRODUCT": lambda: vec.dot(a, b), "DISTANCE": lambda: np.linalg.norm(a - b, axis=1),
+            "LENGTH": lambda: np.linalg.norm(a, axis=1),
+        }
+        n = len(a)
+        if op in val:
+            return np.zeros((n, 3)), val[op]()
+        return vec[op](), np.zeros(n)
+
+
+VECTOR_MATH_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT", "PROJECT",
+                   "REFLECT", "SCALE", "NORMALIZE", "ABSOLUTE", "MINIMUM", "MAXIMUM", "FLOOR", "CEIL",
+                   "FRACTION", "MODULO", "WRAP", "SNAP", "SINE", "COSINE", "TANGENT", "DOT_PRODUCT",
+                   "DISTANCE", "LENGTH")
+
+
+def _blend(mode, t, c1, c2):
+    """Cycles' svm_mix for colours: fac t (N, 1), colours (N, 3)."""
+    tm = 1.0 - t
+    with np.errstate(all="ignore"):
+        if mode == "MIX":
+            return c1 + t * (c2 - c1)
+        if mode == "ADD":
+            return c1 + t * c2
+        if mode == "MULTIPLY":
+            return c1 * (tm + t * c2)
+        if mode == "SUBTRACT":
+            return c1 - t * c2
+        if mode == "SCREEN":
+            return 1.0 - (tm + t * (1.0 - c2)) * (1.0 - c1)
+        if mode == "DIVIDE":
+            return np.where(c2 != 0, tm * c1 + t * _safe_div(c1, c2), c1)
+        if mode == "DIFFERENCE":
+            return c1 + t * (np.abs(c1 - c2) - c1)
+        if mode == "EXCLUSION":
+            return np.maximum(c1 + t * (c1 + c2 - 2 * c1 * c2 - c1), 0.0)
+        if mode == "DARKEN":
+            return c1 + t * (np.minimum(c1, c2) - c1)
+        if mode == "LIGHTEN":
+            return c1 + t * (np.maximum(c1, c2) - c1)
+        if mode == "OVERLAY":
+            return np.where(c1 < 0.5, c1 * (tm + 2 * t * c2), 1.0 - (tm + 2 * t * (1.0 - c2)) * (1.0 - c1))
+        if mode == "DODGE":
+            tmp = 1.0 - t * c2
+            return np.where(c1 != 0, np.where(tmp <= 0, 1.0, np.minimum(_safe_div(c1, tmp), 1.0)), c1)
+        if mode == "BURN":
+            tmp = tm + t * c2
+            return np.where(tmp <= 0, 0.0, np.clip(1.0 - _safe_div(1.0 - c1, tmp), 0.0, 1.0))
+        if mode == "SOFT_LIGHT":
+            scr = 1.0 - (1.0 - c2) * (1.0 - c1)
+            return tm * c1 + t * ((1.0 - c1) * c2 * c1 + c1 * scr)
+        if mode == "LINEAR_LIGHT":
+            return c1 + t * (2.0 * c2 - 1.0)
+    raise KeyError(mode)
+
+
+BLEND_MODES = ("MIX", "ADD", "MULTIPLY", "SUBTRACT", "SCREEN", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN",
+               "LIGHTEN", "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT")
+
+
+def rgb_to_hsv(c):
+    """Cycles' rgb_to_hsv (h, s, v in [0, 1])."""
+    r, g, b = c[:, 0], c[:, 1], c[:, 2]
+    cmax = c.max(axis=1)
+    cmin = c.min(axis=1)
+    delta = cmax - cmin
+    s = np.where(cmax != 0, _safe_div(delta, cmax), 0.0)
+    ok = s != 0
+    d = np.where(delta != 0, delta, 1.0)
+    cr, cg, cb = (cmax - r) / d, (cmax - g) / d, (cmax - b) / d
+    h = np.where(r == cmax, cb - cg, np.where(g == cmax, 2.0 + cr - cb, 4.0 + cg - cr)) / 6.0
+    h = np.where(h < 0, h + 1.0, h)
+    return np.stack([np.where(ok, h, 0.0), s, cmax], axis=1)
+
+
+def hsv_to_rgb(hsv):
+    """Cycles' hsv_to_rgb."""
+    h, s, v = hsv[:, 0], hsv[:, 1], hsv[:, 2]
+    h6 = np.where(h == 1.0, 0.0, h) * 6.0
+    i = np.floor(h6)
+    f = h6 - i
+    p, q, t = v * (1 - s), v * (1 - s * f), v * (1 - s * (1 - f))
+    i = i.astype(np.int64) % 6
+    choices = [np.stack(x, 1) for x in ((v, t, p), (q, v, p), (p, v, t), (p, q, v), (t, p, v), (v, p, q))]
+    out = np.choose(i[:, None], choices)
+    return np.where((s == 0)[:, None], v[:, None], out)
+
+
+def euler_matrix(rot):
+    """(N, 3, 3) rotation from XYZ Euler angles (N, 3), Blender's convention (Rz Ry Rx)."""
+    cx, cy, cz = np.cos(rot[:, 0]), np.cos(rot[:, 1]), np.cos(rot[:, 2])
+    sx, sy, sz = np.sin(rot[:, 0]), np.sin(rot[:, 1]), np.sin(rot[:, 2])
+    m = np.empty((len(rot), 3, 3))
+    m[:, 0, 0], m[:, 0, 1], m[:, 0, 2] = cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz
+    m[:, 1, 0], m[:, 1, 1], m[:, 1, 2] = cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz
+    m[:, 2, 0], m[:, 2, 1], m[:, 2, 2] = -sy, cy * sx, cy * cx
+    return m
+
+
+def _mapping(kind, v, loc, rot, scale):
+    m = euler_matrix(rot)
+    if kind == "POINT":
+        return np.einsum("nij,nj->ni", m, v * scale) + loc
+    if kind == "TEXTURE":
+        return _safe_div(np.einsum("nji,nj->ni", m, v - loc), scale)
+    if kind == "VECTOR":
+        return np.einsum("nij,nj->ni", m, v * scale)
+    return _normalize(np.einsum("nij,nj->ni", m, _safe_div(v, scale)))
+
+
+def _ramp(fac, positions, colors, interpolation):
+    """Blender's colour band: constant outside the stops, LINEAR / EASE / CONSTANT between."""
+    pos = np.asarray(positions, float)
+    col = np.asarray(colors, float)
+    f = np.asarray(fac, float)
+    k = np.searchsorted(pos, f, side="right")
+    lo = np.clip(k - 1, 0, len(pos) - 1)
+    hi = np.clip(k, 0, len(pos) - 1)
+    span = pos[hi] - pos[lo]
+    t = np.where(span > 0, (f - pos[lo]) / np.where(span > 0, span, 1.0), 0.0)
+    if interpolation == "CONSTANT":
+        t = np.zeros_like(t)
+    elif interpolation == "EASE":
+        t = t * t * (3.0 - 2.0 * t)
+    out = col[lo] + t[:, None] * (col[hi] - col[lo])
+    return out[:, :3], out[:, 3]
+
+
+def _checker(p, c1, c2, scale):
+    p = (p * scale[:, None] + 0.000001) * 0.999999
+    i = np.abs(np.floor(p)).astype(np.int64) % 2
+    fac = ((i[:, 0] == i[:, 1]) == (i[:, 2] == 1)).astype(float)
+    return np.where(fac[:, None] == 1.0, c1, c2), fac
+
+
+def _map_range(kind, v, a, b, c, d, steps, clamp):
+    t = _safe_div(v - a, b - a)
+    if kind == "STEPPED":
+        t = np.where(steps > 0, np.floor(t * (steps + 1)) / np.where(steps > 0, steps, 1.0), 0.0)
+    elif kind == "SMOOTHSTEP":
+        t = np.clip(t, 0, 1)
+        t = t * t * (3 - 2 * t)
+    elif kind == "SMOOTHERSTEP":
+        t = np.clip(t, 0, 1)
+        t = t * t * t * (t * (t * 6 - 15) + 10)
+    out = c + t * (d - c)
+    if clamp and kind in ("LINEAR", "STEPPED"):
+        out = np.clip(out, np.minimum(c, d), np.maximum(c, d))
+    return out
+
+
+class Evaluator:
+    """Evaluates program outputs in one context; each node at most once (memoised)."""
+
+    def __init__(self, program: Program, ctx, textures: list[Texture]):
+        self.program = program
+        self.ctx = ctx
+        self.textures = textures
+        self.memo: dict[int, tuple] = {}
+        self._footprint: tuple | None = None  # evaluators one pixel-footprint step away in x and y
+
+    def __call__(self, ref) -> np.ndarray:
+        node, output = ref
+        return self.outputs(node)[output]
+
+    def outputs(self, i: int) -> tuple:
+        found = self.memo.get(i)
+        if found is None:
+            found = self.memo[i] = self._run(self.program.nodes[i])
+        return found
+
+    def _shifted(self, dp) -> "Evaluator":
+        return Evaluator(self.program, self.ctx.shifted(dp), self.textures)
+
+    def _footprint_evaluators(self) -> tuple | None:
+        """Evaluators at the hit moved across its pixel footprint (None without one), made once
+        for all the image nodes of the program, so the nodes upstream of them run once per step."""
+        if self._footprint is None:
+            dx, dy = self.ctx.footprint()
+            self._footprint = (None,) if dx is None else (self._shifted(dx), self._shifted(dy))
+        return None if self._footprint[0] is None else self._footprint
+
+    def _run(self, node) -> tuple:
+        n = self.ctx.n
+        x = [self(r) for r in node.inputs] if node.op not in ("bump",) else None
+        p = node.params
+        op = node.op
+        if op == "const":
+            v = np.asarray(p["value"], float)
+            return (np.broadcast_to(v, (n,) + v.shape).copy(),)
+        if op == "coord":
+            return (self.ctx.coord(p["name"], p.get("map", "")),)
+        if op == "attribute":
+            rgba = self.ctx.attribute(p["name"])
+            return rgba[:, :3], rgba[:, :3] @ LUMINANCE, rgba[:, 3]
+        if op == "image":
+            if p.get("projection") == "BOX":
+                return self._image_box(p, node.inputs[0], x[0])
+            return self._image(p, node.inputs[0], x[0])
+        if op == "environment":
+            tex = self.textures[p["image"]]
+            rgba = tex.lookup(equirect_uv(x[0]), None, "REPEAT", p.get("interpolation", "Linear"))
+            return rgba[:, :3], rgba[:, 3]
+        if op == "math":
+            out = _math(p["operation"], x[0], x[1], x[2])
+            return (np.clip(out, 0, 1) if p.get("clamp") else out,)
+        if op == "vector_math":
+            return _vector_math(p["operation"], x[0], x[1], x[2], x[3])
+        if op == "mix":
+            return (self._mix(p, x),)
+        if op == "invert":
+            fac, c = x[0][:, None], x[1]
+            return (c + fac * (1.0 - 2.0 * c),)
+        if op == "gamma":
+            c, g = x[0], x[1][:, None]
+            return (np.where(c > 0, _safe_pow(np.maximum(c, 0), np.broadcast_to(g, c.shape)), c),)
+        if op == "hsv":
+            hue, sat, val, fac, c = x
+            hsv = rgb_to_hsv(c)
+            hsv[:, 0] = np.mod(hsv[:, 0] + hue + 0.5, 1.0)
+            hsv[:, 1] = np.clip(hsv[:, 1] * sat, 0, 1)
+            hsv[:, 2] = hsv[:, 2] * val
+            out = hsv_to_rgb(hsv)
+            return (np.maximum(fac[:, None] * out + (1 - fac[:, None]) * c, 0.0),)
+        if op == "rgb_to_bw":
+            return (x[0] @ LUMINANCE,)
+        if op == "separate":
+            c = rgb_to_hsv(x[0]) if p.get("mode") == "HSV" else x[0]
+            return c[:, 0], c[:, 1], c[:, 2]
+        if op == "combine":
+            c = np.stack(x[:3], axis=1)
+            return (hsv_to_rgb(c) if p.get("mode") == "HSV" else c,)
+        if op == "ramp":
+            return _ramp(x[0], p["positions"], p["colors"], p["interpolation"])
+        if op == "checker":
+            return _checker(x[0], x[1], x[2], x[3])
+        if op in proctex.OPS:
+            return proctex.evaluate(op, p, x)
+        if op == "mapping":
+            return (_mapping(p["type"], x[0], x[1], x[2], x[3]),)
+        if op == "normal_map":
+            return (self._normal_map(p, x[0], x[1]),)
+        if op == "bump":
+            return (self._bump(p, node.inputs),)
+        if op == "clamp":
+            v, lo, hi = x
+            if p.get("type") == "RANGE":
+                lo, hi = np.minimum(lo, hi), np.maximum(lo, hi)
+            return (np.minimum(np.maximum(v, lo), hi),)
+        if op == "map_range":
+            return (_map_range(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
+        if op == "convert":
+            return (_convert(p["kind"], x[0]),)
+        raise KeyError(f"unknown program op {op!r}")
+
+    def _mix(self, p, x):
+        fac, a, b = x
+        kind = p.get("data_type", "RGBA")
+        if kind == "FLOAT":
+            t = np.clip(fac, 0, 1) if p.get("clamp_factor", True) else fac
+            return a + t * (b - a)
+        if fac.ndim == 1:
+            fac = fac[:, None]
+        t = np.clip(fac, 0, 1) if p.get("clamp_factor", True) else fac
+        if kind == "VECTOR":
+            return a + t * (b - a)
+        out = _blend(p.get("blend", "MIX"), t, a, b)
+        return np.clip(out, 0, 1) if p.get("clamp_result") else out
+
+    def _image(self, p, vector_ref, uv3):
+        tex = self.textures[p["image"]]
+        uv = uv3[:, :2]
+        footprint = None
+        if p.get("interpolation", "Linear") != "Closest":
+            shifted = self._footprint_evaluators()
+            if shifted is not None:
+                footprint = tuple(e(vector_ref)[:, :2] - uv for e in shifted)
+        rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+        return rgba[:, :3], rgba[:, 3]
+
+    def _image_box(self, p, vector_ref, co):
+        """Cycles' svm_node_tex_image_box: up to three planar lookups, one per axis of the
+        object-space normal, weighted by it with ``blend`` softening the seams."""
+        tex = self.textures[p["image"]]
+        normal = self.ctx.coord("normal")
+        weights = box_weights(normal, p.get("blend", 0.0))
+        footprint = None
+        if p.get("interpolation", "Linear") != "Closest":
+            shifted = self._footprint_evaluators()
+            if shifted is not None:
+                footprint = tuple(e(vector_ref) - co for e in shifted)
+        out = np.zeros((self.ctx.n, 4))
+        # per face: the two coordinates read, and which normal sign flips the first (no mirrored images)
+        faces = ((1, 2, normal[:, 0] < 0), (0, 2, normal[:, 1] > 0), (1, 0, normal[:, 2] > 0))
+        for axis, (u, v, flip) in enumerate(faces):
+            sel = np.flatnonzero(weights[:, axis] > 0)
+            if len(sel) == 0:
+                continue
+            sign = np.where(flip[sel], -1.0, 1.0)
+            uv = np.stack([np.where(flip[sel], 1.0 - co[sel, u], co[sel, u]), co[sel, v]], axis=1)
+            fp = None if footprint is None else tuple(
+                np.stack([d[sel, u] * sign, d[sel, v]], axis=1) for d in footprint)
+            rgba = tex.lookup(uv, fp, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+            out[sel] += weights[sel, axis, None] * rgba
+        return out[:, :3], out[:, 3]
+
+    def _normal_map(self, p, strength, color):
+        ctx = self.ctx
+        n = ctx.normal
+        t, sign = ctx.tangent(p.get("map", ""))
+        b = sign[:, None] * np.cross(n, t)
+        c = 2.0 * color - 1.0
+        out = _normalize(c[:, :1] * t + c[:, 1:2] * b + c[:, 2:] * n)
+        s = np.maximum(strength, 0.0)[:, None]
+        return _normalize(n + (out - n) * s)
+
+    def _bump(self, p, refs):
+        strength_ref, distance_ref, height_ref, normal_ref = refs
+        strength = np.clip(self(strength_ref), 0, 1)[:, None]
+        dist = self(distance_ref) * (-1.0 if p.get("invert") else 1.0)
+        n = self(normal_ref) if normal_ref is not None else self.ctx.normal
+        t, b = orthonormal_basis(n)
+        eps = self.ctx.bump_step()
+        h = self(height_ref)
+        hx = self._shifted(t * eps[:, None])(height_ref)
+        hy = self._shifted(b * eps[:, None])(height_ref)
+        grad = ((hx - h) / eps)[:, None] * t + ((hy - h) / eps)[:, None] * b
+        out = _normalize(n - dist[:, None] * grad)
+        return _normalize(strength * out + (1.0 - strength) * n)
+
+
+def box_weights(normal, blend):
+    """(N, 3) weights of the x, y and z projections of Box mapping (Cycles' seven zones of the
+    normal's barycentric triangle: one face, two blended, or all three in the middle)."""
+    a = np.abs(normal)
+    a = a / np.maximum(a.sum(axis=1, keepdims=True), TINY)
+    x, y, z = a[:, 0], a[:, 1], a[:, 2]
+    limit = 0.5 * (1.0 + blend)
+    w = np.zeros_like(a)
+    with np.errstate(all="ignore"):
+        zones = [
+            (x > limit * (x + y)) & (x > limit * (x + z)),
+            (y > limit * (x + y)) & (y > limit * (y + z)),
+            (z > limit * (x + z)) & (z > limit * (y + z)),
+        ]
+        for axis, zone in enumerate(zones):
+            w[zone, axis] = 1.0
+        rest = ~(zones[0] | zones[1] | zones[2])
+        if blend <= 0.0:
+            w[rest, 0] = 1.0  # Cycles' fallback: no valid face, use x
+            return w
+        pairs = ((z < (1 - limit) * (y + x), 0, 1, x, y), (x < (1 - limit) * (y + z), 1, 2, y, z),
+                 (y < (1 - limit) * (x + z), 0, 2, x, z))
+        for cond, i, j, a_i, a_j in pairs:
+            sel = rest & cond
+            t = np.clip((a_i / (a_i + a_j) - 0.5 * (1.0 - blend)) / blend, 0.0, 1.0)
+            w[sel, i] = t[sel]
+            w[sel, j] = 1.0 - t[sel]
+            rest = rest & ~cond
+        three = ((2.0 - limit) * a + (limit - 1.0)) / (2.0 * limit - 1.0)
+        w[rest] = three[rest]
+    return w
+
+
+def _convert(kind, v):
+    if kind == "color_to_float":
+        return v @ LUMINANCE
+    if kind == "vector_to_float":
+        return v.mean(axis=1)
+    return np.repeat(v[:, None], 3, axis=1)  # float to colour or vector
+
+
+class DirectionContext:
+    """World lookups: every coordinate is the world-space ray direction."""
+
+    def __init__(self, directions):
+        self.dirs = np.asarray(directions, float)
+        self.n = len(self.dirs)
+        self.normal = self.dirs
+
+    def coord(self, name, uv_map=""):
+        return self.dirs
+
+    def attribute(self, name):
+        return np.zeros((self.n, 4))
+
+    def footprint(self):
+        return None, None
+
+    def shifted(self, dp):
+        return DirectionContext(self.dirs + dp)
+
+    def tangent(self, uv_map):
+        t, _ = orthonormal_basis(self.dirs)
+        return t, np.ones(self.n)
+
+    def bump_step(self):
+        return np.full(self.n, 1e-4)

@@ -1,0 +1,321 @@
+"""Per-hit materials: shader programs evaluated at the hits, bound to the BSDF lobes.
+
+For each material with varying inputs, ``MaterialShading.bind`` evaluates the program
+over all hits of the material in a wave and splits them into groups that share one
+``MaterialShader``: colours and closure weights enter the lobes per hit exactly, the
+other inputs (roughness, metallic, IOR, ...) are rounded to 1/256 (the precision of an
+8-bit texture; coarser when several vary at once and a wave would need more than
+MAX_GROUPS shaders) and each distinct combination gets its own shader, built once and
+cached, since their energy tables are tabulated per lobe.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..base import vectors as vec
+from ..bsdf.shader import MaterialShader, Tables
+from ..scene import Closure, Material, SceneData
+from .nodes import Evaluator
+from .textures import Texture
+
+LINEAR_INPUTS = ("weight", "color")
+"""Inputs that enter the lobes per hit; the others key a cached shader."""
+QUANTUM = 256.0
+MIN_QUANTUM = 8.0
+MAX_GROUPS = 64
+CACHE_LIMIT = 4096
+GRID_TABLES = Tables(grid=True)
+EXACT_TABLES = Tables()
+
+
+class SurfaceContext:
+    """Coordinates of a batch of hits for shader programs; ``shifted`` moves them on the surface."""
+
+    def __init__(self, attrs: "SurfaceAttributes", prim, bary, pos, normal, width=None, direction=None):
+        self.attrs = attrs
+        self.prim = prim
+        self.bary = bary
+        self.pos = pos
+        self.normal = normal
+        self.width = width
+        self.direction = direction
+        self.n = len(prim)
+
+    def shifted(self, dp):
+        db = self.attrs.bary_shift(self.prim, dp)
+        return SurfaceContext(self.attrs, self.prim, self.bary + db, self.pos + dp, self.normal, None,
+                              self.direction)
+
+    def coord(self, name, uv_map=""):
+        a = self.attrs
+        if name == "uv":
+            uv = a.corner(self.prim, self.bary, ("uv", uv_map))
+            return np.concatenate([uv[:, :2], np.zeros((self.n, 1))], axis=1)
+        if name == "position":
+            return self.pos
+        if name == "normal_world":
+            return self.normal
+        if name == "incoming":
+            return -self.direction if self.direction is not None else self.normal
+        if name == "normal":
+            return a.object_normal(self.prim, self.normal)
+        p = a.object_position(self.prim, self.bary)
+        if name == "generated":
+            lo, size = a.texspace(self.prim)
+            return np.where(size > 0, (p - lo) / np.maximum(size, 1e-30), 0.0)
+        return p  # "object"
+
+    def attribute(self, name):
+        return self.attrs.corner(self.prim, self.bary, ("color", name))
+
+    def footprint(self):
+        """World-space vectors spanning a pixel's footprint on the surface (major, minor axis)."""
+        if self.width is None:
+            return None, None
+        n = self.normal
+        d = self.direction
+        cos = np.abs(np.einsum("ij,ij->i", d, n))
+        along = d - n * np.einsum("ij,ij->i", d, n)[:, None]
+        fallback = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+        along = np.where((np.linalg.norm(along, axis=1) > 1e-9)[:, None], along, fallback)
+        major = vec.normalize(along, 1e-300)
+        minor = vec.normalize(np.cross(n, major), 1e-300)
+        w = self.width[:, None]
+        return major * w / np.maximum(cos, 1e-2)[:, None], minor * w
+
+    def tangent(self, uv_map):
+        return self.attrs.tangent(self.prim, self.normal, uv_map, self.bary)
+
+    def bump_step(self):
+        w = self.width if self.width is not None else np.zeros(self.n)
+        return np.maximum(0.1 * w, 1e-6 * (1.0 + np.abs(self.pos).max(axis=1)))
+
+
+class SurfaceAttributes:
+    """Per-triangle access to the meshes' corner data through ``Geometry.source``."""
+
+    def __init__(self, scene: SceneData, geometry):
+        self.scene = scene
+        self.geometry = geometry
+        self.source = geometry.source
+        self._mesh_of = np.array([instance.mesh for instance in scene.instances], np.int64)
+        self._texspaces = {}  # id(mesh) -> (corner, size); the scene outlives this object
+
+    def _groups(self, prim):
+        inst = self.source[prim, 0]
+        for i in np.unique(inst):
+            sel = np.flatnonzero(inst == i)
+            yield sel, self.scene.instances[i], self.scene.meshes[self._mesh_of[i]], self.source[prim[sel], 1]
+
+    def corner(self, prim, bary, key):
+        kind, name = key
+        width = 2 if kind == "uv" else 4
+        out = np.zeros((len(prim), width))
+        for sel, _, mesh, tri in self._groups(prim):
+            if name:
+                data = mesh.attributes.get(name)
+            else:
+                data = mesh.uvs if kind == "uv" else mesh.colors
+            if data is None or data.shape[2] < width - (2 if kind == "color" else 0):
+                continue
+            values = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
+            out[sel, :values.shape[1]] = values[:, :width]
+            if kind == "color" and values.shape[1] < 4:
+                out[sel, 3] = 1.0
+        return out
+
+    def object_position(self, prim, bary):
+        out = np.zeros((len(prim), 3))
+        for sel, _, mesh, tri in self._groups(prim):
+            out[sel] = np.einsum("ni,nij->nj", bary[sel], mesh.vertices[mesh.triangles[tri]])
+        return out
+
+    def object_normal(self, prim, normal):
+        out = np.zeros((len(prim), 3))
+        for sel, inst, _, _ in self._groups(prim):
+            out[sel] = vec.normalize(normal[sel] @ inst.matrix[:3, :3], 1e-300)
+        return out
+
+    def texspace(self, prim):
+        lo = np.zeros((len(prim), 3))
+        size = np.ones((len(prim), 3))
+        for sel, _, mesh, _ in self._groups(prim):
+            lo[sel], size[sel] = self._texspace_of(mesh)
+        return lo, size
+
+    def _texspace_of(self, mesh):
+        """(corner, size) of the mesh's texture space: its own, or its bounds, found once a render."""
+        found = self._texspaces.get(id(mesh))
+        if found is None:
+            if mesh.texspace is not None:
+                loc, half = (np.asarray(x, float) for x in mesh.texspace)
+            else:
+                a, b = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+                loc, half = 0.5 * (a + b), 0.5 * (b - a)
+            found = self._texspaces[id(mesh)] = (loc - half, 2.0 * half)
+        return found
+
+    def _edges(self, prim):
+        """World-space edges (mid-shutter) of triangles ``prim`` from their first corner."""
+        p = self.geometry.world_vertices[self.geometry.triangles[prim]]
+        return p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+
+    def bary_shift(self, prim, dp):
+        """Barycentric change for a world-space step dp in the triangle's plane."""
+        e1, e2 = self._edges(prim)
+        a11 = np.einsum("ij,ij->i", e1, e1)
+        a12 = np.einsum("ij,ij->i", e1, e2)
+        a22 = np.einsum("ij,ij->i", e2, e2)
+        r1 = np.einsum("ij,ij->i", e1, dp)
+        r2 = np.einsum("ij,ij->i", e2, dp)
+        det = a11 * a22 - a12 * a12
+        det = np.where(np.abs(det) > 1e-300, det, 1e-300)
+        b1 = (a22 * r1 - a12 * r2) / det
+        b2 = (a11 * r2 - a12 * r1) / det
+        return np.stack([-(b1 + b2), b1, b2], axis=1)
+
+    def tangent(self, prim, normal, uv_map, bary=None):
+        """Unit tangent along +u of the UV map, orthogonal to ``normal``, and the bitangent sign:
+        the mesh's exported MikkTSpace tangents where it has them, else the triangle's dP/du."""
+        t, sign = self._triangle_tangent(prim, normal, uv_map)
+        if bary is None:
+            return t, sign
+        for sel, inst, mesh, tri in self._groups(prim):
+            data = mesh.attributes.get("tangent:" + uv_map)
+            if data is None:
+                continue
+            v = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
+            world = v[:, :3] @ inst.matrix[:3, :3].T
+            world -= normal[sel] * np.einsum("ij,ij->i", world, normal[sel])[:, None]
+            ok = np.linalg.norm(world, axis=1) > 1e-12
+            t[sel[ok]] = vec.normalize(world[ok], 1e-300)
+            sign[sel] = np.where(v[:, 3] < 0, -1.0, 1.0) * np.sign(np.linalg.det(inst.matrix[:3, :3]) or 1.0)
+        return t, sign
+
+    def _triangle_tangent(self, prim, normal, uv_map):
+        bary = np.tile([1.0, 0.0, 0.0], (len(prim), 1))
+        uv0 = self.corner(prim, bary, ("uv", uv_map))
+        uv1 = self.corner(prim, np.tile([0.0, 1.0, 0.0], (len(prim), 1)), ("uv", uv_map))
+        uv2 = self.corner(prim, np.tile([0.0, 0.0, 1.0], (len(prim), 1)), ("uv", uv_map))
+        du1, dv1 = (uv1 - uv0).T
+        du2, dv2 = (uv2 - uv0).T
+        det = du1 * dv2 - du2 * dv1
+        det = np.where(np.abs(det) > 1e-20, det, 1e-20)
+        e1, e2 = self._edges(prim)
+        dpdu = (e1 * dv2[:, None] - e2 * dv1[:, None]) / det[:, None]
+        dpdv = (e2 * du1[:, None] - e1 * du2[:, None]) / det[:, None]
+        t = vec.normalize(dpdu - normal * np.einsum("ij,ij->i", dpdu, normal)[:, None], 1e-300)
+        sign = np.where(np.einsum("ij,ij->i", np.cross(normal, t), dpdv) < 0, -1.0, 1.0)
+        return t, sign
+
+
+class MaterialShading:
+    """One material: its constant shader, or its program and the shaders bound per hit."""
+
+    def __init__(self, material: Material, textures: list[Texture], warnings: list[str] | None = None):
+        self.material = material
+        self.textures = textures
+        self.shader = MaterialShader(material)
+        self.varying = material.program is not None and any(c.inputs for c in material.closures)
+        self.normal_ref = next((c.inputs["normal"] for c in material.closures if "normal" in c.inputs), None)
+        self.emitters = [c for c in material.closures if c.kind in ("EMISSION", "PRINCIPLED")
+                         and ("emission" in c.inputs or ("weight" in c.inputs and np.any(c.emission > 0)))]
+        self.varying_emission = material.program is not None and bool(self.emitters)
+        self._cache: dict[bytes, MaterialShader] = {}
+        self.coarsened = False
+        self.warnings = warnings if warnings is not None else []  # the renderer's, added to while rendering
+
+    @property
+    def emission(self):
+        return self.shader.emission
+
+    def emission_at(self, ctx: SurfaceContext) -> np.ndarray:
+        """(N, 3) emitted radiance of a material with varying emission at the points of ``ctx``."""
+        ev = Evaluator(self.material.program, ctx, self.textures)
+        total = np.zeros((ctx.n, 3))
+        for c in self.material.closures:
+            if c.kind not in ("EMISSION", "PRINCIPLED"):
+                continue
+            e = np.asarray(ev(c.inputs["emission"]), float) if "emission" in c.inputs else c.emission
+            w = np.asarray(ev(c.inputs["weight"]), float) if "weight" in c.inputs else c.weight
+            total += w * e
+        return total
+
+    def bind(self, ctx: SurfaceContext):
+        """[(hit indices, shader bound to them)] and the per-hit shading normal (or None)."""
+        if not self.varying:
+            return [(np.arange(ctx.n), self.shader)], None
+        ev = Evaluator(self.material.program, ctx, self.textures)
+        normal = ev(self.normal_ref) if self.normal_ref is not None else None
+        linear = {}
+        keyed = []
+        for i, c in enumerate(self.material.closures):
+            for name, ref in c.inputs.items():
+                if name in ("normal", "emission"):
+                    continue
+                value = np.asarray(ev(ref), float)
+                if name in LINEAR_INPUTS:
+                    linear.setdefault(i, {})[name] = np.broadcast_to(
+                        value if value.ndim == 2 else value[:, None], (ctx.n, 3))
+                else:
+                    v = value if value.ndim == 2 else value[:, None]
+                    keyed.append((i, name, v))
+        if keyed:
+            keys, inverse, keyed = self._quantise(keyed)
+        else:
+            keys, inverse = np.zeros((1, 0)), np.zeros(ctx.n, np.int64)
+        out = []
+        for k, key in enumerate(keys):
+            rows = np.flatnonzero(inverse == k)
+            shader = self._shader_for(key, keyed, linear)
+            values = {i: {name: v[rows] for name, v in d.items()} for i, d in linear.items()}
+            out.append((rows, shader.bind(values) if values else shader))
+        return out, normal
+
+    def _quantise(self, keyed):
+        """Distinct rounded values of the keyed inputs: steps of 1/QUANTUM, coarsened by halves
+        while a wave would need more than MAX_GROUPS shaders (several textured inputs at once)."""
+        table = np.concatenate([k[2] for k in keyed], axis=1)
+        quantum = QUANTUM
+        while True:
+            keys, inverse = np.unique(np.round(table * quantum) / quantum, axis=0, return_inverse=True)
+            if len(keys) <= MAX_GROUPS or quantum <= MIN_QUANTUM:
+                break
+            quantum /= 2
+        if quantum < QUANTUM and not self.coarsened:
+            self.coarsened = True
+            self.warnings.append(f"material '{self.material.name}': its textured inputs other than colours "
+                              f"were rounded to steps of 1/{int(quantum)}")
+        return keys, inverse.reshape(-1), keyed
+
+    def _shader_for(self, key, keyed, linear) -> MaterialShader:
+        token = key.tobytes()
+        shader = self._cache.get(token)
+        if shader is not None:
+            return shader
+        closures = [replace(c, inputs={}) for c in self.material.closures]
+        col = 0
+        for i, name, v in keyed:
+            width = v.shape[1]
+            value = key[col:col + width]
+            col += width
+            setattr(closures[i], name, float(value[0]) if width == 1 else np.resize(value, 3))
+        for i, d in linear.items():
+            for name in d:
+                setattr(closures[i], name, np.ones(3))
+        closures = [Closure(**{f: getattr(c, f) for f in c.__dataclass_fields__}) for c in closures]
+        varying = {i: tuple(d) for i, d in linear.items()}
+        shader = MaterialShader(Material(self.material.name, closures), varying, GRID_TABLES if keyed else EXACT_TABLES)
+        if len(self._cache) < CACHE_LIMIT:
+            self._cache[token] = shader
+        return shader
+
+
+def load_textures(scene: SceneData, warnings: list[str]) -> list[Texture]:
+    textures = [Texture(image) for image in scene.images]
+    for t in textures:
+        if t.error:
+            warnings.append(f"image '{t.name}' could not be read ({t.error}): rendered magenta")
+    return textures
