@@ -30,11 +30,11 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import numpy as np  # noqa: E402
-from readme import write_block  # noqa: E402
 
 from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from readme import write_block  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 REFERENCE_SAMPLES = 2048
@@ -84,9 +84,8 @@ def log_interp(points, t):
 
 
 def sample_scenes(width, names):
-    from scenes import load
-
     import drt_engine
+    from scenes import load
 
     drt_engine.register()
     for name in names:

@@ -17,10 +17,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from scenes import SCENES, load, settings  # noqa: E402
-
 import drt_engine  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
+from scenes import SCENES, load, settings  # noqa: E402
 
 MODULES = ("core/lights.py", "core/environment.py")
 TOP = 6

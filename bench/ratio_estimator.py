@@ -25,12 +25,12 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 import numpy as np  # noqa: E402
-from readme import write_block  # noqa: E402
 
-from drt_engine.core.film.ratio_sums import RATIO  # noqa: E402
 from drt_engine.core.render.adaptive import RELMSE_EPSILON, true_error  # noqa: E402
+from drt_engine.core.film.ratio_sums import RATIO  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from readme import write_block  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 ESTIMATORS = ("MONTE_CARLO", "RATIO")
@@ -109,9 +109,8 @@ def measure(name, data, base, spps, seeds, ref_samples) -> dict:
 
 
 def sample_scenes(width, names):
-    from scenes import load, settings
-
     import drt_engine
+    from scenes import load, settings
 
     drt_engine.register()
     for name in names:

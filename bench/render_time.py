@@ -17,12 +17,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "bench")]
 
-from scenes import SCENES, load, settings  # noqa: E402
-
 import drt_engine  # noqa: E402
 from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
-
+from scenes import SCENES, load, settings  # noqa: E402
 
 def by_module(stats: pstats.Stats) -> dict[str, float]:
     """Own (tottime) CPU seconds per drt_engine.core module, the rest lumped as 'other'."""

@@ -43,14 +43,14 @@ sys.path[:0] = [str(ROOT), str(ROOT / "bench")]
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
-from readme import write_block  # noqa: E402
-from scenes import SCENES, load, settings  # noqa: E402
 
 import drt_engine  # noqa: E402
 from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.render.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from readme import write_block  # noqa: E402
+from scenes import SCENES, load, settings  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tests" / "blender"))
 from render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)

@@ -33,15 +33,16 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import bpy  # noqa: E402
 import numpy as np  # noqa: E402
-from readme import write_block  # noqa: E402
-from scenes import SCENES, load, settings  # noqa: E402
-from startup import describe, measure  # noqa: E402
 
 import drt_engine  # noqa: E402
 from drt_engine.core.geometry import camera as camera_rays  # noqa: E402
 from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render.render import WAVE, Renderer  # noqa: E402
+from readme import write_block  # noqa: E402
+from scenes import SCENES, load, settings  # noqa: E402
+from startup import describe, measure  # noqa: E402
 
 TARGET_RATIO = 0.35
 TARGET_SPEEDUP = 1.6

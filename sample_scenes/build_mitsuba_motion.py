@@ -36,9 +36,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # scene_helpers, also under `blender --python`
+import scene_helpers as sh  # noqa: E402
+
 import bmesh  # noqa: E402
 import bpy  # noqa: E402
-import scene_helpers as sh  # noqa: E402
 from mathutils import Matrix, Vector  # noqa: E402
 
 RESOLUTION = 48

@@ -10,8 +10,8 @@ import math
 import sys
 from pathlib import Path
 
-import bmesh
 import bpy  # first: it puts Blender's own modules (bmesh, mathutils) on sys.path
+import bmesh
 from mathutils import Vector
 
 HERE = Path(__file__).resolve().parent

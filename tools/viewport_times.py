@@ -18,7 +18,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from bench.readme import write_block  # noqa: E402
-
 TIMES = ROOT / "out" / "ui" / "viewport_times.json"
 
 

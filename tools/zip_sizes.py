@@ -13,7 +13,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from bench.readme import write_block  # noqa: E402
-
 NOTES = {"macos_arm64": " (PyPI has no embreex 4.4 wheel for Intel Macs)"}
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 import bpy
 import mathutils
 import numpy as np
+
 from datablocks import new_material, new_world
 from export_helpers import empty_scene
 

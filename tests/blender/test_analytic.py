@@ -22,6 +22,7 @@ import math
 import bpy
 import numpy as np
 import pytest
+
 import render_helpers as rh
 from datablocks import new_material, new_world
 

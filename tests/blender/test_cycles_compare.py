@@ -60,6 +60,7 @@ from typing import Callable
 import bpy
 import numpy as np
 import pytest
+
 import render_helpers as rh
 from datablocks import new_material, new_world
 

@@ -13,22 +13,15 @@ import bpy
 import numpy as np
 import OpenImageIO as oiio
 import pytest
-from datablocks import new_compositor
 
 import drt_engine.blender.engine as engine_module
-from drt_engine.blender.engine import DRTRenderEngine, render_window
 from drt_engine.core.render import adaptive
+from drt_engine.blender.engine import DRTRenderEngine, render_window
 from drt_engine.core.render.render import WAVE, Renderer
-from drt_engine.core.scene import (
-    DEFAULT_MATERIAL,
-    Camera,
-    Closure,
-    Instance,
-    Material,
-    Mesh,
-    SceneData,
-)
+from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import PASSES, RenderSettings
+
+from datablocks import new_compositor
 
 STRENGTH = 2.0
 LAYER = "ViewLayer"

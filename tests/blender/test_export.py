@@ -12,13 +12,14 @@ import bpy
 import numpy as np
 import pytest
 from bpy_extras.object_utils import world_to_camera_view
-from datablocks import new_material, new_world
-from export_helpers import add_object, cube_mesh, empty_scene, render_export, total_area
 from mathutils import Vector
 
 from drt_engine.blender.export import export_scene
 from drt_engine.core.errors import SceneError
 from drt_engine.core.scene import DEFAULT_MATERIAL
+
+from datablocks import new_material, new_world
+from export_helpers import add_object, cube_mesh, empty_scene, render_export, total_area
 
 # ---------------------------------------------------------------- geometry
 

@@ -17,6 +17,7 @@ import bpy
 import numpy as np
 import psutil
 import pytest
+
 from render_helpers import read_channels
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -43,6 +43,7 @@ import sys
 
 import numpy as np
 import pytest
+
 import render_helpers as rh
 
 sys.path.insert(0, str(rh.ROOT / "sample_scenes"))

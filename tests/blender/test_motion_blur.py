@@ -11,6 +11,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
+
 from conftest import emission_material, render_exr
 from datablocks import new_world
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
+
 import render_helpers as rh
 from datablocks import new_material, new_world
 from test_cycles_compare import add_light, focused_scene

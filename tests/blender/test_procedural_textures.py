@@ -9,8 +9,9 @@ is checked the same way on an emissive sphere.
 """
 from __future__ import annotations
 
-import procedural_scenes as ps
 import pytest
+
+import procedural_scenes as ps
 import render_helpers as rh
 from export_helpers import render_export
 

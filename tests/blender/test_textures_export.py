@@ -11,13 +11,13 @@ from pathlib import Path
 import bpy
 import numpy as np
 import pytest
-import render_helpers as rh
-from datablocks import new_material, new_world
-from export_helpers import add_object, empty_scene, render_export
 
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import MAGENTA, srgb_to_linear
+import render_helpers as rh
+from datablocks import new_material, new_world
+from export_helpers import add_object, empty_scene, render_export
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 from textured_scenes import write_image  # noqa: E402

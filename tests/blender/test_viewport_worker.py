@@ -9,15 +9,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 
-from scenes import look_at  # noqa: E402
-from test_determinism import scene  # noqa: E402
-
 from drt_engine.blender.export.viewport import level_cameras  # noqa: E402
 from drt_engine.blender.viewport import ViewportRender  # noqa: E402
 from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.scene import Camera  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
+from scenes import look_at  # noqa: E402
+from test_determinism import scene  # noqa: E402
 
 
 def finish(viewport):

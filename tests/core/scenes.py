@@ -1,15 +1,7 @@
 """Small scenes written by hand for core tests (no Blender)."""
 import numpy as np
 
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    Mesh,
-    SceneData,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
 
 
 def translation(x=0.0, y=0.0, z=0.0):

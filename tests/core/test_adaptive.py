@@ -9,21 +9,13 @@ import time
 
 import numpy as np
 import pytest
-from scenes import translation
 
-from drt_engine.core.film.film import Film
 from drt_engine.core.render import adaptive
+from drt_engine.core.film.film import Film
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    Mesh,
-    SceneData,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
+from scenes import translation
 
 RES = 24
 EMISSION = 0.5

@@ -1,19 +1,11 @@
 """Same settings and seed give the same image bit for bit, whatever the thread count."""
 import numpy as np
 import pytest
-from scenes import look_at, plane, uv_sphere
 
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    World,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import PASSES, RenderSettings
+from scenes import look_at, plane, uv_sphere
 
 
 def scene():
@@ -60,9 +52,8 @@ def test_bit_identical_when_waves_are_split_over_threads(monkeypatch):
 
 
 def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
-    from textured_scenes import environment_world, image_program
-
     from drt_engine.core.scene import TextureImage
+    from textured_scenes import environment_world, image_program
 
     base = scene()
     rng = np.random.default_rng(4)

@@ -1,11 +1,11 @@
 """Depth of field and motion blur measured against their geometric predictions."""
 import numpy as np
 import pytest
-from scenes import plane, translation
 
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
+from scenes import plane, translation
 
 GLOW = Material("glow", [Closure("EMISSION", emission=(1.0, 1.0, 1.0))])
 

@@ -1,22 +1,15 @@
 """Image-based lighting: the world from an environment map, importance sampled, with MIS."""
 import numpy as np
 import pytest
-from scenes import look_at, uv_sphere
-from textured_scenes import environment_world, ortho_top, uv_plane
 
 from drt_engine.core.bsdf import microfacet as mf
 from drt_engine.core.lights.environment import Environment
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Material,
-    SceneData,
-    TextureImage,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import Texture, equirect_direction, equirect_uv
+from scenes import look_at, uv_sphere
+from textured_scenes import environment_world, ortho_top, uv_plane
 
 L = 0.7
 

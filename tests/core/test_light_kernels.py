@@ -4,28 +4,17 @@ pdf, pdf), the choice among many lights picks each light as often as its stated 
 and the environment table's samples follow the density ``map_pdf`` states."""
 import numpy as np
 import pytest
-from scenes import look_at, plane, top_camera, translation
-from textured_scenes import environment_world
 
-from drt_engine.core.lights.choice import pick_light, pick_probability
-from drt_engine.core.lights.collection import (
-    _intersect_batch,
-    _pdf_batch,
-    _sample_batch,
-)
 from drt_engine.core.lights.environment import Environment, direction_at, map_pdf
+from drt_engine.core.lights.choice import pick_light, pick_probability
 from drt_engine.core.lights.kinds import light_table
+from drt_engine.core.lights.collection import _intersect_batch, _pdf_batch, _sample_batch
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    TextureImage,
-)
+from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import Texture, equirect_direction
+from scenes import look_at, plane, top_camera, translation
+from textured_scenes import environment_world
 
 RNG = np.random.default_rng(17)
 ABOVE = look_at((0.2, -0.1, 1.5), (0.0, 0.0, 0.0))  # shines down onto the shading points

@@ -6,11 +6,11 @@ found it; a perfect mirror shows light bodies at the radiance Cycles gives them.
 """
 import numpy as np
 import pytest
-from scenes import plane, top_camera, translation
 
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
+from scenes import plane, top_camera, translation
 
 L = 2.0
 

@@ -8,11 +8,11 @@ radiance is albedo / pi times that. Each pixel is compared with the closed form 
 its footprint (box filter), and the check is shown to fail on the render 3% too dark.
 """
 import numpy as np
-from scenes import lit_plane_scene, translation
 
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Light
 from drt_engine.core.settings import RenderSettings
+from scenes import lit_plane_scene, translation
 
 I, h, X0, X1, ALBEDO = 2.0, 0.5, -0.5, 0.5, 0.5
 RES, HALF = 48, 1.0

@@ -3,15 +3,15 @@ import dataclasses
 
 import numpy as np
 import pytest
-from test_determinism import scene
 
-from drt_engine.core.errors import SettingsError
-from drt_engine.core.film import parts
-from drt_engine.core.film.ratio_sums import RATIO
 from drt_engine.core.render import merge, report
+from drt_engine.core.film import parts
 from drt_engine.core.render.adaptive import image_error
+from drt_engine.core.errors import SettingsError
+from drt_engine.core.film.ratio_sums import RATIO
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import PASSES, RenderSettings
+from test_determinism import scene
 
 SAMPLES = 12
 RELATIVE = 1e-6

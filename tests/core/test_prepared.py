@@ -4,14 +4,14 @@ import dataclasses
 
 import numpy as np
 import pytest
-from scenes import look_at, translation
-from test_determinism import scene
 
+from drt_engine.core.sampling import dims as D
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.sampling import dims as D
 from drt_engine.core.scene import Camera, Light
 from drt_engine.core.settings import PASSES, RenderSettings
+from scenes import look_at, translation
+from test_determinism import scene
 
 
 def camera(eye):

@@ -1,19 +1,11 @@
 """Analytic radiometry: a Lambertian plane under each light type, within 1%."""
 import numpy as np
 import pytest
-from scenes import lit_plane_scene, plane, top_camera, translation, uv_sphere
 
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    World,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
+from scenes import lit_plane_scene, plane, top_camera, translation, uv_sphere
 
 ALBEDO = 0.5
 D = 2.0

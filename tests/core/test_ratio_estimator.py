@@ -6,15 +6,15 @@ tracks the true error as tests/blender/test_adaptive_calibration.py asks of Mont
 """
 import numpy as np
 import pytest
-import scenes
-from scenes import translation
 
+from drt_engine.core.render.adaptive import true_error
 from drt_engine.core.film.film import Film
 from drt_engine.core.film.ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO
-from drt_engine.core.render.adaptive import true_error
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Light
 from drt_engine.core.settings import RenderSettings
+import scenes
+from scenes import translation
 
 WIDTH = 48
 REFERENCE_SAMPLES = 1024

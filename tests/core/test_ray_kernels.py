@@ -7,12 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scenes import plane, translation, uv_sphere
 
 from drt_engine.core.geometry import camera as camera_rays
 from drt_engine.core.geometry.accel import Geometry
 from drt_engine.core.geometry.motion import Motion, invert_frame
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
+from scenes import plane, translation, uv_sphere
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -2,12 +2,7 @@
 import numpy as np
 
 from drt_engine.core.scene import Program
-from drt_engine.core.shading.nodes import (
-    DirectionContext,
-    Evaluator,
-    hsv_to_rgb,
-    rgb_to_hsv,
-)
+from drt_engine.core.shading.nodes import DirectionContext, Evaluator, hsv_to_rgb, rgb_to_hsv
 
 N = 5
 

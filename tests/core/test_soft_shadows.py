@@ -8,19 +8,11 @@ the occluder and the ground looks down at a strip across the edge.
 """
 import numpy as np
 import pytest
-from scenes import plane, translation
 
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    Mesh,
-    SceneData,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
+from scenes import plane, translation
 
 R, H, h = 0.5, 4.0, 1.0
 WIDTH = 2 * R * h / (H - h)

@@ -1,17 +1,8 @@
 """Small textured scenes and images written in code for the texture and IBL tests."""
 import numpy as np
-from scenes import translation
 
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Material,
-    Mesh,
-    Program,
-    SceneData,
-    World,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, Program, SceneData, World
+from scenes import translation
 
 
 def write_image(path, pixels_top_first: np.ndarray):

@@ -11,15 +11,7 @@ import copy
 import numpy as np
 
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    World,
-)
+from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import PASSES, RenderSettings
 
 __all__ = ["render", "Camera", "Closure", "Instance", "Light", "Material", "SceneData", "World", "PASSES",

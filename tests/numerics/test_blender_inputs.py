@@ -5,10 +5,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-import blender_scenes as bs
 import bpy
 import numpy as np
 import pytest
+
+import blender_scenes as bs
 
 ROOT = Path(__file__).resolve().parents[2]
 

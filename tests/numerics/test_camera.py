@@ -4,8 +4,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import blender_scenes as bs
 import numpy as np
+
+import blender_scenes as bs
 from core_cases import Camera, Closure, Instance, Material, SceneData, render
 from scenes import plane, translation
 

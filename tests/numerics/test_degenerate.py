@@ -2,20 +2,11 @@
 faces, meshes without faces, 10^6 triangles in one object, 10^4 objects."""
 import numpy as np
 import pytest
-from core_cases import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    World,
-    diffuse,
-    render,
-)
-from scenes import look_at, plane, translation, uv_sphere
 
 from drt_engine.core.scene import Mesh
+
+from core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, diffuse, render
+from scenes import look_at, plane, translation, uv_sphere
 
 
 def lit(meshes, instances=None, res=16, materials=None):

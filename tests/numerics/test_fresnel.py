@@ -8,11 +8,12 @@ spread alpha·|eta - 1| is below the delta threshold, masked at that spread.
 """
 import numpy as np
 import pytest
-from core_cases import Camera, Closure, Instance, Material, SceneData, World, render
-from scenes import look_at, uv_sphere
 
 from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Mesh
+
+from core_cases import Camera, Closure, Instance, Material, SceneData, World, render
+from scenes import look_at, uv_sphere
 
 
 def checkerboard(n=8, size=4.0, z=-2.0):

@@ -5,9 +5,10 @@ Scene: a diffuse plane (albedo 0.8) at z = 0, the camera 5 m above looking down,
 """
 import math
 
-import blender_scenes as bs
 import numpy as np
 import pytest
+
+import blender_scenes as bs
 import render_helpers as rh
 
 ALBEDO = 0.8

@@ -2,10 +2,11 @@
 a parented animated hierarchy. Camera 5 m above looking down, black world, emissive subjects."""
 import math
 
-import blender_scenes as bs
 import bpy
 import numpy as np
 import pytest
+
+import blender_scenes as bs
 from scene_helpers import fcurves
 
 HALF_VIEW = 1.0  # orthographic view of 2 m x 2 m

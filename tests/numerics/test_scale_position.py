@@ -9,16 +9,8 @@ moves a silhouette across a sample.
 """
 import numpy as np
 import pytest
-from core_cases import (
-    Camera,
-    Closure,
-    Instance,
-    Light,
-    Material,
-    SceneData,
-    World,
-    render,
-)
+
+from core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, render
 from scenes import look_at, plane, translation, uv_sphere
 
 
@@ -73,8 +65,9 @@ def test_same_image_far_from_the_origin(offset, s, reference):
 def test_same_image_far_from_the_origin_through_blender(drt, tmp_path, offset):
     """A sphere on a floor under a point and an area light, the camera 6 m away; every location
     shifted by ``offset`` (integers, exact in Blender's float32 matrices): the same image."""
-    import blender_scenes as bs
     import bpy
+
+    import blender_scenes as bs
 
     def build(o):
         scene = bs.new_scene(24, 24, 8)

@@ -5,11 +5,12 @@ the float32 error of the triangle (``accel.spawn``, ``Geometry.offset_scale``).
 """
 import numpy as np
 import pytest
-from core_cases import diffuse, render
-from scenes import look_at, plane, translation
 
 from drt_engine.core.geometry.accel import Geometry, spawn
 from drt_engine.core.scene import Camera, Instance, Light, Mesh, SceneData
+
+from core_cases import diffuse, render
+from scenes import look_at, plane, translation
 
 TRIANGLES = 4000
 DIRECTIONS = 16

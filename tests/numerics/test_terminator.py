@@ -9,9 +9,10 @@ under it); Cycles loses 0.01%.
 """
 import math
 
-import blender_scenes as bs
 import bpy
 import numpy as np
+
+import blender_scenes as bs
 import render_helpers as rh
 
 SUN = np.array([1.0, 0.0, 0.0])  # towards the sun

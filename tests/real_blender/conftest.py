@@ -18,14 +18,8 @@ import time
 from pathlib import Path
 
 import pytest
-from blender_env import (
-    IGNIS_SCENES,
-    MARK,
-    REPO,
-    SAMPLE_SCENES,
-    BlenderEnv,
-    check_output,
-)
+
+from blender_env import IGNIS_SCENES, MARK, REPO, SAMPLE_SCENES, BlenderEnv, check_output
 
 HERE = Path(__file__).resolve().parent
 ZIP = REPO / "dist" / "drt_engine-0.1.0-linux_x64.zip"

@@ -12,6 +12,7 @@ import time
 import numpy as np
 import OpenImageIO as oiio
 import pytest
+
 from blender_env import REPO, check_output
 
 UI_OUT = REPO / "out" / "ui"

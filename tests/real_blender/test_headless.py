@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from blender_env import IGNIS_SCENES, REPO, SAMPLE_SCENES, check_output, read_passes
 
 NAMES = SAMPLE_SCENES + tuple(f"ignis_{name}" for name in IGNIS_SCENES)

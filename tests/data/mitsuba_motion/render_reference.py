@@ -17,8 +17,8 @@ which the original ``*_ref_rgb_var.exr`` files show.)
 import sys
 import xml.etree.ElementTree as ET
 
-import mitsuba as mi
 import numpy as np
+import mitsuba as mi
 
 mi.set_variant("scalar_rgb")
 
