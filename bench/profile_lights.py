@@ -21,7 +21,7 @@ import drt_engine  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
-MODULES = ("core/lights.py", "core/environment.py")
+MODULES = ("core/lights/collection.py", "core/lights/environment.py")
 TOP = 6
 
 

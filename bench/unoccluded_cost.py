@@ -1,4 +1,4 @@
-"""Cost per call of the closed-form unoccluded irradiance (core/unoccluded.py) per light kind,
+"""Cost per call of the closed-form unoccluded irradiance (core/lights/unoccluded.py) per light kind,
 and its worst relative error against the reference cubature of tests/core/test_unoccluded.py.
 
 Cost: ``unoccluded`` over a batch of random shading points under each light with random
