@@ -1,4 +1,4 @@
-"""Measures what the ratio estimator (shadow_estimator RATIO, core.ratio) is worth against Monte Carlo.
+"""Measures what the ratio estimator (shadow_estimator RATIO, core.integrator.ratio) is worth against Monte Carlo.
 
 Per scene (the soft-shadow scene of bench/soft_shadow.py and the four sample scenes), renders
 with MONTE_CARLO and with RATIO at a few sample counts and seeds, one thread each; for each, the

@@ -1,7 +1,7 @@
 """Render time of the sample scenes, whole and per module, for before/after comparisons of a change.
 
 ``python bench/render_time.py [--width 160] [--samples 16] [--threads 1] [--scenes ...] [--top 12]``:
-for each scene, the time to prepare the scene (core.prepared; export excluded), the render's
+for each scene, the time to prepare the scene (core.render.prepared; export excluded), the render's
 wall time (best of ``--repeat``, reusing the prepared scene) and, from one cProfile run of the
 render, each core module's own time and the number of Python function calls.
 """

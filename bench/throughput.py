@@ -15,7 +15,7 @@ For each sample scene, in one run:
     process before the renderer is made (bpy, the scene, the export);
 (f) cold and warm start (bench/startup.py): the first render with an empty kernel cache and
     with the cache filled, each in a fresh process.
-The scene is prepared once (core.prepared) and shared by the raw rays and both DRT renders.
+The scene is prepared once (core.render.prepared) and shared by the raw rays and both DRT renders.
 Writes bench/THROUGHPUT.md and its section of bench/RESULTS.md.
 """
 from __future__ import annotations

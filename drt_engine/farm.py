@@ -3,7 +3,7 @@
 The CLI process is the Dask client. It reads the scene's samples and frames from the
 .blend, sends the file's bytes once to every worker, submits one task per sample range
 of each frame (``farm_task.render_range``), and adds the parts into each frame's image in
-range order as they come back (``core.merge``). Dask reschedules the task of a worker
+range order as they come back (``core.render.merge``). Dask reschedules the task of a worker
 that dies; parts depend only on their range, so the image does not change. Only the
 CLI uses this module: the Blender extension never imports Dask.
 """

@@ -53,7 +53,7 @@ def render_window(render, width: int, height: int) -> tuple[int, int, int, int]:
 
 
 last_reports: dict[str, dict] = {}
-"""The report (core.report.report_dict) of the newest final render of each view layer, by name.
+"""The report (core.render.report.report_dict) of the newest final render of each view layer, by name.
 
 The CLI runs Blender's render operator in its own process; this is how it gets the
 engine's settings, stats and error log back to write ``<OUT stem>.drt.json``.
@@ -65,7 +65,7 @@ progress_listener = None
 
 persistent: dict[str, tuple[str, object]] = {}
 """With Blender's Persistent Data on (Render Properties > Performance, as for Cycles): per view
-layer, the content key (core.prepared.content_key) and prepared scene of its last final render,
+layer, the content key (core.render.prepared.content_key) and prepared scene of its last final render,
 so the next frame reuses the Embree scenes, lights and materials when only the camera changed."""
 
 

@@ -2,7 +2,7 @@
 
 Blender calls the engine's ``view_update`` and ``view_draw`` on its main thread, which
 must never wait for the tracer. The scene is exported there (reading Blender data is
-only safe on the main thread), then a worker thread prepares it (core.prepared: Embree
+only safe on the main thread), then a worker thread prepares it (core.render.prepared: Embree
 scenes, lights, materials) and traces; ``view_draw`` only uploads the newest image and
 draws it. Each view renders progressively: one sample at 1/8, 1/4 and 1/2 of the region's
 resolution (drawn stretched), then the full resolution accumulating the viewport samples,
@@ -90,7 +90,7 @@ class ViewportRender:
 
     def prepared(self, scene_data):
         """The prepared scene of ``scene_data``: the one made for it before, else the previous
-        scene's updated for the edit (core.prepared.PreparedScene.update rebuilds only what
+        scene's updated for the edit (core.render.prepared.PreparedScene.update rebuilds only what
         changed), else a new one (under a lock: a stale worker and a new one never prepare the
         same scene twice)."""
         from ..core.render.prepared import PreparedScene

@@ -92,7 +92,7 @@ class Material:
 
 @dataclass
 class ProgramNode:
-    """One operation of a shader program: ``op`` (the cases of core.shadernodes.Evaluator._run), its inputs as
+    """One operation of a shader program: ``op`` (the cases of core.shading.nodes.Evaluator._run), its inputs as
     ``(node, output)`` references to earlier nodes, and constant parameters."""
 
     op: str

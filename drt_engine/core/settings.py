@@ -9,7 +9,7 @@ SAMPLING_PATTERNS = ("GRID", "JITTERED", "SOBOL")
 FILTER_TYPES = ("BOX", "GAUSSIAN", "BLACKMAN_HARRIS")
 ADAPTIVE_MODES = ("NOISE", "CONTRAST")
 SHADOW_ESTIMATORS = ("MONTE_CARLO", "RATIO")
-"""How the diffuse direct light of lights with a closed form is estimated (core.ratio)."""
+"""How the diffuse direct light of lights with a closed form is estimated (core.integrator.ratio)."""
 
 PASSES = (
     "Combined",  # RGBA
@@ -22,7 +22,7 @@ PASSES = (
     "Env",  # environment seen directly
     "Sample Count",  # samples taken per pixel
     "Noise",  # standard error of the Combined estimate per pixel
-    "Denoising Albedo",  # Cycles' albedo of the first diffuse-like hit, for the Denoise node (core.denoising)
+    "Denoising Albedo",  # Cycles' albedo of the first diffuse-like hit, for the Denoise node (core.film.denoising)
     "Denoising Normal",  # its normal in Cycles' camera space
 )
 PASS_CHANNELS = {

@@ -1,4 +1,4 @@
-"""Disjoint sample ranges rendered apart add up to the whole render (core.parts)."""
+"""Disjoint sample ranges rendered apart add up to the whole render (core.film.parts)."""
 import dataclasses
 
 import numpy as np

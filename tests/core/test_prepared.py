@@ -21,7 +21,7 @@ def camera(eye):
 def test_another_camera_on_a_prepared_scene_gives_the_image_of_a_scene_prepared_for_it():
     """Nothing camera-dependent is kept: a render reusing the prepared scene equals one that
     prepares the scene anew (around the same centre: Embree's float32 coordinates are centred
-    on the camera the scene was prepared with, see core.prepared)."""
+    on the camera the scene was prepared with, see core.render.prepared)."""
     base = scene()
     prepared = PreparedScene(base)
     assert np.array_equal(prepared.geometry.center, base.camera.matrix[:3, 3])

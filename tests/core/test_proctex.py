@@ -1,4 +1,4 @@
-"""Procedural textures (core.proctex) against values derived by hand or by a reference.
+"""Procedural textures (core.shading.proctex) against values derived by hand or by a reference.
 
 The hashes are checked against Bob Jenkins' lookup3.c ``hashword`` (initval 13, which
 Cycles' hash_uint{,2,3,4} specialise) and against the PCG3D of "Hash Functions for GPU

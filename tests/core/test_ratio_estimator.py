@@ -1,4 +1,4 @@
-"""The ratio estimator (shadow_estimator RATIO, core.ratio) on the soft-shadow scene (scenes.soft_shadow_scene).
+"""The ratio estimator (shadow_estimator RATIO, core.integrator.ratio) on the soft-shadow scene (scenes.soft_shadow_scene).
 
 Exact where the light is wholly in view; no bias against a converged Monte Carlo reference
 beyond the noise (image mean and 4x4 blocks); an error estimate (Noise pass, error log) that

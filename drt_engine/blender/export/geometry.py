@@ -112,7 +112,7 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
 class MeshCache:
     """Exported meshes kept from one viewport export to the next, so an edit that leaves a mesh
     alone (a transform, a material, a light) neither reads it from Blender again nor makes the
-    core rebuild it (core.prepared compares meshes by identity).
+    core rebuild it (core.render.prepared compares meshes by identity).
 
     Keyed as GeometryExporter keys meshes (the evaluated datablock, the slots' materials) and
     the tangent maps its materials need; ``forget`` drops what the depsgraph reports as new

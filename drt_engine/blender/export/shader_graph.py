@@ -376,10 +376,10 @@ class Compiler:
                 self._in(node, "Color2", "color"), self._in(node, "Scale", "float"))
         return self.op("checker", args), 0 if output.identifier == "Color" else 1
 
-    # -- procedural textures (core.proctex) ------------------------------------------
+    # -- procedural textures (core.shading.proctex) ------------------------------------------
     def _procedural(self, node, output, op, **params):
         """A procedural texture node: its vector (Generated coordinates when unlinked, as in
-        Cycles), its other sockets in core.proctex's order, and the output's index."""
+        Cycles), its other sockets in core.shading.proctex's order, and the output's index."""
         mapping = getattr(node, "texture_mapping", None)
         if mapping is not None and (any(mapping.translation) or any(mapping.rotation)
                                     or any(v != 1.0 for v in mapping.scale)):

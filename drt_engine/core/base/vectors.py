@@ -1,7 +1,7 @@
 """Vectors and frames: rows of (N, 3) arrays for the wave-level code, and the per-ray scalar
 forms the kernels call.
 
-The array helpers write their three products out instead of calling BLAS or a NumPy
+Most array helpers write their three products out instead of calling BLAS or a NumPy
 reduction: on a length-3 axis those cost several times more, and BLAS's rounding depends on
 the build (images must be bit-identical on every machine).
 """

@@ -11,7 +11,7 @@ The diffuse lobe is evaluated for light sampling only: as in Cook's distribution
 tracing (and Cycles with diffuse bounces 0) no rays continue from it.
 
 Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
-sampling, pdf, lobe choice, pass colours) is ``lobe_kernels``, compiled, over the flat
+sampling, pdf, lobe choice, pass colours) is ``lobes``, compiled, over the flat
 arrays ``MaterialShader`` packs the lobes into.
 """
 from __future__ import annotations
@@ -31,7 +31,7 @@ from . import microfacet as mf
 @dataclass(eq=False)
 class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
-    arrays of ``lobe_kernels``."""
+    arrays of ``lobes``."""
     kind: str  # "diffuse" | "reflect" | "glass" | "transparent"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
@@ -338,7 +338,7 @@ _KINDS = {"diffuse": lk.DIFFUSE, "reflect": lk.REFLECT, "glass": lk.GLASS, "tran
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The lobes as ``lobe_kernels``' flat arrays: constants (L, P), tables (L, T, len(MU_TABLE))
+    """The lobes as ``lobes``' flat arrays: constants (L, P), tables (L, T, len(MU_TABLE))
     and the per-hit part for a constant shader (1, L, H)."""
     n_mu = len(mf.MU_TABLE)
     lp = np.zeros((len(lobes), lk.P))
@@ -393,7 +393,7 @@ def _bools(a):
 class MaterialShader:
     """Evaluates and samples one material's lobes for batches of local directions.
 
-    The lobes are packed once into flat arrays (see ``lobe_kernels``) and every method is one
+    The lobes are packed once into flat arrays (see ``lobes``) and every method is one
     compiled loop over the batch. A shader built with ``varying`` closures (closure index ->
     names of inputs that vary per hit) is bound to the hits of one call with ``bind``, which
     gives it a per-hit row of those inputs; methods then take ``rows``, the hits' positions in
@@ -515,7 +515,7 @@ class MaterialShader:
 
     def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
         """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles
-        splits its closures for the Denoising Albedo pass (``lobe_kernels.denoising_albedos``)."""
+        splits its closures for the Denoising Albedo pass (``lobes.denoising_albedos``)."""
         n = len(mu_o)
         diff = np.empty((n, 3))
         spec = np.empty((n, 3))

@@ -137,7 +137,7 @@ def _splat_counts(pixel, sample, combined, replicate, count, count_a, sum_a):
 
 @kernel
 def _splat_ratio(pixel, sample, ndu, replicate, total):
-    """The ratio estimator's N, D, U (core.ratio) into the first columns of ``total`` for every
+    """The ratio estimator's N, D, U (core.integrator.ratio) into the first columns of ``total`` for every
     sample and into the last ones for class A (chosen as ``_splat_counts`` chooses)."""
     k = ndu.shape[1]
     for i in range(len(pixel)):
@@ -162,7 +162,7 @@ class Film:
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
-    (core.ratio), and Combined is read resolved: its diffuse direct part of the lights
+    (core.integrator.ratio), and Combined is read resolved: its diffuse direct part of the lights
     with a closed form is U N / D.
     """
 

@@ -113,7 +113,7 @@ def from_film(film: Film, settings: RenderSettings, header: dict) -> Part:
 
 
 def _sum_names(passes, channels: dict) -> list[str]:
-    """The film sums a part holds, in order: its passes', then the ratio estimator's (core.ratio)."""
+    """The film sums a part holds, in order: its passes', then the ratio estimator's (core.integrator.ratio)."""
     return [name for name in passes if name in channels] + ([RATIO] if RATIO in channels else [])
 
 

@@ -4,8 +4,8 @@ Each depth step intersects all live rays at once, adds what they see (emission, 
 world, each weighted by multiple importance sampling against light sampling), estimates
 direct light at every hit with one shadow ray per light strategy, and continues each path
 through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
-Stages pass named records (core.records); every random number comes from the sampler the
-caller hands to ``trace``, at the dimensions core.dims lays out.
+Stages pass named records (core.integrator.records); every random number comes from the sampler the
+caller hands to ``trace``, at the dimensions core.sampling.dims lays out.
 """
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ class StepSamples:
 class WaveOutput:
     """The per-sample values of every pass a wave computes: the wave's accumulator, which the
     stages add their contributions to (Combined RGB, alpha, the auxiliary passes, and the
-    ratio estimator's N, D, U when it is used, core.ratio)."""
+    ratio estimator's N, D, U when it is used, core.integrator.ratio)."""
 
     radiance: np.ndarray
     alpha: np.ndarray
@@ -86,7 +86,7 @@ class WaveOutput:
 
 
 class Integrator:
-    """Traces waves of one scene's camera over its prepared scene (core.prepared) with one settings."""
+    """Traces waves of one scene's camera over its prepared scene (core.render.prepared) with one settings."""
 
     def __init__(self, prepared, scene, settings, plan):
         self.prepared = prepared
@@ -358,7 +358,7 @@ class Integrator:
     # -- next-event estimation ----------------------------------------------------------
     def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
         """Shadow rays (not yet traced) for the hits of one shader, one per light strategy; for
-        the lights the ratio estimator takes, their D and U go to the wave's sums (core.ratio)."""
+        the lights the ratio estimator takes, their D and U go to the wave's sums (core.integrator.ratio)."""
         lights = self.lights
         out = []
         time = hits.time if self.timed else None
@@ -401,7 +401,7 @@ class Integrator:
     def _diffuse_albedo(shader, hits: SurfaceHits, sel_lobes):
         """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
         the diffuse part toward the normal, since it is that times the cosine (the layers above
-        attenuate it by factors of wo alone, lobe_kernels.eval_lobes)."""
+        attenuate it by factors of wo alone, lobes.eval_lobes)."""
         n = len(hits.path)
         normal = np.zeros((n, 3))
         normal[:, 2] = 1.0

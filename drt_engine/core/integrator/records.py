@@ -116,7 +116,7 @@ class BsdfSample:
 @dataclass
 class ShadowRays:
     """Shadow rays not yet traced: what each adds to its path's radiance when unblocked, and
-    the share of that the ratio estimator takes (its N; zero for other lights, core.ratio)."""
+    the share of that the ratio estimator takes (its N; zero for other lights, core.integrator.ratio)."""
 
     path: np.ndarray
     origins: np.ndarray

@@ -44,7 +44,7 @@ class RenderResult:
 class Renderer:
     """Renders one SceneData with one RenderSettings.
 
-    ``prepared`` (core.prepared.PreparedScene) reuses the Embree scenes, lights and materials
+    ``prepared`` (core.render.prepared.PreparedScene) reuses the Embree scenes, lights and materials
     built for the same scene with another camera; without it they are built here.
     """
 
@@ -78,7 +78,7 @@ class Renderer:
         return self.prepared.warnings
 
     def render(self, progress=None) -> RenderResult:
-        """Render progressively (core.driver) and return the passes, stats and error log."""
+        """Render progressively (core.render.driver) and return the passes, stats and error log."""
         s = self.settings
         first_id, end_id = s.sample_range()
         cap = end_id - first_id  # samples a pixel takes here: ids first_id.. of the full set

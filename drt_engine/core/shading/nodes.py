@@ -4,7 +4,7 @@ A ``Program`` (core.scene) is Blender's node graph compiled by the export into a
 of operations; this module evaluates the outputs a material asks for, vectorised over
 the hits. Each operation follows Cycles' SVM definition of its node (svm_math_util.h,
 svm_color_util.h, svm_checker.h, svm_ramp.h, svm_mapping_util.h, svm_normal_map.h,
-svm_bump.h; the procedural textures in core.proctex). Scalars are (N,) arrays, colours and vectors (N, 3).
+svm_bump.h; the procedural textures in core.shading.proctex). Scalars are (N,) arrays, colours and vectors (N, 3).
 
 Coordinates come from a context (``SurfaceContext`` for hits, ``DirectionContext`` for
 the world). A context can be shifted by a small world-space offset: that gives image

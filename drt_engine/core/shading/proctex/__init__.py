@@ -1,6 +1,6 @@
 """Blender's procedural textures, evaluated over all hits as Cycles' SVM kernel evaluates them.
 
-``evaluate(op, params, inputs)`` is the shader-program entry (core.shadernodes): ``inputs``
+``evaluate(op, params, inputs)`` is the shader-program entry (core.shading.nodes): ``inputs``
 are the node's sockets in the order listed in ``INPUTS``, (N,) for values and (N, 3) for
 vectors and colours; it returns the node's outputs in the order listed in ``OUTPUTS``.
 """
