@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from drt_engine.core.bsdf import lobes as lk
 from drt_engine.core.bsdf import microfacet as mf
+from drt_engine.core.bsdf import mixture, tables
 from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Closure, Material
 
@@ -18,7 +18,7 @@ def test_table_lookup_is_linear_interpolation():
                          np.geomspace(1e-7, 1, 2000), [0.0, 1.0, 1.5, -0.5]])
     values = np.sin(7 * mu) + mu
     lt = values[None, None, :]
-    got = np.array([lk.at(lt, 0, 0, *lk.locate(mu, x)) for x in xs])
+    got = np.array([tables.at(lt, 0, 0, *tables.locate(mu, x)) for x in xs])
     assert np.allclose(got, np.interp(xs, mu, values), rtol=0, atol=1e-14)
 
 
@@ -82,9 +82,11 @@ def test_scalar_functions_give_the_batch_results():
     sampled = shader.sample(wo, u_sel, u2, inside)
     sel = np.zeros((1, len(shader.sampled)))
     for i in range(n):
-        lk.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0)
-        e = lk.eval_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *wi[i], above[i], inside[i], sel, 0)
+        mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0)
+        e = mixture.eval_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *wi[i], above[i], inside[i],
+                               sel, 0)
         assert np.array_equal(e, [*f_diff[i], *f_nd[i], pdf[i]])
-        s = lk.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], u_sel[i], *u2[i], inside[i], sel, 0)
+        s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], u_sel[i], *u2[i], inside[i],
+                                 sel, 0)
         assert np.array_equal(s[:7], [*sampled[0][i], *sampled[1][i], sampled[2][i]])
         assert s[7:] == tuple(bool(x[i]) for x in sampled[3:])

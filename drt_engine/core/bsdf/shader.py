@@ -11,8 +11,9 @@ The diffuse lobe is evaluated for light sampling only: as in Cook's distribution
 tracing (and Cycles with diffuse bounces 0) no rays continue from it.
 
 Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
-sampling, pdf, lobe choice, pass colours) is ``lobes``, compiled, over the flat
-arrays ``MaterialShader`` packs the lobes into.
+sampling, pdf, lobe choice, pass colours) is compiled (one module per lobe kind, ``mixture``
+over them, ``passes``, run per wave by ``rows``), over the flat arrays ``MaterialShader``
+packs the lobes into (``layout``).
 """
 from __future__ import annotations
 
@@ -24,21 +25,22 @@ from typing import Callable
 import numpy as np
 
 from ..scene import Closure, Material
-from . import lobes as lk
+from . import layout
 from . import microfacet as mf
+from .rows import colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, weights_rows
 
 
 @dataclass(eq=False)
 class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
-    arrays of ``lobes``."""
+    arrays of ``layout``."""
     kind: str  # "diffuse" | "reflect" | "glass" | "transparent"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
     alpha: float = 0.0
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
-    fresnel_kind: int = lk.F_TINT  # the same Fresnel for the kernels (lobe_kernels.fresnel)
+    fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
     f0: np.ndarray = field(default_factory=lambda: np.ones(3))  # Fresnel colour: tint or metal f0
     eta: float = 1.5  # glass: n_inside / n_outside
@@ -155,7 +157,7 @@ EXACT = Tables()
 
 
 def _reflect_lobe(weight, alpha, fresnel, layers=(), multiscatter=True, tables=EXACT, key=None, tint=None,
-                  table=None, fresnel_kind=lk.F_TINT, fresnel_eta=1.0, f0=None) -> Lobe:
+                  table=None, fresnel_kind=layout.F_TINT, fresnel_eta=1.0, f0=None) -> Lobe:
     """A GGX reflection lobe with Fresnel ``fresnel`` (for the kernels: ``fresnel_kind``,
     ``fresnel_eta`` and the colour ``f0``) times a constant ``tint`` (its albedo table is the
     untinted one times the tint, so lobes differing in tint share tables); ``table`` (mu, E)
@@ -264,7 +266,7 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
         coat_ior = max(c.coat_ior, 1.0 + 1e-4)
         coat = _reflect_lobe(w * c.coat_weight, _alpha(c.coat_roughness), _dielectric_fresnel(coat_ior, np.ones(3)),
                              tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
-                             fresnel_kind=lk.F_DIELECTRIC, fresnel_eta=coat_ior)
+                             fresnel_kind=layout.F_DIELECTRIC, fresnel_eta=coat_ior)
         coat.role = "coat"
         lobes.append(coat)
         tint = 1.0 + c.coat_weight * (np.clip(c.coat_tint, 0, None) - 1.0)
@@ -280,7 +282,7 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
             mu, ea, eb = tables.f82(alpha, f82)
             table = (mu, base * ea + eb)
         metal = _reflect_lobe(w * metallic, alpha, _f82_fresnel(base, f82), base_layers, c.multiscatter, tables,
-                              _key("f82", base, f82), table=table, fresnel_kind=lk.F_F82, f0=base)
+                              _key("f82", base, f82), table=table, fresnel_kind=layout.F_F82, f0=base)
         metal.role, metal.f82 = "metal", f82
         lobes.append(metal)
     dielectric = 1.0 - metallic
@@ -298,7 +300,7 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
             eta = mf.ior_from_f0(f0)
             spec = _reflect_lobe(w * opaque, alpha, _dielectric_fresnel(eta, np.ones(3)), base_layers,
                                  c.multiscatter, tables, _key("dielectric", eta, np.ones(3)), spec_tint,
-                                 fresnel_kind=lk.F_DIELECTRIC, fresnel_eta=eta)
+                                 fresnel_kind=layout.F_DIELECTRIC, fresnel_eta=eta)
             spec.role = "spec"
             lobes.append(spec)
             diffuse_layers.append(_layer_under(spec))
@@ -334,50 +336,51 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     return lobes
 
 
-_KINDS = {"diffuse": lk.DIFFUSE, "reflect": lk.REFLECT, "glass": lk.GLASS, "transparent": lk.TRANSPARENT}
+_KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
+          "transparent": layout.TRANSPARENT}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The lobes as ``lobes``' flat arrays: constants (L, P), tables (L, T, len(MU_TABLE))
+    """The lobes as ``layout``'s flat arrays: constants (L, P), tables (L, T, len(MU_TABLE))
     and the per-hit part for a constant shader (1, L, H)."""
     n_mu = len(mf.MU_TABLE)
-    lp = np.zeros((len(lobes), lk.P))
-    lt = np.zeros((len(lobes), lk.T, n_mu))
-    hp = np.zeros((1, len(lobes), lk.H))
+    lp = np.zeros((len(lobes), layout.P))
+    lt = np.zeros((len(lobes), layout.T, n_mu))
+    hp = np.zeros((1, len(lobes), layout.H))
     for l, lobe in enumerate(lobes):
         row = lp[l]
-        row[lk.P_KIND] = _KINDS[lobe.kind]
-        row[lk.P_DELTA] = lobe.delta
-        row[lk.P_ALPHA], row[lk.P_ALPHA_T], row[lk.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
-        row[lk.P_REFRACT_ONLY] = lobe.refract_only
-        row[lk.P_FRESNEL], row[lk.P_ETA_F] = lobe.fresnel_kind, lobe.fresnel_eta
-        row[lk.P_F82:lk.P_F82 + 3] = 1.0 if lobe.f82 is None else lobe.f82
-        row[lk.P_LAYERS] = len(lobe.layers)
+        row[layout.P_KIND] = _KINDS[lobe.kind]
+        row[layout.P_DELTA] = lobe.delta
+        row[layout.P_ALPHA], row[layout.P_ALPHA_T], row[layout.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
+        row[layout.P_REFRACT_ONLY] = lobe.refract_only
+        row[layout.P_FRESNEL], row[layout.P_ETA_F] = lobe.fresnel_kind, lobe.fresnel_eta
+        row[layout.P_F82:layout.P_F82 + 3] = 1.0 if lobe.f82 is None else lobe.f82
+        row[layout.P_LAYERS] = len(lobe.layers)
         for t, (emax, tint) in enumerate(lobe.layers):
-            lt[l, lk.T_UNDER + t] = emax
-            row[lk.P_LAYER_TINT + 3 * t:lk.P_LAYER_TINT + 3 * t + 3] = tint
-        row[lk.P_SAMPLED] = sampled.index(lobe) if lobe in sampled else -1
-        row[lk.P_WEIGHT:lk.P_WEIGHT + 3] = lobe.weight
+            lt[l, layout.T_UNDER + t] = emax
+            row[layout.P_LAYER_TINT + 3 * t:layout.P_LAYER_TINT + 3 * t + 3] = tint
+        row[layout.P_SAMPLED] = sampled.index(lobe) if lobe in sampled else -1
+        row[layout.P_WEIGHT:layout.P_WEIGHT + 3] = lobe.weight
         if lobe.table is not None:
             assert np.array_equal(lobe.table[0], mf.MU_TABLE)  # every table is over MU_TABLE
-            lt[l, lk.T_E:lk.T_E + 3] = np.broadcast_to(lobe.table[1], (n_mu, 3)).T
-            lt[l, lk.T_LAYER_E:lk.T_LAYER_E + 3] = np.broadcast_to(lobe.layer_table[1], (n_mu, 3)).T
+            lt[l, layout.T_E:layout.T_E + 3] = np.broadcast_to(lobe.table[1], (n_mu, 3)).T
+            lt[l, layout.T_LAYER_E:layout.T_LAYER_E + 3] = np.broadcast_to(lobe.layer_table[1], (n_mu, 3)).T
         if lobe.ms is not None:
-            row[lk.P_MS], row[lk.P_E_AVG] = 1.0, lobe.ms[2]
-            lt[l, lk.T_MS] = lobe.ms[1]
+            row[layout.P_MS], row[layout.P_E_AVG] = 1.0, lobe.ms[2]
+            lt[l, layout.T_MS] = lobe.ms[1]
         if lobe.delta and lobe.kind in ("reflect", "glass"):
-            lt[l, lk.T_WHITE] = mf.white_albedo(float(lobe.alpha))[1]
+            lt[l, layout.T_WHITE] = mf.white_albedo(float(lobe.alpha))[1]
         if lobe.affine is not None:
             ea, eb, e1, a_avg, b_avg = lobe.affine
-            row[lk.P_AFFINE] = 1.0
-            lt[l, lk.T_EA:lk.T_EA + 3], lt[l, lk.T_EB:lk.T_EB + 3], lt[l, lk.T_E1] = ea.T, eb.T, e1
-            row[lk.P_A_AVG:lk.P_A_AVG + 3], row[lk.P_B_AVG:lk.P_B_AVG + 3] = a_avg, b_avg
+            row[layout.P_AFFINE] = 1.0
+            lt[l, layout.T_EA:layout.T_EA + 3], lt[l, layout.T_EB:layout.T_EB + 3], lt[l, layout.T_E1] = ea.T, eb.T, e1
+            row[layout.P_A_AVG:layout.P_A_AVG + 3], row[layout.P_B_AVG:layout.P_B_AVG + 3] = a_avg, b_avg
         h = hp[0, l]
-        h[lk.H_SCALE:lk.H_SCALE + 3] = 1.0
-        h[lk.H_COLOUR:lk.H_COLOUR + 3] = lobe.albedo
-        h[lk.H_TINT_R:lk.H_TINT_R + 3] = lobe.tint_r
-        h[lk.H_TINT_T:lk.H_TINT_T + 3] = lobe.tint_t
-        h[lk.H_F0:lk.H_F0 + 3] = lobe.f0
+        h[layout.H_SCALE:layout.H_SCALE + 3] = 1.0
+        h[layout.H_COLOUR:layout.H_COLOUR + 3] = lobe.albedo
+        h[layout.H_TINT_R:layout.H_TINT_R + 3] = lobe.tint_r
+        h[layout.H_TINT_T:layout.H_TINT_T + 3] = lobe.tint_t
+        h[layout.H_F0:layout.H_F0 + 3] = lobe.f0
     return lp, lt, hp
 
 
@@ -393,7 +396,7 @@ def _bools(a):
 class MaterialShader:
     """Evaluates and samples one material's lobes for batches of local directions.
 
-    The lobes are packed once into flat arrays (see ``lobes``) and every method is one
+    The lobes are packed once into flat arrays (see ``layout``) and every method is one
     compiled loop over the batch. A shader built with ``varying`` closures (closure index ->
     names of inputs that vary per hit) is bound to the hits of one call with ``bind``, which
     gives it a per-hit row of those inputs; methods then take ``rows``, the hits' positions in
@@ -430,20 +433,20 @@ class MaterialShader:
         for l, lobe in enumerate(self.lobes):
             v = values.get(lobe.source, {})
             if "weight" in v:
-                hp[:, l, lk.H_SCALE:lk.H_SCALE + 3] = v["weight"]
+                hp[:, l, layout.H_SCALE:layout.H_SCALE + 3] = v["weight"]
             color = v.get("color")
             if color is None:
                 continue
             base = np.clip(color, 0.0, 1.0)
             if lobe.role in ("diffuse", "transparent"):
-                hp[:, l, lk.H_COLOUR:lk.H_COLOUR + 3] = base
+                hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = base
             elif lobe.role == "glass":
-                hp[:, l, lk.H_TINT_T:lk.H_TINT_T + 3] = np.sqrt(base)
+                hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = np.sqrt(base)
             elif lobe.role == "bsdf_glass":
-                hp[:, l, lk.H_TINT_T:lk.H_TINT_T + 3] = base
-                hp[:, l, lk.H_TINT_R:lk.H_TINT_R + 3] = base
+                hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = base
+                hp[:, l, layout.H_TINT_R:layout.H_TINT_R + 3] = base
             elif lobe.affine is not None:
-                hp[:, l, lk.H_F0:lk.H_F0 + 3] = base
+                hp[:, l, layout.H_F0:layout.H_F0 + 3] = base
         bound = copy.copy(self)
         bound.hp, bound.bound = hp, True
         return bound
@@ -458,7 +461,7 @@ class MaterialShader:
     def selection(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L) probabilities of continuing through each non-diffuse lobe."""
         out = np.zeros((len(mu_o), len(self.sampled)))
-        lk.selection_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        selection_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
         return out
 
     # -- evaluation -----------------------------------------------------------------
@@ -478,7 +481,7 @@ class MaterialShader:
         f_diff = np.empty((n, 3))
         f_nd = np.empty((n, 3))
         pdf = np.empty(n)
-        lk.evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
+        evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
                          _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
         return f_diff, f_nd, pdf
 
@@ -499,7 +502,7 @@ class MaterialShader:
         delta = np.empty(n, bool)
         valid = np.empty(n, bool)
         passthrough = np.empty(n, bool)
-        lk.sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
+        sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
                        _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
                        len(self.sampled))
         return wi, weight, pdf, delta, valid, passthrough
@@ -510,17 +513,17 @@ class MaterialShader:
         n = len(mu_o)
         diff = np.empty((n, 3))
         gloss = np.empty((n, 3))
-        lk.colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
+        colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
         return diff, gloss
 
     def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
         """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles
-        splits its closures for the Denoising Albedo pass (``lobes.denoising_albedos``)."""
+        splits its closures for the Denoising Albedo pass (``passes.denoising_albedos``)."""
         n = len(mu_o)
         diff = np.empty((n, 3))
         spec = np.empty((n, 3))
         take = np.empty(n, bool)
-        lk.denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
+        denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
                           diff, spec, take)
         return diff, spec, take
 
@@ -528,5 +531,5 @@ class MaterialShader:
         """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,
         per-hit scale) times its multiple-scattering factor, what the albedo tables decide."""
         out = np.empty((len(mu_o), len(self.lobes), 3))
-        lk.weights_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        weights_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
         return out

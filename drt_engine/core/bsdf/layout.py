@@ -1,0 +1,52 @@
+"""Where each lobe number sits in the flat arrays ``shader.MaterialShader`` packs its lobes into.
+
+- ``lp`` (L, P): each lobe's constants at the ``P_*`` offsets (kind, roughness, IOR, Fresnel,
+  layering, constant weight, ...);
+- ``lt`` (L, T, len(mu)): each lobe's albedo tables at the view cosines ``mu``, at the ``T_*`` offsets;
+- ``hp`` (M, L, H): what a texture may change per hit (weight scale, colour, tints, Fresnel
+  colour), one row for a constant shader and one per hit for a bound one; ray i reads row
+  ``hp[prow[i]]`` (``hp`` and the row ``r`` in the scalar functions).
+"""
+# lobe kinds and Fresnel kinds
+DIFFUSE, REFLECT, GLASS, TRANSPARENT = 0, 1, 2, 3
+F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
+
+# lp: constants per lobe
+P_KIND = 0
+P_DELTA = 1  # 1: sampled as a delta distribution (see shader.Lobe.delta)
+P_ALPHA = 2
+P_ALPHA_T = 3  # glass: spread of refracted directions
+P_ETA = 4  # glass: n_inside / n_outside
+P_REFRACT_ONLY = 5
+P_FRESNEL = 6  # F_DIELECTRIC (times the colour H_F0), F_F82 (f0 = H_F0), F_TINT (H_F0)
+P_ETA_F = 7  # IOR of a dielectric Fresnel
+P_F82 = 8  # (3) F82 tint
+P_MS = 11  # 1: multiple-scattering compensation
+P_E_AVG = 12  # cosine-weighted white albedo (multiscatter)
+P_AFFINE = 13  # 1: albedo from the tables of f0 A + B with a per-hit f0 (T_EA, T_EB)
+P_LAYERS = 14  # number of layers above (0 to 2)
+P_LAYER_TINT = 15  # (2 x 3) tint of each layer term
+P_SAMPLED = 21  # index among the lobes a ray continues through, -1 for diffuse
+P_WEIGHT = 22  # (3) constant weight
+P_A_AVG = 25  # (3) cosine averages of A and B (affine multiscatter)
+P_B_AVG = 28
+P = 31
+
+# lt: tables per lobe over mu
+T_E = 0  # (3) total albedo, for lobe choice
+T_LAYER_E = 3  # (3) albedo as Cycles estimates it for layering and GlossCol
+T_MS = 6  # multiple-scattering factor
+T_UNDER = 7  # (2) max albedo of the layer above, per layer term
+T_WHITE = 9  # exact white single-scatter albedo at alpha (delta lobes' masking)
+T_EA = 10  # (3) affine albedo parts
+T_EB = 13
+T_E1 = 16  # white single-scatter albedo of the tables (affine)
+T = 17
+
+# hp: per hit
+H_SCALE = 0  # (3) weight multiplier
+H_COLOUR = 3  # (3) diffuse / transparent colour
+H_TINT_R = 6  # (3) glass reflection tint
+H_TINT_T = 9  # (3) glass transmission tint
+H_F0 = 12  # (3) Fresnel colour
+H = 15

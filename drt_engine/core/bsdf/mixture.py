@@ -1,0 +1,149 @@
+"""The mixture of a hit's lobes: which lobe a ray continues through, evaluation of them all
+toward a direction, and sampling one (with the pdf of the whole mixture).
+
+These scalar functions (``selection``, ``eval_lobes``, ``sample_lobes``) take one ray's numbers
+and are what a fused kernel calls; ``rows`` runs them over a wave's arrays. Directions are
+local (z the shading normal) with wo above, as in ``shader``.
+
+The scalar functions of the lobe modules are inlined where they are called
+(``inline="always"``): a call between compiled functions increments and decrements the
+reference count of every array it passes, atomic operations that cost more than a diffuse
+lobe's arithmetic (measured here: evaluation and sampling about 1.5 to 2 times slower
+without). Microfacet's take only numbers and stay calls (inlining them too added a third to
+the compile time and gained nothing measurable). The price is compile time, paid once per
+install (the kernels are cached).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..base.constants import TINY
+from ..base.jit import kernel
+from .diffuse import diffuse_eval
+from .glass import glass_eval, glass_sample, lobe_eta
+from .layout import DIFFUSE, P_DELTA, P_KIND, P_SAMPLED, REFLECT, TRANSPARENT
+from .reflection import reflect_eval, reflect_sample
+from .tables import lobe_albedo, lobe_scale, locate, ms_factor
+from .transparent import transparent_sample
+
+
+@kernel(inline="always")
+def selection(lp, lt, hp, r, mu, mu_o, sel, si):
+    """Fill ``sel[si]`` with the probabilities of continuing through each non-diffuse lobe:
+    proportional to their albedos' largest channel, uniform when all are black."""
+    j, t = locate(mu, mu_o)
+    total = 0.0
+    n = 0
+    for l in range(lp.shape[0]):
+        k = int(lp[l, P_SAMPLED])
+        if k < 0:
+            continue
+        a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+        sel[si, k] = max(max(a0, a1), a2)
+        total += sel[si, k]
+        n += 1
+    for k in range(n):
+        sel[si, k] = sel[si, k] / max(total, TINY) if total > 0.0 else 1.0 / n
+
+
+
+@kernel(inline="always")
+def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si):
+    """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
+
+    ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
+    back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo. Returns
+    (diffuse part RGB, non-diffuse part RGB, density of continuing toward wi through the
+    non-diffuse lobes).
+    """
+    j, t = locate(mu, woz)
+    fd0 = fd1 = fd2 = fn0 = fn1 = fn2 = pdf = 0.0
+    refl = above and wiz > 0.0
+    trans = (not above) and wiz < 0.0
+    for l in range(lp.shape[0]):
+        if lp[l, P_DELTA] != 0.0:
+            continue
+        kind = int(lp[l, P_KIND])
+        if kind == DIFFUSE:
+            if refl:
+                d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
+                fd0 += d0
+                fd1 += d1
+                fd2 += d2
+            continue
+        if kind == REFLECT:
+            if not refl:
+                continue
+            f0, f1, f2, p = reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+        else:
+            f0, f1, f2, p = glass_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz, refl, trans, lobe_eta(lp, l, inside))
+            if p == 0.0 and f0 == 0.0 and f1 == 0.0 and f2 == 0.0:
+                continue
+        s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
+        ms = ms_factor(lp, lt, hp, r, j, t, l)
+        fn0 += s0 * f0 * ms
+        fn1 += s1 * f1 * ms
+        fn2 += s2 * f2 * ms
+        pdf += sel[si, int(lp[l, P_SAMPLED])] * p
+    return fd0, fd1, fd2, fn0, fn1, fn2, pdf
+
+
+
+@kernel(inline="always")
+def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
+    """Sample lobe l alone: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
+    kind = int(lp[l, P_KIND])
+    if kind == TRANSPARENT:
+        return transparent_sample(hp, r, l, wox, woy, woz)
+    if kind == REFLECT:
+        return reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
+    return glass_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta)
+
+
+@kernel(inline="always")
+def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si):
+    """Continue through one non-diffuse lobe chosen by ``sel[si]`` (``selection`` at wo).
+
+    Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
+    the transparent lobe was taken). For non-delta lobes the weight and pdf are those of
+    the whole non-diffuse mixture (one-sample MIS over lobes), as multiple importance
+    sampling with light sampling requires.
+    """
+    n = sel.shape[1]
+    count = 0
+    acc = 0.0
+    for k in range(n):
+        acc += sel[si, k]
+        if u_select >= acc:
+            count += 1
+    choice = min(count, n - 1)
+    lo = 0.0
+    for k in range(choice):
+        lo += sel[si, k]
+    p_choice = sel[si, choice]
+    u_re = min(max((u_select - lo) / max(p_choice, TINY), 0.0), 1.0 - 1e-12)
+    j, t = locate(mu, woz)
+    l = 0
+    while int(lp[l, P_SAMPLED]) != choice:
+        l += 1
+    wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
+                                                lobe_eta(lp, l, inside))
+    s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
+    ms = ms_factor(lp, lt, hp, r, j, t, l)
+    p = max(p_choice, TINY)
+    w0, w1, w2 = w0 * s0 * ms / p, w1 * s1 * ms / p, w2 * s2 * ms / p
+    delta = lp[l, P_DELTA] != 0.0
+    valid = ok and p_choice > 0.0
+    pdf = 0.0
+    if valid and not delta:
+        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
+                                              sel, si)
+        if pdf > 0.0:
+            w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
+        else:
+            w0 = w1 = w2 = 0.0
+            valid = False
+    w0 = w0 if np.isfinite(w0) else 0.0
+    w1 = w1 if np.isfinite(w1) else 0.0
+    w2 = w2 if np.isfinite(w2) else 0.0
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, int(lp[l, P_KIND]) == TRANSPARENT

@@ -1,0 +1,81 @@
+"""GGX reflection lobe (metal, specular, coat, glossy): Fresnel, evaluation with its pdf, sampling.
+
+The reflected half of sampling (``reflected``: a microfacet normal and wo mirrored about it)
+and the masking weight are shared with glass, whose reflection is this lobe's.
+"""
+from __future__ import annotations
+
+from ..base import vectors as vec
+from ..base.constants import TINY
+from ..base.jit import kernel
+from . import microfacet as mf
+from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_DELTA, P_ETA_F, P_F82, P_FRESNEL,
+                     P_KIND, T_WHITE)
+from .tables import at
+
+
+@kernel(inline="always")
+def fresnel(lp, hp, r, l, c):
+    """RGB Fresnel factor of a reflect lobe at cos(wo, h) = c."""
+    kind = int(lp[l, P_FRESNEL])
+    if kind == F_DIELECTRIC:
+        f = mf.fresnel_dielectric1(c, lp[l, P_ETA_F])
+        return f * hp[r, l, H_F0], f * hp[r, l, H_F0 + 1], f * hp[r, l, H_F0 + 2]
+    if kind == F_F82:
+        return (mf.fresnel_f82(c, hp[r, l, H_F0], lp[l, P_F82]),
+                mf.fresnel_f82(c, hp[r, l, H_F0 + 1], lp[l, P_F82 + 1]),
+                mf.fresnel_f82(c, hp[r, l, H_F0 + 2], lp[l, P_F82 + 2]))
+    return hp[r, l, H_F0], hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2]
+
+
+@kernel(inline="always")
+def reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
+    """GGX reflection: (f |cos| RGB, density of sampling wi through this lobe)."""
+    alpha = lp[l, P_ALPHA]
+    hx, hy, hz = vec.unit(wox + wix, woy + wiy, woz + wiz)
+    cos_oh = min(max(wox * hx + woy * hy + woz * hz, 0.0), 1.0)
+    d = mf.ggx_d(hz, alpha)
+    c = d * mf.ggx_g2(woz, wiz, alpha) / (4.0 * max(woz, TINY))
+    f0, f1, f2 = fresnel(lp, hp, r, l, cos_oh)
+    return f0 * c, f1 * c, f2 * c, mf.ggx_g1(woz, alpha) * d / (4.0 * max(woz, TINY))
+
+
+
+@kernel(inline="always")
+def masking(lp, lt, l, j, t, woz, wiz):
+    """Sampling weight G2/G1 of visible-normal sampling toward wi.
+
+    A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
+    (the mean of G2/G1 over the lobe it stands for, which differs from G2/G1 at the
+    mirror direction near grazing); its refraction is masked at the refracted spread
+    alpha_t (none at IOR 1).
+    """
+    alpha = lp[l, P_ALPHA]
+    if lp[l, P_DELTA] == 0.0:
+        return mf.ggx_g2(woz, abs(wiz), alpha) / mf.ggx_g1(woz, alpha)
+    if wiz > 0.0:
+        return at(lt, l, T_WHITE, j, t)
+    a_t = lp[l, P_ALPHA_T] if int(lp[l, P_KIND]) == GLASS else alpha
+    return mf.ggx_g2(woz, abs(wiz), a_t) / mf.ggx_g1(woz, a_t)
+
+
+@kernel(inline="always")
+def reflected(lp, l, wox, woy, woz, u0, u1):
+    """(microfacet normal h, cos(wo, h), wo mirrored about h): h is the shading normal for a delta
+    lobe, else sampled among the normals visible from wo."""
+    if lp[l, P_DELTA] != 0.0:
+        hx, hy, hz = 0.0, 0.0, 1.0
+    else:
+        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA], u0, u1)
+    c = wox * hx + woy * hy + woz * hz
+    rx, ry, rz = 2.0 * c * hx - wox, 2.0 * c * hy - woy, 2.0 * c * hz - woz
+    return hx, hy, hz, c, rx, ry, rz
+
+
+@kernel(inline="always")
+def reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1):
+    """Sample the lobe alone: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
+    _, _, _, c, rx, ry, rz = reflected(lp, l, wox, woy, woz, u0, u1)
+    f0, f1, f2 = fresnel(lp, hp, r, l, min(max(c, 0.0), 1.0))
+    g = masking(lp, lt, l, j, t, woz, rz)
+    return rx, ry, rz, f0 * g, f1 * g, f2 * g, rz > 0.0
