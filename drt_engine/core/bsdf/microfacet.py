@@ -1,8 +1,8 @@
 """GGX microfacet terms, Fresnel, and their sampling in a local frame; albedo tables.
 
 Local frame: z is the (shading) normal. The microfacet terms are scalar kernels (one
-direction's components and numbers in, a few numbers out) that the lobe kernels of
-``lobes`` call per ray (vectors and frames are core.base.vectors).
+direction's components and numbers in, a few numbers out) that the lobe modules
+(``reflection``, ``glass``) and ``passes`` call per ray (vectors and frames are core.base.vectors).
 Alpha below ``DELTA_ALPHA`` is treated as a perfect mirror or smooth interface: the
 microfacet normal is the macro normal, but the lobe keeps the albedo of GGX at its own
 alpha (masking matters within a fraction of a degree of grazing, where alpha·tanθ is no
