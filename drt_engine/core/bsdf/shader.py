@@ -27,6 +27,7 @@ import numpy as np
 from ..scene import Closure, Material
 from . import layout
 from . import microfacet as mf
+from .records import BsdfSample, BsdfValue
 from .rows import colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, weights_rows
 
 
@@ -470,8 +471,8 @@ class MaterialShader:
         """BSDF times |cos| for light sampling.
 
         ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived
-        from the back of the surface (glass sees the inverse IOR). Returns (diffuse part,
-        non-diffuse part, density of continuing in direction wi through the non-diffuse
+        from the back of the surface (glass sees the inverse IOR). Returns a BsdfValue (diffuse
+        part, non-diffuse part, density of continuing in direction wi through the non-diffuse
         lobes, for multiple importance sampling). ``sel``: ``selection(wo[:, 2])`` when the
         caller has it already (it depends on wo only, so every light strategy shares it).
         """
@@ -483,14 +484,14 @@ class MaterialShader:
         pdf = np.empty(n)
         evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
                          _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
-        return f_diff, f_nd, pdf
+        return BsdfValue(diffuse=f_diff, glossy=f_nd, pdf=pdf)
 
     # -- sampling -------------------------------------------------------------------
     def sample(self, wo: np.ndarray, u_select: np.ndarray, u2: np.ndarray, inside: np.ndarray, rows=None):
         """Continue through one non-diffuse lobe chosen by its albedo.
 
-        Returns (wi, weight = f |cos| / pdf, pdf (0 for delta), delta flag, valid flag,
-        pass-through flag: the transparent lobe was taken).
+        Returns a BsdfSample (wi, weight = f |cos| / pdf, pdf (0 for delta), delta flag, valid
+        flag, pass-through flag: the transparent lobe was taken).
         For non-delta lobes the weight and pdf are those of the whole non-diffuse
         mixture (one-sample MIS over lobes), which multiple importance sampling with
         light sampling requires.
@@ -505,7 +506,7 @@ class MaterialShader:
         sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
                        _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
                        len(self.sampled))
-        return wi, weight, pdf, delta, valid, passthrough
+        return BsdfSample(wi_l=wi, weight=weight, pdf=pdf, delta=delta, valid=valid, passthrough=passthrough)
 
     # -- albedo passes --------------------------------------------------------------
     def colors(self, mu_o: np.ndarray, rows=None):

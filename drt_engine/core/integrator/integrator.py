@@ -24,7 +24,7 @@ from ..geometry.accel import spawn
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
 from .ratio import add_unoccluded
-from .records import BsdfSample, PathState, Samples, ShadowRays, SurfaceHits
+from .records import PathState, Samples, ShadowRays, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
@@ -36,6 +36,23 @@ def _power(a, b):
     a2 = np.where(np.isinf(a), 1.0, a * a)
     b2 = np.where(np.isinf(a), 0.0, b * b)
     return a2 / np.maximum(a2 + b2, TINY)
+
+
+def _add_emitted(out: "WaveOutput", path, throughput, emitted, prev_pdf, light_pdf):
+    """Emission a BSDF-sampled ray found, any emitter: weighted by the power heuristic against
+    light sampling where both could have produced the direction (``light_pdf(rows)``, the
+    light-sampling density of those rows' directions; None if light sampling never picks this
+    emitter; camera rays and delta lobes, prev_pdf = inf, take it whole). Adds it to the wave's
+    radiance and denoising features and returns throughput x weighted emission."""
+    weight = np.ones(len(path))
+    smooth = np.flatnonzero(~np.isinf(prev_pdf))
+    if len(smooth) and light_pdf is not None:
+        weight[smooth] = _power(prev_pdf[smooth], light_pdf(smooth))
+    e = throughput * emitted * weight[:, None]
+    out.radiance[path] += e
+    if out.features is not None:
+        out.features.emitted(path, emitted * weight[:, None])
+    return e
 
 
 @dataclass
@@ -182,8 +199,9 @@ class Integrator:
         time = sampler.get(samples.pixel, samples.sample, D.TIME) if self.timed else np.zeros(n)
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
         self._count("camera", n)
-        state = PathState(np.arange(n), cam.origins, cam.directions, cam.tmax, np.ones((n, 3)), np.full(n, np.inf),
-                          np.zeros((n, 3)), np.zeros((n, 3)), np.ones(n, bool), time)
+        state = PathState(path=np.arange(n), origins=cam.origins, dirs=cam.directions, tmax=cam.tmax,
+                          throughput=np.ones((n, 3)), prev_pdf=np.full(n, np.inf), prev_normal=np.zeros((n, 3)),
+                          prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time)
         return state, cam
 
     # -- what rays see ----------------------------------------------------------------
@@ -191,19 +209,16 @@ class Integrator:
         """Lights hit directly: always by reflected and refracted rays, by the camera if asked."""
         if len(rays) == 0:
             return
-        contrib = le
-        smooth = np.flatnonzero(~np.isinf(rays.prev_pdf))
-        if len(smooth):
+
+        def light_pdf(smooth):
             pl = np.zeros(len(smooth))
             for li in np.unique(light_id[smooth]):
                 sel = light_id[smooth] == li
                 k = smooth[sel]
                 pl[sel] = self.lights.pdf(li, rays.origins[k], rays.dirs[k], t[k], rays.time[k])
-            contrib = contrib.copy()
-            contrib[smooth] *= _power(rays.prev_pdf[smooth], pl)[:, None]
-        out.radiance[rays.path] += rays.throughput * contrib
-        if out.features is not None:
-            out.features.emitted(rays.path, contrib)
+            return pl
+
+        _add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
         if self.film_transparent:
             direct = rays.straight
             out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
@@ -222,21 +237,13 @@ class Integrator:
             keep = np.flatnonzero(~st)
             rays, world = rays.take(keep), world[keep]
         if len(rays) and lights.world_seen:
-            weight = np.ones(len(rays))
-            smooth = np.flatnonzero(~np.isinf(rays.prev_pdf))
-            if len(smooth) and lights.world is not None:
-                weight[smooth] = _power(rays.prev_pdf[smooth],
-                                        lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
-            out.radiance[rays.path] += rays.throughput * world * weight[:, None]
-            if out.features is not None:
-                out.features.emitted(rays.path, world * weight[:, None])
+            sampled = None if lights.world is None else (  # a world light sampling can find
+                lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
+            _add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled)
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
-            weight = np.where(np.isinf(bounced.prev_pdf), 1.0, _power(bounced.prev_pdf, pdf_sun))
-            out.radiance[bounced.path] += bounced.throughput * sun * weight[:, None]
-            if out.features is not None:
-                out.features.emitted(bounced.path, sun * weight[:, None])
+            _add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
 
     def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
@@ -249,10 +256,11 @@ class Integrator:
         bad = vec.dot(wo, ns_o) <= 1e-6
         ns_o[bad] = ng_o[bad]
         tangent, bitangent = _frame(ns_o)
-        return SurfaceHits(state.path[rows], rows, prim, self.geometry.material[prim], pos, ng_o, ns_o, tangent,
-                           bitangent, wo, _to_local(wo, tangent, bitangent, ns_o), inside,
-                           self.geometry.offset_scale(prim, pos), state.throughput[rows], state.straight[rows],
-                           state.time[rows], ns)
+        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material[prim], pos=pos,
+                           ng=ng_o, ns=ns_o, tangent=tangent, bitangent=bitangent, wo=wo,
+                           wo_l=_to_local(wo, tangent, bitangent, ns_o), inside=inside,
+                           scale=self.geometry.offset_scale(prim, pos), throughput=state.throughput[rows],
+                           straight=state.straight[rows], time=state.time[rows], normal=ns)
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
@@ -263,16 +271,9 @@ class Integrator:
         prim = surf.prim[glowing]
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing])
-        weight = np.ones(len(glowing))
-        prev_pdf = state.prev_pdf[hit]
-        smooth = np.flatnonzero(~np.isinf(prev_pdf))
-        if len(smooth):
-            pl = self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]], hits.t[hit[smooth]])
-            weight[smooth] = _power(prev_pdf[smooth], pl)
-        e = surf.throughput[glowing] * emission * weight[:, None]
-        out.radiance[surf.path[glowing]] += e
-        if out.features is not None:
-            out.features.emitted(surf.path[glowing], emission * weight[:, None])
+        e = _add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
+                         lambda smooth: self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]],
+                                                                 hits.t[hit[smooth]]))
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
@@ -375,9 +376,9 @@ class Integrator:
                 continue
             wi_l = _to_local(ls.wi, hits.tangent, hits.bitangent, hits.ns)
             above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
-            f_diff, f_nd, pdf_b = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
-            f_diff, f_nd = ls.restrict(f_diff, f_nd, above)
-            w_l = _power(ls.pdf, pdf_b)
+            f = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
+            f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
+            w_l = _power(ls.pdf, f.pdf)
             contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
             by_ratio = k in self.ratio and albedo is not None
             if by_ratio:
@@ -393,19 +394,20 @@ class Integrator:
             dist = ls.dist[sel]
             stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
             tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
-            out.append(ShadowRays(hits.path[sel], origin, ls.wi[sel], np.maximum(tmax, 0.0), contrib[sel],
-                                  diffuse[sel] if by_ratio else np.zeros((len(sel), 3)) if self.ratio else None))
+            share = diffuse[sel] if by_ratio else np.zeros((len(sel), 3)) if self.ratio else None
+            out.append(ShadowRays(path=hits.path[sel], origins=origin, dirs=ls.wi[sel], tmax=np.maximum(tmax, 0.0),
+                                  contrib=contrib[sel], diffuse=share))
         return out
 
     @staticmethod
     def _diffuse_albedo(shader, hits: SurfaceHits, sel_lobes):
         """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
         the diffuse part toward the normal, since it is that times the cosine (the layers above
-        attenuate it by factors of wo alone, lobes.eval_lobes)."""
+        attenuate it by factors of wo alone, bsdf.mixture.eval_lobes)."""
         n = len(hits.path)
         normal = np.zeros((n, 3))
         normal[:, 2] = 1.0
-        f_diff, _, _ = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes)
+        f_diff = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes).diffuse
         return hits.throughput * f_diff if (f_diff > 0).any() else None
 
     def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
@@ -427,7 +429,7 @@ class Integrator:
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
         """The paths of these hits continued through one sampled lobe (None if none goes on)."""
-        bs = BsdfSample(*shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside))
+        bs = shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside)
         new_thr = hits.throughput * bs.weight
         sel = np.flatnonzero(bs.valid & (vec.max3(new_thr) > 0))
         wi = _to_world(bs.wi_l[sel], hits.tangent[sel], hits.bitangent[sel], hits.ns[sel])
@@ -443,9 +445,10 @@ class Integrator:
         self._count("reflection", (~transmit).sum())
         self._count("transparent", passthrough.sum())
         n = len(sel)
-        return PathState(hits.path[sel], origin, wi, np.full(n, np.inf), new_thr[sel],
-                         np.where(bs.delta[sel], np.inf, bs.pdf[sel]), hits.ng[sel], hits.ns[sel],
-                         hits.straight[sel] & passthrough, hits.time[sel])
+        return PathState(path=hits.path[sel], origins=origin, dirs=wi, tmax=np.full(n, np.inf),
+                         throughput=new_thr[sel], prev_pdf=np.where(bs.delta[sel], np.inf, bs.pdf[sel]),
+                         prev_normal=hits.ng[sel], prev_shading=hits.ns[sel],
+                         straight=hits.straight[sel] & passthrough, time=hits.time[sel])
 
 
 TERMINATOR_CUTOFF = 0.1

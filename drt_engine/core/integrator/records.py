@@ -101,19 +101,6 @@ class SurfaceHits:
 
 
 @dataclass
-class BsdfSample:
-    """A direction sampled from a hit's lobes: local and world direction, the throughput
-    it leaves, its pdf (inf for a delta lobe) and whether it passed straight through."""
-
-    wi_l: np.ndarray
-    weight: np.ndarray
-    pdf: np.ndarray
-    delta: np.ndarray
-    valid: np.ndarray
-    passthrough: np.ndarray
-
-
-@dataclass
 class ShadowRays:
     """Shadow rays not yet traced: what each adds to its path's radiance when unblocked, and
     the share of that the ratio estimator takes (its N; zero for other lights, core.integrator.ratio)."""
