@@ -9,9 +9,9 @@
 #                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make bench-ratio the ratio estimator against Monte Carlo: efficiency, bias, where the error is
-#                    (bench/ratio_estimator.py: README block, bench/ratio_estimator.json); about 30 minutes
+#                    (bench/ratio_estimator.py: docs/ratio-estimator.md, bench/ratio_estimator.json); about 30 minutes
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
-#   make texture-parity  DRT vs Cycles per procedural texture and mode (tools/texture_parity.py: README table)
+#   make texture-parity  DRT vs Cycles per procedural texture and mode (bench/texture_parity.py: docs/shader-node-parity.md)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes the venvs and wheels/
 #   make blender-env build (once, cached in BLENDER_ENV) a Debian 13 root with Blender 4.3.2; needs root
@@ -105,7 +105,7 @@ extension: $(WHEELS) | $(STAMP)
 	$(BLENDER_EXT) build --source-dir $(STAGE) --output-dir $(DIST) --split-platforms
 	@rm -rf $(STAGE)
 	@for zip in $(DIST)/drt_engine-*.zip; do $(BLENDER_EXT) validate "$$zip" || exit 1; done
-	$(PY) tools/zip_sizes.py --dist $(DIST)
+	$(PY) bench/zip_sizes.py --dist $(DIST)
 
 scenes: $(STAMP)
 	@for script in sample_scenes/build_*.py; do echo "$(PY) $$script"; $(PY) "$$script" || exit 1; done
@@ -145,4 +145,4 @@ test-blender: blender-env extension
 	DRT_BLENDER_ENV=$(BLENDER_ENV) $(PY) -m pytest tests/real_blender -q $(PYTEST_ARGS)
 
 texture-parity: $(STAMP)
-	$(PY) tools/texture_parity.py
+	$(PY) bench/texture_parity.py

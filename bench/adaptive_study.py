@@ -12,8 +12,8 @@ adaptive render ends sooner, every pixel under the threshold, uniform is read at
 estimated relMSE (``adaptive.image_error``) against the true one, each averaged over the
 seeds at the k-th step; and renders with ``target_error`` set, their true relMSE at the stop.
 
-Writes bench/results/adaptive_<what>.json; ``--publish`` also writes the table into README.md's
-block ``adaptive-<what>`` (bench/readme.py) and the measurements to bench/adaptive_<what>.json
+Writes bench/results/adaptive_<what>.json; ``--publish`` also writes the table into docs/adaptive-sampling.md's
+block ``adaptive-<what>`` (bench/blocks.py) and the measurements to bench/adaptive_<what>.json
 (committed).
 """
 from __future__ import annotations
@@ -34,7 +34,7 @@ import numpy as np  # noqa: E402
 from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from readme import write_block  # noqa: E402
+from blocks import write_block  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 REFERENCE_SAMPLES = 2048
@@ -200,7 +200,7 @@ def main(argv=None):
     parser.add_argument("--min-samples", type=int, default=0, help="adaptive Min Samples (0: automatic, the default)")
     parser.add_argument("--soft-thresholds", type=float, nargs="*", default=[None],
                         help="noise thresholds of the soft-shadow rows (default: the default threshold only)")
-    parser.add_argument("--publish", action="store_true", help="also write README.md's block and bench/adaptive_<what>.json")
+    parser.add_argument("--publish", action="store_true", help="also write docs/adaptive-sampling.md's block and bench/adaptive_<what>.json")
     parser.add_argument("--publish-only", action="store_true", help="publish the last run's results without rendering")
     parser.add_argument("--append", action="store_true", help="add this run's rows to the last run's saved results "
                         "(scenes run one process each)")

@@ -1,4 +1,4 @@
-"""README block ``bench:denoise`` from what tests/blender/test_denoise.py measured (out/ui/denoise.json).
+"""docs/denoising.md's block ``bench:denoise`` from what tests/blender/test_denoise.py measured (out/ui/denoise.json).
 
     .venv/bin/python -m pytest tests/blender/test_denoise.py && .venv/bin/python bench/denoise_figures.py
 """
@@ -26,7 +26,7 @@ def block(m: dict) -> str:
 
 
 def main() -> None:
-    from bench.readme import write_block
+    from bench.blocks import write_block
 
     write_block("denoise", block(json.loads(MEASURED.read_text())))
 

@@ -10,7 +10,7 @@ In one run, on this machine:
 (c) a part's pixel-proportional costs at 1920x1080 (write, read, add into the film, pickle
     size), in this process;
 (d) from these, a model of the speed-up on N machines (one worker each), written into
-    README.md between the farm markers, the raw figures into bench/FARM.json.
+    docs/render-farms.md between the farm markers, the raw figures into bench/FARM.json.
 
     .venv/bin/python bench/farm.py [--size 96 --samples 256]
 """
@@ -21,7 +21,6 @@ import json
 import math
 import os
 import pickle
-import re
 import resource
 import subprocess
 import sys
@@ -37,7 +36,10 @@ import numpy as np  # noqa: E402
 from drt_engine.core.film import parts  # noqa: E402
 from drt_engine.core.film.film import Film  # noqa: E402
 
+from blocks import replace_between  # noqa: E402
+
 SCENE = ROOT / "sample_scenes" / "cornell_box.blend"
+PAGE = ROOT / "docs" / "render-farms.md"
 MARK_BEGIN, MARK_END = "<!-- farm: begin -->", "<!-- farm: end -->"
 NETWORK = 1e9 / 8  # bytes per second: the model assumes 1 Gbit/s between the machines
 MODEL_MACHINES = (1, 2, 4, 8, 16, 64)
@@ -174,8 +176,7 @@ def section(m: dict) -> str:
     aw, ah, aspp, frames = ANIMATION
     model_rows = "\n".join(f"| {n} | {mod['frame'][n]:.1f}x | {mod['animation'][n]:.1f}x |" for n in MODEL_MACHINES)
     p = m["parts"]
-    return f"""{MARK_BEGIN}
-Measured by `bench/farm.py` on this machine ({m['cores']} cores; load average {m['load'][0]:.0f} at the start and
+    return f"""Measured by `bench/farm.py` on this machine ({m['cores']} cores; load average {m['load'][0]:.0f} at the start and
 {m['load'][1]:.0f} at the end: {_load_words(m)}): `{m['scene']}` at {m['size']}x{m['size']}, {m['samples']} samples.
 2 local workers took {f['wall_s'] / s['wall_s']:.2f} times the wall time of 1 process (cluster start and each task's
 overhead below against a render of {s['render_s']:.1f} s).
@@ -208,17 +209,11 @@ Per task {mod['worker_s']:.1f} s of overhead; one render alone {mod['alone_s']:.
 | machines | {w}x{h} frame | {frames}-frame animation |
 |---|---|---|
 {model_rows}
-{MARK_END}
 """
 
 
 def publish(text: str) -> None:
-    readme = ROOT / "README.md"
-    old = readme.read_text()
-    pattern = re.compile(re.escape(MARK_BEGIN) + ".*?" + re.escape(MARK_END) + "\n?", re.S)
-    if MARK_BEGIN not in old:
-        raise SystemExit(f"README.md has no {MARK_BEGIN} marker")
-    readme.write_text(pattern.sub(lambda _: text, old))
+    replace_between(PAGE, MARK_BEGIN, MARK_END, text)
 
 
 def main():

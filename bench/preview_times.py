@@ -3,9 +3,9 @@ preview, ``bpy.ops.wm.previews_ensure``, the engine's ``is_preview`` path) of th
 box's materials, kernels cached, and where each render's time goes: every material's previews
 are rendered WARM_ROUNDS times (the first compiles or loads the kernels), then once more, measured.
 
-    .venv/bin/python bench/preview_times.py [--label NAME] [--readme]
+    .venv/bin/python bench/preview_times.py [--label NAME] [--publish]
 
-Appends a run to bench/preview_times.json under ``--label``; ``--readme`` writes the README
+Appends a run to bench/preview_times.json under ``--label``; ``--publish`` writes docs/performance.md's
 block ``bench:preview-times`` from every label in that file.
 """
 from __future__ import annotations
@@ -80,7 +80,7 @@ def measure() -> dict:
     return out
 
 
-def readme_block(runs: dict) -> str:
+def block(runs: dict) -> str:
     lines = ["| code | icon (px) median / max s | export / prepare / trace s | large (px) median / max s "
              "| export / prepare / trace s |", "|---|---|---|---|---|"]
     for label, run in runs.items():
@@ -102,15 +102,15 @@ def readme_block(runs: dict) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--label", default="current")
-    parser.add_argument("--readme", action="store_true")
+    parser.add_argument("--publish", action="store_true")
     args = parser.parse_args()
     runs = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     runs[args.label] = measure()
     RESULTS.write_text(json.dumps(runs, indent=2) + "\n")
     print(json.dumps(runs[args.label], indent=2))
-    if args.readme:
-        from bench.readme import write_block
-        write_block("preview-times", readme_block(runs))
+    if args.publish:
+        from bench.blocks import write_block
+        write_block("preview-times", block(runs))
 
 
 if __name__ == "__main__":

@@ -9,8 +9,8 @@ table gives RATIO's efficiency over MONTE_CARLO's, its relMSE and time ratios, a
 bias: the relative difference of its image mean from the reference's.
 
 References are cached in bench/results/ (ratio_reference_<scene>_<w>x<h>.npz). Writes
-bench/results/ratio_estimator.json; ``--publish`` also writes the table into README.md's block
-``ratio`` (bench/readme.py) and the measurements to bench/ratio_estimator.json (committed).
+bench/results/ratio_estimator.json; ``--publish`` also writes the table into docs/ratio-estimator.md's block
+``ratio`` (bench/blocks.py) and the measurements to bench/ratio_estimator.json (committed).
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ from drt_engine.core.render.adaptive import RELMSE_EPSILON, true_error  # noqa: 
 from drt_engine.core.film.ratio_sums import RATIO  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from readme import write_block  # noqa: E402
+from blocks import write_block  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 ESTIMATORS = ("MONTE_CARLO", "RATIO")
@@ -146,7 +146,7 @@ def main(argv=None):
     parser.add_argument("--seeds", type=int, default=2)
     parser.add_argument("--reference-samples", type=int, default=1024)
     parser.add_argument("--scenes", nargs="*", default=["cornell_box", "glossy_spheres", "dof_row", "motion_blur"])
-    parser.add_argument("--publish", action="store_true", help="write README's block and bench/ratio_estimator.json")
+    parser.add_argument("--publish", action="store_true", help="write docs/ratio-estimator.md's block and bench/ratio_estimator.json")
     args = parser.parse_args(argv)
     from soft_shadow import soft_shadow_scene
 

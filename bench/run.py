@@ -22,7 +22,7 @@ the same scene (its sync and BVH build).
 
 Writes bench/results/<scene>.png (log-log plot), bench/results/<scene>.json and
 bench/results/RESULTS.md; with --publish also bench/RESULTS.md, the plots in bench/plots/ and
-README.md's block ``bench-adaptive`` (bench/readme.py).
+docs/adaptive-sampling.md's block ``bench-adaptive`` (bench/blocks.py).
 """
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.render.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from readme import write_block  # noqa: E402
+from blocks import write_block  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "tests" / "blender"))
@@ -289,8 +289,8 @@ def table(results, width, ref_samples, cap, plots=".") -> str:
     return "\n".join(lines) + "\n"
 
 
-def readme_block(results, width, ref_samples, cap) -> str:
-    """README's adaptive benchmark paragraph: where it was made, with what, and the speed-ups."""
+def adaptive_block(results, width, ref_samples, cap) -> str:
+    """docs/adaptive-sampling.md's adaptive benchmark paragraph: where it was made, with what, and the speed-ups."""
     return "\n".join([f"Made by `make bench` on {time.strftime('%Y-%m-%d', time.gmtime())} ({machine()}). "
                       + settings_text(width, ref_samples, cap), "", "Speed-up at relMSE 1e-3 (at 3e-3 in "
                       "brackets), each adaptive curve over its own renderer's plain sampling:", ""]
@@ -315,7 +315,7 @@ def main(argv=None):
     parser.add_argument("--scenes", nargs="*", default=SCENES)
     parser.add_argument("--out", default=str(ROOT / "bench" / "results"))
     parser.add_argument("--publish", action="store_true", help="also write bench/RESULTS.md, the plots in "
-                        "bench/plots/ and README.md's adaptive benchmark block (committed)")
+                        "bench/plots/ and docs/adaptive-sampling.md's adaptive benchmark block (committed)")
     args = parser.parse_args(argv)
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -334,7 +334,7 @@ def main(argv=None):
         for name in results:
             shutil.copyfile(out_dir / f"{name}.png", plots / f"{name}.png")
         publish_table(table(results, args.width, args.reference_samples, args.cap, "plots"))
-        write_block("bench-adaptive", readme_block(results, args.width, args.reference_samples, args.cap))
+        write_block("bench-adaptive", adaptive_block(results, args.width, args.reference_samples, args.cap))
 
 
 if __name__ == "__main__":

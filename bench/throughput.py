@@ -40,7 +40,7 @@ import drt_engine  # noqa: E402
 from drt_engine.core.geometry import camera as camera_rays  # noqa: E402
 from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render.render import WAVE, Renderer  # noqa: E402
-from readme import write_block  # noqa: E402
+from blocks import write_block  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 from startup import describe, measure  # noqa: E402
 
@@ -242,7 +242,7 @@ def main(argv=None):
     text = table(rows, memory, startup, args.width, args.samples, cores, args.memory_scene, args.memory_samples)
     (ROOT / "bench" / "THROUGHPUT.md").write_text(text)
     write_results_section(text)
-    write_block("throughput", text.split("\n", 2)[2])  # README's copy, without the title
+    write_block("throughput", text.split("\n", 2)[2])  # docs/performance.md's copy, without the title
     print(text)
 
 

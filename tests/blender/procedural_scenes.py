@@ -1,5 +1,5 @@
 """Procedural texture cases and the scenes that show them, for the Cycles parity test and
-tools/texture_parity.py (which writes the measured figures into README's node table).
+bench/texture_parity.py (which writes the measured figures into docs/shader-node-parity.md's table).
 
 Every case is one emissive 2 x 2 m tile of a grid seen straight down by an orthographic
 camera, each tile exactly ``TILE`` pixels wide: the texture node, fed by the tile's Object

@@ -1,7 +1,7 @@
 """A render split into sample ranges (parts, a Dask LocalCluster of 2 workers) is the single render.
 
 The merge adds float64 sums in another grouping than the single render's waves, so images
-are compared within 1e-6 relative (README: Render farms). Every run is bounded by a
+are compared within 1e-6 relative (docs/render-farms.md). Every run is bounded by a
 timeout, and every process a run started must be gone when it ends.
 """
 import json

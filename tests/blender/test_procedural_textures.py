@@ -48,7 +48,7 @@ def test_lit_scene_matches_cycles(drt, tmp_path):
     assert figures["ok"], figures
 
 
-@pytest.mark.parametrize("blend", [0.0, 0.3])  # as tools/texture_parity.BOX_BLENDS
+@pytest.mark.parametrize("blend", [0.0, 0.3])  # as bench/texture_parity.BOX_BLENDS
 def test_image_box_projection_matches_cycles(drt, tmp_path, blend):
     scene = ps.box_scene(blend=blend)
     assert not [w for w in render_export(scene).warnings if "projection" in w]

@@ -1,4 +1,4 @@
-"""The version matrix says what it does: README's table is the one the Makefile and CI make, the
+"""The version matrix says what it does: docs/blender-versions.md's table is the one the Makefile and CI make, the
 extension's oldest Blender is the oldest one tested, and every tested Blender's Python has the
 extension's wheels on every platform."""
 import sys
@@ -6,18 +6,18 @@ import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(ROOT / "bench"))
 import versions_table  # noqa: E402
 from test_extension import WHEEL_TAG  # noqa: E402
 
 MANIFEST = tomllib.loads((ROOT / "blender_manifest.toml").read_text())
 
 
-def test_readme_table_is_what_the_makefile_and_ci_run():
-    readme = (ROOT / "README.md").read_text()
-    start = readme.index(versions_table.BEGIN) + len(versions_table.BEGIN)
-    assert readme[start:readme.index(versions_table.END)] == "\n" + versions_table.table(), (
-        "README's Tested Blender versions table is stale: run `python3 tools/versions_table.py --write`")
+def test_docs_table_is_what_the_makefile_and_ci_run():
+    page = versions_table.PAGE.read_text()
+    start = page.index(versions_table.BEGIN) + len(versions_table.BEGIN)
+    assert page[start:page.index(versions_table.END)] == "\n" + versions_table.table(), (
+        "docs/blender-versions.md's table is stale: run `python3 bench/versions_table.py --write`")
 
 
 def test_ci_runs_the_other_versions():

@@ -1,10 +1,10 @@
-"""README's viewport figures, from what the GUI test measured (out/ui/viewport_times.json).
+"""docs/viewport.md's figures, from what the GUI test measured (out/ui/viewport_times.json).
 
 ``make test-blender`` drives Blender 4.3.2's GUI under Xvfb (tests/real_blender/in_blender/
 gui_driver.py: the 3D view maximised, 50 orbit steps and 20 edits on the Cornell box) and
 writes each step's time to the first new image drawn, to the first full-resolution image,
 and Blender's resident memory after it. This prints the table; ``--publish`` also writes it
-into README.md between its markers, so the figures there are the ones measured, not typed.
+into docs/viewport.md between its markers, so the figures there are the ones measured, not typed.
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from statistics import mean, median
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from bench.readme import write_block  # noqa: E402
+from bench.blocks import write_block  # noqa: E402
 TIMES = ROOT / "out" / "ui" / "viewport_times.json"
 
 
@@ -54,7 +54,7 @@ def table(times: dict) -> str:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--times", type=Path, default=TIMES)
-    parser.add_argument("--publish", action="store_true", help="write the table into README.md")
+    parser.add_argument("--publish", action="store_true", help="write the table into docs/viewport.md")
     args = parser.parse_args()
     if not args.times.is_file():
         sys.exit(f"error: {args.times} does not exist: run make test-blender first")

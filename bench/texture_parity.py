@@ -1,15 +1,14 @@
-"""Measure DRT's procedural textures against Cycles and write the figures into README.
+"""Measure DRT's procedural textures against Cycles and write the figures into docs/shader-node-parity.md.
 
 Renders tests/blender/procedural_scenes.py's grid (one tile per texture and mode), lit
 scene and Box-projected image with DRT (seed 0) and Cycles (seeds 0 and 1) at 64 samples, as the parity test does,
-writes docs/texture_parity.json, and replaces README's block between the markers below with
+writes docs/texture_parity.json, and replaces docs/shader-node-parity.md's block between the markers below with
 a table of each case's worst 4x4-block difference from Cycles beside Cycles' own between its
-two seeds. Run from the repository root: .venv/bin/python tools/texture_parity.py
+two seeds. Run from the repository root: .venv/bin/python bench/texture_parity.py
 """
 from __future__ import annotations
 
 import json
-import re
 import sys
 import tempfile
 from pathlib import Path
@@ -20,11 +19,13 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "blender")]
 import bpy  # noqa: E402
 
 import drt_engine  # noqa: E402
+from bench.blocks import replace_between  # noqa: E402
 import procedural_scenes as ps  # noqa: E402
 import render_helpers as rh  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- texture parity: begin -->", "<!-- texture parity: end -->"
 JSON_PATH = ROOT / "docs" / "texture_parity.json"
+PAGE = ROOT / "docs" / "shader-node-parity.md"
 BOX_BLENDS = (0.0, 0.3)
 
 
@@ -47,7 +48,7 @@ def measure() -> dict:
 
 
 def table(figures: dict) -> str:
-    rows = [f"Measured by `tools/texture_parity.py` (Blender {figures['blender']}, {figures['samples']} samples, "
+    rows = [f"Measured by `bench/texture_parity.py` (Blender {figures['blender']}, {figures['samples']} samples, "
             f"{figures['tile_px']}-pixel tiles): the worst 4x4-block difference of DRT from Cycles, beside "
             "Cycles' own worst between two seeds; a case passes at 1.5x that plus 0.002.", "",
             "| texture and mode | DRT vs Cycles | Cycles vs Cycles | within |", "|---|---|---|---|"]
@@ -56,20 +57,11 @@ def table(figures: dict) -> str:
     return "\n".join(rows) + "\n"
 
 
-def write_readme(text: str) -> None:
-    readme = ROOT / "README.md"
-    old = readme.read_text()
-    if MARK_BEGIN not in old:
-        raise SystemExit(f"README.md has no {MARK_BEGIN} marker")
-    pattern = re.compile(re.escape(MARK_BEGIN) + ".*?" + re.escape(MARK_END), re.S)
-    readme.write_text(pattern.sub(lambda _: f"{MARK_BEGIN}\n{text}{MARK_END}", old))
-
-
 def main() -> None:
     drt_engine.register()
     figures = measure()
     JSON_PATH.write_text(json.dumps(figures, indent=1) + "\n")
-    write_readme(table(figures))
+    replace_between(PAGE, MARK_BEGIN, MARK_END, table(figures))
     failed = [name for name, f in figures["cases"].items() if not f["ok"]]
     print(f"{len(figures['cases'])} cases, {len(failed)} outside the limit" + (f": {failed}" if failed else ""))
 

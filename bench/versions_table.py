@@ -1,10 +1,10 @@
-"""README's "Tested Blender versions" table, made from what the Makefile and CI run.
+"""docs/blender-versions.md's "Tested Blender versions" table, made from what the Makefile and CI run.
 
 The rows come from the Makefile's ``BPY_VERSIONS`` (each version's requirements file gives its bpy,
 NumPy and Python) and from the ``make`` lines of ``.ci/run`` (which targets CI runs, and for which
 versions); the Debian binary of ``make test-blender`` is the one row written here. ``--write``
-puts the table into README.md between its markers; without it the table is printed.
-tests/blender/test_version_matrix.py fails while README's table differs from this output.
+puts the table into docs/blender-versions.md between its markers; without it the table is printed.
+tests/blender/test_version_matrix.py fails while that page's table differs from this output.
 """
 from __future__ import annotations
 
@@ -13,7 +13,10 @@ import shlex
 import sys
 from pathlib import Path
 
+from blocks import replace_between
+
 ROOT = Path(__file__).resolve().parents[1]
+PAGE = ROOT / "docs" / "blender-versions.md"
 BEGIN, END = "<!-- versions table: begin -->", "<!-- versions table: end -->"
 DEFAULT = "5.0"  # the pinned default: .venv from requirements.txt
 NAMES = {"4.2": "4.2 LTS", "5.2": "5.2 LTS"}
@@ -78,15 +81,12 @@ def table() -> str:
     return "\n".join(rows) + "\n"
 
 
-def write_readme() -> None:
-    readme = ROOT / "README.md"
-    text = readme.read_text()
-    start, end = text.index(BEGIN) + len(BEGIN), text.index(END)
-    readme.write_text(text[:start] + "\n" + table() + text[end:])
+def write_page() -> None:
+    replace_between(PAGE, BEGIN, END, table())
 
 
 if __name__ == "__main__":
     if sys.argv[1:] == ["--write"]:
-        write_readme()
+        write_page()
     else:
         sys.stdout.write(table())

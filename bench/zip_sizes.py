@@ -1,7 +1,7 @@
 """Sizes of the extension zips in dist/ and of the numba + llvmlite wheels inside them.
 
-`make extension` prints the table; `python tools/zip_sizes.py --publish` also writes it into
-README.md between its markers, so the sizes there are the ones measured, not typed.
+`make extension` prints the table; `python bench/zip_sizes.py --publish` also writes it into
+docs/install.md between its markers, so the sizes there are the ones measured, not typed.
 """
 import argparse
 import re
@@ -12,7 +12,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from bench.readme import write_block  # noqa: E402
+from bench.blocks import write_block  # noqa: E402
 NOTES = {"macos_arm64": " (PyPI has no embreex 4.4 wheel for Intel Macs)"}
 
 
@@ -33,7 +33,7 @@ def table(dist: Path) -> str:
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--dist", type=Path, default=ROOT / "dist")
-    parser.add_argument("--publish", action="store_true", help="write the table into README.md")
+    parser.add_argument("--publish", action="store_true", help="write the table into docs/install.md")
     args = parser.parse_args()
     text = table(args.dist)
     print(text)
