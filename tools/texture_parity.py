@@ -15,13 +15,13 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "blender")]
+sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402
 
 import drt_engine  # noqa: E402
-import procedural_scenes as ps  # noqa: E402
-import render_helpers as rh  # noqa: E402
+from tests.support import procedural_scenes as ps  # noqa: E402
+from tests.support import render_helpers as rh  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- texture parity: begin -->", "<!-- texture parity: end -->"
 JSON_PATH = ROOT / "docs" / "texture_parity.json"
