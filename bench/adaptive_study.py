@@ -4,7 +4,7 @@
 (Adaptive Sampling ticked, nothing else changed) at the scene's own sample count, several
 seeds; the true relMSE of each against a 2048-sample reference; the ratio is uniform's
 relMSE, interpolated log-log in CPU time at the adaptive render's end, over adaptive's,
-pooled over the seeds (mean relMSE). Also the soft-shadow scene (bench/soft_shadow.py)
+pooled over the seeds (mean relMSE). Also the soft-shadow scene (tests/support/scenes.py)
 under a time limit, both renders given the same limit and a cap they cannot reach (if the
 adaptive render ends sooner, every pixel under the threshold, uniform is read at its time).
 
@@ -122,7 +122,7 @@ def gain_row(name, data, base, samples, seeds, time_limit=0.0, min_samples=0, th
 def gain(args):
     rows = [gain_row(*scene, seeds=range(args.seeds), min_samples=args.min_samples)
             for scene in sample_scenes(args.width, args.scenes)]
-    from soft_shadow import soft_shadow_scene
+    from tests.support.scenes import soft_shadow_scene
 
     data, base = soft_shadow_scene(args.soft_width)
     for threshold in args.soft_thresholds:  # None: the default threshold

@@ -13,12 +13,11 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests" / "core"))
 
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from scenes import look_at, plane, top_camera, translation  # noqa: E402
+from tests.support.scenes import look_at, plane, top_camera, translation  # noqa: E402
 
 N = 65_536
 REPEAT = 20

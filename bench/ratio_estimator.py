@@ -1,6 +1,6 @@
 """Measures what the ratio estimator (shadow_estimator RATIO, core.integrator.ratio) is worth against Monte Carlo.
 
-Per scene (the soft-shadow scene of bench/soft_shadow.py and the four sample scenes), renders
+Per scene (the soft-shadow scene of tests/support/scenes.py and the four sample scenes), renders
 with MONTE_CARLO and with RATIO at a few sample counts and seeds, one thread each; for each, the
 true relMSE against a converged DRT Monte Carlo reference (less the reference's own estimated
 variance) and the CPU time of the render (kernels compiled beforehand). Efficiency is
@@ -148,7 +148,7 @@ def main(argv=None):
     parser.add_argument("--scenes", nargs="*", default=["cornell_box", "glossy_spheres", "dof_row", "motion_blur"])
     parser.add_argument("--publish", action="store_true", help="write docs/ratio-estimator.md's block and bench/ratio_estimator.json")
     args = parser.parse_args(argv)
-    from soft_shadow import soft_shadow_scene
+    from tests.support.scenes import soft_shadow_scene
 
     seeds = range(args.seeds)
     data, base = soft_shadow_scene(args.soft_width)

@@ -52,8 +52,7 @@ from drt_engine.core.settings import RenderSettings  # noqa: E402
 from blocks import write_block  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
-sys.path.insert(0, str(ROOT / "tests" / "blender"))
-from render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)
+from tests.support.render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)
 
 WIDTH = 256
 LEVELS = (1e-2, 3e-3, 1e-3)

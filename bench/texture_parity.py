@@ -1,6 +1,6 @@
 """Measure DRT's procedural textures against Cycles and write the figures into docs/shader-node-parity.md.
 
-Renders tests/blender/procedural_scenes.py's grid (one tile per texture and mode), lit
+Renders tests/support/procedural_scenes.py's grid (one tile per texture and mode), lit
 scene and Box-projected image with DRT (seed 0) and Cycles (seeds 0 and 1) at 64 samples, as the parity test does,
 writes docs/texture_parity.json, and replaces docs/shader-node-parity.md's block between the markers below with
 a table of each case's worst 4x4-block difference from Cycles beside Cycles' own between its
@@ -14,14 +14,14 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "blender")]
+sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402
 
 import drt_engine  # noqa: E402
 from bench.blocks import replace_between  # noqa: E402
-import procedural_scenes as ps  # noqa: E402
-import render_helpers as rh  # noqa: E402
+from tests.support import procedural_scenes as ps  # noqa: E402
+from tests.support import render_helpers as rh  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- texture parity: begin -->", "<!-- texture parity: end -->"
 JSON_PATH = ROOT / "docs" / "texture_parity.json"

@@ -1,4 +1,4 @@
-"""Make the repository root importable so ``import drt_engine`` works from any test.
+"""Make the repository root importable so ``import drt_engine`` and ``from tests.support import ...`` work from any test.
 
 tests/real_blender needs the Debian root with a real Blender: only ``make test-blender``
 collects it (it sets DRT_BLENDER_ENV); ``make test`` leaves it out.

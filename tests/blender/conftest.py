@@ -15,9 +15,9 @@ import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
 from drt_engine.cli import exit_now
 from drt_engine.core.settings import PASS_CHANNELS
-import sample_scene_files
-from datablocks import new_material, new_world
-from render_helpers import read_channels, set_exr_output
+from tests.support import sample_scene_files
+from tests.support.datablocks import new_material, new_world
+from tests.support.render_helpers import read_channels, set_exr_output
 
 CAMERA_HEIGHT = 5.0
 _EXIT_STATUS = pytest.StashKey[int]()

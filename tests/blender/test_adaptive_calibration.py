@@ -19,7 +19,7 @@ from drt_engine.blender.export import export_scene
 from drt_engine.core.render.adaptive import first_test, true_error
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import RenderSettings
-from sample_scene_files import SCENES
+from tests.support.sample_scene_files import SCENES
 
 WIDTH = 32
 REFERENCE_SAMPLES = 1024

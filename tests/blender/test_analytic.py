@@ -23,8 +23,8 @@ import bpy
 import numpy as np
 import pytest
 
-import render_helpers as rh
-from datablocks import new_material, new_world
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material, new_world
 
 ALBEDO = 0.5
 HEIGHT = 2.0  # light above the plane

@@ -61,8 +61,8 @@ import bpy
 import numpy as np
 import pytest
 
-import render_helpers as rh
-from datablocks import new_material, new_world
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material, new_world
 
 SAMPLE_SCENES = rh.ROOT / "sample_scenes"
 DATA = rh.ROOT / "tests" / "data"

@@ -8,8 +8,8 @@ import math
 import bpy
 import numpy as np
 
-from datablocks import new_compositor, new_material
-from render_helpers import ROOT, read_channels, save_side_by_side, set_exr_output, set_resolution
+from tests.support.datablocks import new_compositor, new_material
+from tests.support.render_helpers import ROOT, read_channels, save_side_by_side, set_exr_output, set_resolution
 
 LAYER = "ViewLayer"
 COLOUR = (0.2, 0.4, 0.6)

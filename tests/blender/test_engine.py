@@ -21,7 +21,7 @@ from drt_engine.core.render.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import PASSES, RenderSettings
 
-from datablocks import new_compositor
+from tests.support.datablocks import new_compositor
 
 STRENGTH = 2.0
 LAYER = "ViewLayer"

@@ -18,8 +18,8 @@ from drt_engine.blender.export import export_scene
 from drt_engine.core.errors import SceneError
 from drt_engine.core.scene import DEFAULT_MATERIAL
 
-from datablocks import new_material, new_world
-from export_helpers import add_object, cube_mesh, empty_scene, render_export, total_area
+from tests.support.datablocks import new_material, new_world
+from tests.support.export_helpers import add_object, cube_mesh, empty_scene, render_export, total_area
 
 # ---------------------------------------------------------------- geometry
 

@@ -18,7 +18,7 @@ import numpy as np
 import psutil
 import pytest
 
-from render_helpers import read_channels
+from tests.support.render_helpers import read_channels
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES, SEED, SIZE = 8, 5, 32

@@ -44,7 +44,7 @@ import sys
 import numpy as np
 import pytest
 
-import render_helpers as rh
+from tests.support import render_helpers as rh
 
 sys.path.insert(0, str(rh.ROOT / "sample_scenes"))
 import build_mitsuba_motion  # noqa: E402

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from conftest import emission_material, render_exr
-from datablocks import new_world
+from tests.support.datablocks import new_world
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
 from scene_helpers import fcurves  # noqa: E402

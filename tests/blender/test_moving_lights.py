@@ -21,8 +21,8 @@ import bpy
 import numpy as np
 import pytest
 
-import render_helpers as rh
-from datablocks import new_material, new_world
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material, new_world
 from test_cycles_compare import add_light, focused_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import pytest
 
-import procedural_scenes as ps
-import render_helpers as rh
-from export_helpers import render_export
+from tests.support import procedural_scenes as ps
+from tests.support import render_helpers as rh
+from tests.support.export_helpers import render_export
 
 
 @pytest.fixture(scope="module")

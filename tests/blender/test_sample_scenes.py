@@ -8,7 +8,7 @@ import bpy
 import pytest
 from mathutils import Vector
 
-from sample_scene_files import OPENS_COMMITTED_FILES, SCENES, SCENES_DIR, build
+from tests.support.sample_scene_files import OPENS_COMMITTED_FILES, SCENES, SCENES_DIR, build
 SHADERS = {"BSDF_PRINCIPLED", "EMISSION", "BSDF_DIFFUSE", "BSDF_GLOSSY", "BSDF_GLASS"}
 
 

@@ -5,7 +5,6 @@ Each scene is a diffuse plane filling an orthographic view under a uniform white
 """
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import bpy
@@ -15,12 +14,10 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import MAGENTA, srgb_to_linear
-import render_helpers as rh
-from datablocks import new_material, new_world
-from export_helpers import add_object, empty_scene, render_export
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
-from textured_scenes import write_image  # noqa: E402
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material, new_world
+from tests.support.export_helpers import add_object, empty_scene, render_export
+from tests.support.textured_scenes import write_image
 
 RES = 16
 TEXELS = 4

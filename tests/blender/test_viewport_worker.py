@@ -2,21 +2,17 @@
 prepares again, each view shows its coarse levels first and ends with what a render of that
 camera gives."""
 import dataclasses
-import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
-
-from drt_engine.blender.export.viewport import level_cameras  # noqa: E402
-from drt_engine.blender.viewport import ViewportRender  # noqa: E402
-from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
-from drt_engine.core.render.render import Renderer  # noqa: E402
-from drt_engine.core.scene import Camera  # noqa: E402
-from drt_engine.core.settings import RenderSettings  # noqa: E402
-from scenes import look_at  # noqa: E402
-from test_determinism import scene  # noqa: E402
+from drt_engine.blender.export.viewport import level_cameras
+from drt_engine.blender.viewport import ViewportRender
+from drt_engine.core.render.prepared import PreparedScene
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import Camera
+from drt_engine.core.settings import RenderSettings
+from tests.core.test_determinism import scene
+from tests.support.scenes import look_at
 
 
 def finish(viewport):

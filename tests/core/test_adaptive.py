@@ -15,7 +15,7 @@ from drt_engine.core.film.film import Film
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import translation
+from tests.support.scenes import translation
 
 RES = 24
 EMISSION = 0.5

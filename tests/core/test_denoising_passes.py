@@ -6,7 +6,7 @@ from drt_engine.core.bsdf import shader as bsdf
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from scenes import look_at, plane, top_camera
+from tests.support.scenes import look_at, plane, top_camera
 
 DENOISING = ("Combined", "Denoising Albedo", "Denoising Normal")
 COLOUR = (0.2, 0.4, 0.6)

@@ -5,7 +5,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import PASSES, RenderSettings
-from scenes import look_at, plane, uv_sphere
+from tests.support.scenes import look_at, plane, uv_sphere
 
 
 def scene():
@@ -53,7 +53,7 @@ def test_bit_identical_when_waves_are_split_over_threads(monkeypatch):
 
 def test_textured_scene_under_an_environment_map_is_bit_identical_and_finite():
     from drt_engine.core.scene import TextureImage
-    from textured_scenes import environment_world, image_program
+    from tests.support.textured_scenes import environment_world, image_program
 
     base = scene()
     rng = np.random.default_rng(4)

@@ -5,7 +5,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, translation
+from tests.support.scenes import plane, translation
 
 GLOW = Material("glow", [Closure("EMISSION", emission=(1.0, 1.0, 1.0))])
 

@@ -8,8 +8,8 @@ from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import Texture, equirect_direction, equirect_uv
-from scenes import look_at, uv_sphere
-from textured_scenes import environment_world, ortho_top, uv_plane
+from tests.support.scenes import look_at, uv_sphere
+from tests.support.textured_scenes import environment_world, ortho_top, uv_plane
 
 L = 0.7
 

@@ -5,7 +5,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import lit_plane_scene, look_at, plane, top_camera, translation, uv_sphere
+from tests.support.scenes import lit_plane_scene, look_at, plane, top_camera, translation, uv_sphere
 
 
 def test_mirrored_instance_shades_like_its_twin():

@@ -13,8 +13,8 @@ from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import Texture, equirect_direction
-from scenes import look_at, plane, top_camera, translation
-from textured_scenes import environment_world
+from tests.support.scenes import look_at, plane, top_camera, translation
+from tests.support.textured_scenes import environment_world
 
 RNG = np.random.default_rng(17)
 ABOVE = look_at((0.2, -0.1, 1.5), (0.0, 0.0, 0.0))  # shines down onto the shading points

@@ -10,7 +10,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, top_camera, translation
+from tests.support.scenes import plane, top_camera, translation
 
 L = 2.0
 

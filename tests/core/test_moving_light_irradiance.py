@@ -12,7 +12,7 @@ import numpy as np
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Light
 from drt_engine.core.settings import RenderSettings
-from scenes import lit_plane_scene, translation
+from tests.support.scenes import lit_plane_scene, translation
 
 I, h, X0, X1, ALBEDO = 2.0, 0.5, -0.5, 0.5, 0.5
 RES, HALF = 48, 1.0

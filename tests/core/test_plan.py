@@ -8,7 +8,7 @@ from drt_engine.core.integrator.records import Samples
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from scenes import look_at, plane, top_camera, translation, uv_sphere
+from tests.support.scenes import look_at, plane, top_camera, translation, uv_sphere
 
 DIFFUSE = Material("white", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])
 MIRROR = Material("mirror", [Closure("GLOSSY", color=(0.9, 0.9, 0.9), roughness=0.0)])

@@ -10,7 +10,7 @@ from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Light
 from drt_engine.core.settings import PASSES, RenderSettings
-from scenes import look_at, translation
+from tests.support.scenes import look_at, translation
 from test_determinism import scene
 
 

@@ -7,7 +7,7 @@ import numpy as np
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import PASSES, RenderSettings
-from scenes import translation
+from tests.support.scenes import translation
 from test_determinism import scene
 
 SETTINGS = RenderSettings(samples=4, seed=3, threads=1, passes=PASSES)

@@ -5,7 +5,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from scenes import lit_plane_scene, plane, top_camera, translation, uv_sphere
+from tests.support.scenes import lit_plane_scene, plane, top_camera, translation, uv_sphere
 
 ALBEDO = 0.5
 D = 2.0
@@ -95,7 +95,7 @@ def test_white_furnace_diffuse_sphere_under_uniform_world():
 def test_area_light_spread_narrows_emission_like_cycles(spread_deg, view_deg):
     """Seen in a mirror at angle a from its normal, a light of spread s has radiance
     L * max((tan(s/2) - tan a) / (tan(s/2) - s/2), 0) (Cycles' area.h, measured in Cycles)."""
-    from scenes import look_at
+    from tests.support.scenes import look_at
     from test_mis import glossy_plane_scene
     h, a = np.radians(spread_deg) / 2, np.radians(view_deg)
     eye = np.array([np.sin(a), 0.0, np.cos(a)]) * 2.0

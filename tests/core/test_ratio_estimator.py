@@ -13,8 +13,8 @@ from drt_engine.core.film.ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Light
 from drt_engine.core.settings import RenderSettings
-import scenes
-from scenes import translation
+from tests.support import scenes
+from tests.support.scenes import translation
 
 WIDTH = 48
 REFERENCE_SAMPLES = 1024

@@ -12,7 +12,7 @@ from drt_engine.core.geometry import camera as camera_rays
 from drt_engine.core.geometry.accel import Geometry
 from drt_engine.core.geometry.motion import Motion, invert_frame
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
-from scenes import plane, translation, uv_sphere
+from tests.support.scenes import plane, translation, uv_sphere
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -128,10 +128,9 @@ m = np.array([np.eye(4), np.eye(4)]); m[1, :3, 3] = (1, 0, 0)
 cam = Camera(m, (-0.4, 0.4, -0.3, 0.3), (40, 30), aperture_radius=0.1, blades=5)
 r = camera_rays.generate(cam, rng.random(300) * 40, rng.random(300) * 30, rng.random((300, 2)), rng.random(300))
 out["camera"] = np.concatenate([r.origins.ravel(), r.directions.ravel(), r.tmax])
-import sys; sys.path.insert(0, "tests/core")
 from drt_engine.core.geometry.accel import Geometry
 from drt_engine.core.scene import Closure, Instance, Material, SceneData
-from scenes import plane, uv_sphere
+from tests.support.scenes import plane, uv_sphere
 scene = SceneData(camera=None, meshes=[uv_sphere(1.0, segments=8, rings=6), plane(4.0, z=-1.0)],
                   instances=[Instance(0, m), Instance(1, np.eye(4))], materials=[Material("m", [Closure("DIFFUSE")])])
 geo = Geometry(scene, np.array([0.0, 0.0, 5.0]))

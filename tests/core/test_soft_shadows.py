@@ -12,7 +12,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, translation
+from tests.support.scenes import plane, translation
 
 R, H, h = 0.5, 4.0, 1.0
 WIDTH = 2 * R * h / (H - h)

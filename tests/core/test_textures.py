@@ -6,8 +6,8 @@ from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Program, SceneData, TextureImage
 from drt_engine.core.settings import RenderSettings
 from drt_engine.core.shading.textures import MAGENTA, Texture, srgb_to_linear
-from scenes import look_at, uv_sphere
-from textured_scenes import (constant_world_scene, diffuse_textured, image_program, ortho_top, uv_plane,
+from tests.support.scenes import look_at, uv_sphere
+from tests.support.textured_scenes import (constant_world_scene, diffuse_textured, image_program, ortho_top, uv_plane,
                              write_image)
 
 RES = 16

@@ -1,13 +1,12 @@
-"""Numerics suite: the core's hand-made scenes, the Blender and sample-scene helpers on the path, DRT registered."""
+"""Numerics suite: the sample scenes' helpers (scene_helpers) on the path, DRT registered."""
 import sys
 from pathlib import Path
 
 import pytest
 
-TESTS = Path(__file__).resolve().parents[1]
-for folder in (TESTS / "core", TESTS / "blender", TESTS / "numerics", TESTS.parent / "sample_scenes"):
-    if str(folder) not in sys.path:
-        sys.path.insert(0, str(folder))
+SAMPLE_SCENES = Path(__file__).resolve().parents[2] / "sample_scenes"
+if str(SAMPLE_SCENES) not in sys.path:
+    sys.path.insert(0, str(SAMPLE_SCENES))
 
 
 @pytest.fixture(scope="session")

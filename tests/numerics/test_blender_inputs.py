@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
-import blender_scenes as bs
+from tests.support import blender_scenes as bs
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -96,8 +96,8 @@ def test_cli_reports_an_invalid_light_on_one_line(drt, tmp_path):
 def test_ten_thousand_instances_and_a_million_triangles_through_blender(drt, tmp_path):
     """10^4 emissive boxes instanced on a grid's vertices (radiance 1) over a 10^6-triangle sphere
     (radiance 0.5) that fills the view: all exported, and every pixel sees a mix of the two only."""
-    from export_helpers import render_export
-    from scenes import uv_sphere
+    from tests.support.export_helpers import render_export
+    from tests.support.scenes import uv_sphere
 
     scene = bs.new_scene(16, 16, 4)
     scene.camera.location = (0, 0, 30)

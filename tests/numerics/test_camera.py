@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-import blender_scenes as bs
-from core_cases import Camera, Closure, Instance, Material, SceneData, render
-from scenes import plane, translation
+from tests.support import blender_scenes as bs
+from tests.support.core_cases import Camera, Closure, Instance, Material, SceneData, render
+from tests.support.scenes import plane, translation
 
 STRENGTH = 2.0
 
@@ -95,11 +95,11 @@ def test_four_by_four_through_blender(drt, tmp_path):
 
 BIG = """
 import resource, sys, numpy as np
-sys.path[:0] = [{root!r}, {core!r}]
+sys.path.insert(0, {root!r})
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 from drt_engine.core.settings import RenderSettings
-from scenes import plane, translation
+from tests.support.scenes import plane, translation
 cam = Camera(translation(0, 0, 5)[None], (-0.16, 0.16, -0.09, 0.09), (7680, 4320))
 scene = SceneData(cam, [plane(4.0)], [Instance(0, np.eye(4))], [Material("e", [Closure("EMISSION", emission=(2, 2, 2))])])
 image = Renderer(scene, RenderSettings(samples=1, max_depth=0, threads=2)).render().passes["Combined"]
@@ -111,7 +111,7 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20)
 def test_8k_image_in_bounded_memory():
     """7680x4320, one sample, max depth 0, in a fresh process: peak resident memory under 4 GB."""
     root = Path(__file__).resolve().parents[2]
-    code = BIG.format(root=str(root), core=str(root / "tests" / "core"))
+    code = BIG.format(root=str(root))
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr[-2000:]
     peak_gb = float(result.stdout.split()[-1])

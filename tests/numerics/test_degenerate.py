@@ -5,8 +5,8 @@ import pytest
 
 from drt_engine.core.scene import Mesh
 
-from core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, diffuse, render
-from scenes import look_at, plane, translation, uv_sphere
+from tests.support.core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, diffuse, render
+from tests.support.scenes import look_at, plane, translation, uv_sphere
 
 
 def lit(meshes, instances=None, res=16, materials=None):

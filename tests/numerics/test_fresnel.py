@@ -12,8 +12,8 @@ import pytest
 from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Mesh
 
-from core_cases import Camera, Closure, Instance, Material, SceneData, World, render
-from scenes import look_at, uv_sphere
+from tests.support.core_cases import Camera, Closure, Instance, Material, SceneData, World, render
+from tests.support.scenes import look_at, uv_sphere
 
 
 def checkerboard(n=8, size=4.0, z=-2.0):

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-import blender_scenes as bs
-import render_helpers as rh
+from tests.support import blender_scenes as bs
+from tests.support import render_helpers as rh
 
 ALBEDO = 0.8
 

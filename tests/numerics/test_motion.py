@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 import pytest
 
-import blender_scenes as bs
+from tests.support import blender_scenes as bs
 from scene_helpers import fcurves
 
 HALF_VIEW = 1.0  # orthographic view of 2 m x 2 m

@@ -10,8 +10,8 @@ moves a silhouette across a sample.
 import numpy as np
 import pytest
 
-from core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, render
-from scenes import look_at, plane, translation, uv_sphere
+from tests.support.core_cases import Camera, Closure, Instance, Light, Material, SceneData, World, render
+from tests.support.scenes import look_at, plane, translation, uv_sphere
 
 
 def scene(s=1.0, offset=0.0):
@@ -67,7 +67,7 @@ def test_same_image_far_from_the_origin_through_blender(drt, tmp_path, offset):
     shifted by ``offset`` (integers, exact in Blender's float32 matrices): the same image."""
     import bpy
 
-    import blender_scenes as bs
+    from tests.support import blender_scenes as bs
 
     def build(o):
         scene = bs.new_scene(24, 24, 8)

@@ -9,8 +9,8 @@ import pytest
 from drt_engine.core.geometry.accel import Geometry, spawn
 from drt_engine.core.scene import Camera, Instance, Light, Mesh, SceneData
 
-from core_cases import diffuse, render
-from scenes import look_at, plane, translation
+from tests.support.core_cases import diffuse, render
+from tests.support.scenes import look_at, plane, translation
 
 TRIANGLES = 4000
 DIRECTIONS = 16

@@ -11,8 +11,8 @@ and the Glossy lobe fell from 1.000 to 0.944 across the switch.
 import numpy as np
 import pytest
 
-from core_cases import Instance, Material, Closure, SceneData, World, Light, ortho_camera, render
-from scenes import look_at, plane
+from tests.support.core_cases import Instance, Material, Closure, SceneData, World, Light, ortho_camera, render
+from tests.support.scenes import look_at, plane
 
 ROUGHNESS = (0.0, 1e-4, 0.0037, 0.004, 0.0099, 0.01, 0.0101, 1.0)
 ANGLES = (0.0, 60.0, 85.0, 89.0, 89.99)

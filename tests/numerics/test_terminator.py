@@ -12,8 +12,8 @@ import math
 import bpy
 import numpy as np
 
-import blender_scenes as bs
-import render_helpers as rh
+from tests.support import blender_scenes as bs
+from tests.support import render_helpers as rh
 
 SUN = np.array([1.0, 0.0, 0.0])  # towards the sun
 

@@ -16,7 +16,8 @@ def test_core_tests_pass_on_python313_numpy22_with_warnings_as_errors(installed,
     env = installed
     copy = env.work / "repo"
     shutil.copytree(REPO / "drt_engine", copy / "drt_engine", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copytree(REPO / "tests" / "core", copy / "tests" / "core", ignore=shutil.ignore_patterns("__pycache__"))
+    for folder in ("core", "support"):  # the core's tests and the scene builders they import
+        shutil.copytree(REPO / "tests" / folder, copy / "tests" / folder, ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copy(REPO / "tests" / "conftest.py", copy / "tests")
     done = env.run("env", f"PYTHONPATH={SITE_PACKAGES}", "sh", "-c",
                    f"cd {env.inside(copy)} && python3 -c 'import sys, numpy; print(sys.version.split()[0], numpy.__version__)'"

@@ -2,7 +2,7 @@
 import numpy as np
 
 from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, Program, SceneData, World
-from scenes import translation
+from tests.support.scenes import translation
 
 
 def write_image(path, pixels_top_first: np.ndarray):

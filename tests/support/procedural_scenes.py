@@ -17,8 +17,8 @@ import bpy
 import mathutils
 import numpy as np
 
-from datablocks import new_material, new_world
-from export_helpers import empty_scene
+from tests.support.datablocks import new_material, new_world
+from tests.support.export_helpers import empty_scene
 
 TILE = 32
 BLOCK = 4

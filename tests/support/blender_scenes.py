@@ -10,7 +10,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-import render_helpers as rh
+from tests.support import render_helpers as rh
 from drt_engine.blender.properties import BLENDER_PASS_TOGGLES, DRT_PASS_TOGGLES
 from drt_engine.core.settings import PASS_CHANNELS
 
