@@ -283,7 +283,7 @@ def _render(args) -> str:
 
     import bpy
 
-    from .blender import engine, part_files
+    from .blender.hooks import render_hooks
 
     scene = _open_scene(args, blend)
     render = scene.render
@@ -295,26 +295,26 @@ def _render(args) -> str:
         if end > scene.drt.samples:
             raise CLIError(f"--sample-range {first}:{end} goes past the {scene.drt.samples} samples")
         scene.drt.sample_offset, scene.drt.sample_count = first, end - first
-        part_files.collect = True
-        part_files.last_parts.clear()
+        render_hooks.collect_parts = True
+        render_hooks.last_parts.clear()
 
-    engine.last_reports.clear()
+    render_hooks.last_reports.clear()
     start = time.perf_counter()
-    engine.progress_listener = ProgressDisplay(sys.stdout, scene.drt.time_limit, scene.drt.target_error)
+    render_hooks.progress_listener = ProgressDisplay(sys.stdout, scene.drt.time_limit, scene.drt.target_error)
     try:
         bpy.ops.render.render(write_still=False, scene=scene.name)
     except RuntimeError as error:
         raise CLIError(f"render failed: {_blender_message(error)}") from None
     finally:
-        engine.progress_listener.close()
-        engine.progress_listener = None
+        render_hooks.progress_listener.close()
+        render_hooks.progress_listener = None
     elapsed = time.perf_counter() - start
-    if not engine.last_reports:
+    if not render_hooks.last_reports:
         raise CLIError("the render produced no image")
 
     if args.sample_range is not None:
         try:
-            parts.write(output, next(iter(part_files.last_parts.values())))
+            parts.write(output, next(iter(render_hooks.last_parts.values())))
         except OSError as error:
             raise CLIError(str(error)) from None
         done = f"samples {args.sample_range[0]}:{args.sample_range[1]} of {scene.drt.samples} as a part"
@@ -327,7 +327,7 @@ def _render(args) -> str:
         if not output.is_file():
             raise CLIError(f"cannot write {output}")
         done = None
-    stats = _write_report(output, blend, args.frame, engine.last_reports)
+    stats = _write_report(output, blend, args.frame, render_hooks.last_reports)
     width, height = (side * render.resolution_percentage // 100 for side in (render.resolution_x, render.resolution_y))
     return done_line(output, width, height, stats, elapsed, done)
 

@@ -3,8 +3,8 @@
 A `blender -b` job with ``scene.drt.sample_offset`` / ``sample_count`` set writes its part
 beside the frame's output (``<frame path without extension>.samples-START-END.exr``, the
 view layer's name added when the scene renders several); `python -m drt_engine merge`
-adds the parts into the image of all the samples. The CLI instead sets ``collect`` and
-takes the parts from ``last_parts`` to write them where it is told.
+adds the parts into the image of all the samples. The CLI instead sets the hooks'
+``collect_parts`` and takes the parts from their ``last_parts`` to write them where it is told.
 """
 from __future__ import annotations
 
@@ -14,23 +14,19 @@ import bpy
 
 from ..core.errors import DRTError
 from ..core.film import parts
-
-collect = False
-"""True: keep every final render's part in ``last_parts`` instead of writing part files."""
-
-last_parts: dict[str, parts.Part] = {}
-"""The newest part of each view layer, by name, while ``collect`` is on."""
+from .hooks import render_hooks
 
 
-def keep(scene, view_layer, scene_data, film, settings, summary: dict) -> None:
-    """Keep or write the part of a final render, if it is one (``settings.partial``) or ``collect`` is on."""
+def keep_part(scene, view_layer, scene_data, film, settings, summary: dict) -> None:
+    """Keep or write the part of a final render, if it is one (``settings.partial``) or the hooks collect parts."""
+    collect = render_hooks.collect_parts
     if not (settings.partial or collect):
         return
     header = {"blend": bpy.data.filepath, "frame": scene.frame_current, "view_layer": view_layer.name,
               "fingerprint": parts.fingerprint(scene_data), "report": summary}
     part = parts.from_film(film, settings, header)
     if collect:
-        last_parts[view_layer.name] = part
+        render_hooks.last_parts[view_layer.name] = part
         return
     path = part_path(scene, view_layer, settings)
     try:

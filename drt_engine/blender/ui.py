@@ -86,11 +86,6 @@ class DRTButtonsPanel:
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
 
-    def split_layout(self):
-        """The panel's layout in Blender's property-split style (labels left, no keyframe dots)."""
-        layout = split(self.layout)
-        return layout
-
 
 class DRT_PT_sampling(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Sampling"

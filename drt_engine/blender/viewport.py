@@ -12,7 +12,8 @@ current wave) and starts another one; a new view of the same scene (orbit, zoom)
 its prepared scene, an edited scene updates it (only the meshes, materials or lights the
 edit touched are rebuilt). The worker never holds the engine: it asks for redraws through
 a weak reference, so Blender can free the engine whenever it wants, and a
-``weakref.finalize`` on the engine stops the worker first.
+``weakref.finalize`` on the engine stops the worker first. ViewportSession is what the
+engine keeps between its ``view_update`` and ``view_draw`` calls.
 """
 from __future__ import annotations
 
@@ -28,6 +29,8 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.errors import DRTError
+from .properties import settings_from_scene
+from .status import done_line, one_line, stats_line
 
 PUBLISH_INTERVAL = 1.0
 """Seconds between two images of the full-resolution render within a round of samples (every
@@ -41,6 +44,79 @@ waits for the next window redraw, about 0.5 s apart while the tracer held both c
 
 STOP_TIMEOUT = 5.0
 """Seconds the engine waits, when Blender frees it, for the worker to reach its next progress call."""
+
+
+def viewport_settings(settings, preview_samples: int):
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules."""
+    return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
+                               use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
+                               sample_start=0, sample_end=0)
+
+
+class ViewportSession:
+    """One engine's Rendered shading: its worker, the scene of the last ``view_update`` (the camera
+    replaced per view) and the view its render is for, the texture on screen, the meshes kept
+    between exports. Made at the engine's first ``view_update``."""
+
+    def __init__(self, engine):
+        from .export.geometry import MeshCache
+
+        self.worker = ViewportRender(weak_redraw(engine))
+        self.meshes = MeshCache()
+        self.scene = None  # SceneData of the last view_update
+        self.settings = None
+        self.key = None  # region size and matrices the running render is for
+        self.texture = None
+        weakref.finalize(engine, self.worker.stop)  # Blender frees the engine: stop the worker
+
+    def update(self, engine, depsgraph) -> None:
+        """The scene changed (or the viewport opened): export what changed; the next ``draw``
+        restarts the render, whose worker updates the prepared scene for the edit."""
+        from .export import export_scene
+        from .export.viewport import edited_geometry
+
+        self.meshes.forget(edited_geometry(depsgraph.updates))
+        try:
+            scene_data = export_scene(depsgraph, meshes=self.meshes)
+        except Exception as error:
+            if not isinstance(error, DRTError):  # a bug of ours: details in the console
+                print(f"DRT: unexpected error while exporting for the viewport\n{traceback.format_exc()}")
+            self.worker.stop(timeout=0.0)
+            self.scene = None
+            engine.update_stats("", one_line(str(error)))
+            return
+        self.scene = scene_data
+        self.settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer),
+                                          depsgraph.scene.drt.preview_samples)
+        self.key = None  # draw restarts the render with the region's camera
+
+    def draw(self, engine, context, depsgraph) -> None:
+        """Draw the newest image; restart the render first if the view changed."""
+        import gpu
+
+        from .export.viewport import level_cameras, viewport_camera
+
+        region, region_data = context.region, context.region_data
+        if self.scene is not None:
+            key = (region.width, region.height, tuple(map(tuple, region_data.view_matrix)),
+                   tuple(map(tuple, region_data.window_matrix)))
+            if key != self.key:
+                cameras = level_cameras(viewport_camera(region, region_data))
+                self.worker.start(self.scene, cameras, self.settings)
+                self.key = key
+        version, image = self.worker.latest()
+        if self.worker.status:
+            engine.update_stats("", self.worker.status)
+        if image is None:
+            return
+        if self.texture is None:
+            self.texture = ViewportTexture()
+        self.texture.update(version, image)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        engine.bind_display_space_shader(depsgraph.scene)
+        self.texture.draw(region.width, region.height)
+        engine.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
 
 
 class ViewportRender:
@@ -104,7 +180,6 @@ class ViewportRender:
 
     def _run(self, scene_data, cameras, settings, stop: threading.Event) -> None:
         from ..core.render.render import Renderer
-        from .engine import done_line, stats_line
 
         try:
             _nicer(WORKER_NICE)

@@ -14,9 +14,12 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
-import drt_engine.blender.engine as engine_module
+import drt_engine.blender.final as final_module
 from drt_engine.core.render import adaptive
-from drt_engine.blender.engine import DRTRenderEngine, render_window
+from drt_engine.blender.engine import DRTRenderEngine
+from drt_engine.blender.final import progress_callback, render_window
+from drt_engine.blender.hooks import render_hooks
+from drt_engine.blender.status import done_line, stats_line
 from drt_engine.core.render.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
 from drt_engine.core.settings import PASSES, RenderSettings
@@ -55,16 +58,16 @@ def test_persistent_data_reuses_the_prepared_scene_while_only_the_camera_moves(b
         scene.frame_set(frame)
         combined = bl.pass_pixels(bl.render_exr(scene, tmp_path / f"f{frame}.exr"), LAYER, "Combined")
         np.testing.assert_allclose(combined[..., :3], STRENGTH, rtol=1e-4)
-        prepared.append(engine_module.persistent[LAYER][1])
+        prepared.append(render_hooks.persistent[LAYER][1])
     assert prepared[0] is prepared[1]
     emitter = bpy.data.objects["Emitter"].active_material
     emitter.node_tree.nodes["Emission"].inputs["Strength"].default_value = 3.0
     combined = bl.pass_pixels(bl.render_exr(scene, tmp_path / "brighter.exr"), LAYER, "Combined")
     np.testing.assert_allclose(combined[..., :3], 3.0, rtol=1e-4)
-    assert engine_module.persistent[LAYER][1] is not prepared[0]
+    assert render_hooks.persistent[LAYER][1] is not prepared[0]
     scene.render.use_persistent_data = False
     bl.render_exr(scene, tmp_path / "off.exr")
-    assert LAYER not in engine_module.persistent
+    assert LAYER not in render_hooks.persistent
 
 
 def test_enabled_passes_are_written_and_disabled_ones_are_not(bl, tmp_path):
@@ -225,11 +228,11 @@ def emitter_scene_data(size=64):
 
 
 def test_progress_callback_reports_and_refreshes_the_image(monkeypatch):
-    monkeypatch.setattr(engine_module, "DISPLAY_INTERVAL", 0.0)
+    monkeypatch.setattr(final_module, "DISPLAY_INTERVAL", 0.0)
     fake, result = RecordingEngine(), RecordingResult(["Combined"])
     samples = 3 * (WAVE // 64**2)  # several checkpoints (1, 2, 4, ... spp) and several waves
     renderer = Renderer(emitter_scene_data(), RenderSettings(samples=samples, threads=1))
-    outcome = renderer.render(progress=DRTRenderEngine._progress_callback(fake, result))
+    outcome = renderer.render(progress=progress_callback(fake, result))
     assert not outcome.cancelled
     assert len(fake.progress) >= 3
     assert all(0 < a < b for a, b in zip(fake.progress, fake.progress[1:]))
@@ -248,7 +251,7 @@ def test_cancel_returns_promptly_with_the_image_so_far():
     settings = RenderSettings(samples=1_000_000, threads=1, passes=("Combined", "Sample Count"))
     renderer = Renderer(emitter_scene_data(), settings)  # hours of work if it were not cancelled
     start = time.perf_counter()
-    outcome = renderer.render(progress=DRTRenderEngine._progress_callback(fake, result))
+    outcome = renderer.render(progress=progress_callback(fake, result))
     assert time.perf_counter() - start < 10.0
     assert outcome.cancelled and len(fake.progress) == 1
     np.testing.assert_allclose(outcome.passes["Combined"][..., :3], STRENGTH, rtol=1e-4)
@@ -280,7 +283,7 @@ def test_adaptive_render_reports_its_error_log_in_the_metadata(bl, tmp_path):
     scene = bl.emission_scene(samples=64)
     scene.drt.use_adaptive_sampling = True
     scene.drt.adaptive_min_samples = 8
-    engine_module.last_reports.clear()
+    render_hooks.last_reports.clear()
     path = tmp_path / "adaptive.exr"
     bl.render_exr(scene, path)
     image = oiio.ImageInput.open(str(path))
@@ -290,7 +293,7 @@ def test_adaptive_render_reports_its_error_log_in_the_metadata(bl, tmp_path):
     assert metadata[f"drt.{LAYER}.stopped_by"] == "threshold"
     assert metadata[f"drt.{LAYER}.samples"] == str(adaptive.first_test(8))
     log = json.loads(metadata[f"drt.{LAYER}.error_log"])
-    report = engine_module.last_reports[LAYER]
+    report = render_hooks.last_reports[LAYER]
     assert log == report["log"] and log[-1]["stopped"] == "threshold"
     assert report["settings"]["use_adaptive_sampling"] and report["settings"]["adaptive_mode"] == "NOISE"
     assert report["scene"]["resolution"] == [16, 12] and report["view_layer"] == LAYER
@@ -300,8 +303,8 @@ def test_done_line_says_what_stopped_the_render():
     renderer = Renderer(emitter_scene_data(16), RenderSettings(samples=64, threads=1, use_adaptive_sampling=True,
                                                                 adaptive_min_samples=8))
     outcome = renderer.render()
-    line = engine_module.done_line(outcome.stats, outcome.cancelled)
+    line = done_line(outcome.stats, outcome.cancelled)
     assert re.fullmatch(r"Done \| 8 samples \(mean 8\.0\) \| est\. error 0% \| \d+\.\d\d s "
                         r"\| stopped by noise threshold \| plan: .+", line), line
-    assert engine_module.stats_line(12, 64, 6.4e-5, 12.34) == "Sample 12/64 | est. error 0.8% | 12.3 s"
-    assert engine_module.stats_line(1, 64, float("inf"), 0.0) == "Sample 1/64 | est. error ? | 0.0 s"
+    assert stats_line(12, 64, 6.4e-5, 12.34) == "Sample 12/64 | est. error 0.8% | 12.3 s"
+    assert stats_line(1, 64, float("inf"), 0.0) == "Sample 1/64 | est. error ? | 0.0 s"

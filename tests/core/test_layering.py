@@ -149,7 +149,6 @@ def test_every_import_follows_the_layers():
 
 
 KNOWN_CIRCLES = [
-    ["drt_engine.blender", "drt_engine.blender.engine", "drt_engine.blender.viewport"],
     ["drt_engine.cli", "drt_engine.farm"],
 ]
 """Circles the layout issue (#21) still has to break: the RenderEngine and the viewport worker,

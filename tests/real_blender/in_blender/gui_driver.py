@@ -114,7 +114,7 @@ def instrument_engine() -> None:
     """Wrap DRT's render and view_draw to log what Blender asked and what came out."""
     engine = next(c for c in bpy.types.RenderEngine.__subclasses__() if getattr(c, "bl_idname", "") == "DRT")
     render, view_draw = engine.render, engine.view_draw
-    module = sys.modules[engine.__module__]
+    module = importlib.import_module(engine.__module__.rsplit(".", 1)[0] + ".final")
     write_passes = module.write_passes
     written = {}
 
@@ -133,7 +133,7 @@ def instrument_engine() -> None:
     def logged_view_draw(self, context, depsgraph):
         started = time.monotonic()
         view_draw(self, context, depsgraph)
-        viewport = self._viewport
+        viewport = self._viewport and self._viewport.worker
         if viewport is not None:
             version, image = viewport.latest()
             draws.append((time.monotonic(), version, viewport.status, None if image is None else list(image.shape)))
