@@ -19,7 +19,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from drt_engine.core.lights.kinds import light_table  # noqa: E402
+from drt_engine.core.lights.table import light_table  # noqa: E402
 from drt_engine.core.scene import Light  # noqa: E402
 from drt_engine.core.lights.unoccluded import _unoccluded_rows, unoccluded_triangles_batch  # noqa: E402
 from tests.core import test_unoccluded as t  # noqa: E402

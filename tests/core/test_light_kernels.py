@@ -7,7 +7,7 @@ import pytest
 
 from drt_engine.core.lights.environment import Environment, direction_at, map_pdf
 from drt_engine.core.lights.choice import pick_light, pick_probability
-from drt_engine.core.lights.kinds import light_table
+from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _intersect_batch, _pdf_batch, _sample_batch
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, TextureImage

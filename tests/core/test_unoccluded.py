@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from drt_engine.core.lights.kinds import light_table
+from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _sample_batch, _sample_emissive_batch
 from drt_engine.core.scene import Light
 from drt_engine.core.lights.unoccluded import closed_forms, unoccluded_batch, unoccluded_triangles_batch

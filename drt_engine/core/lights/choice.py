@@ -10,7 +10,7 @@ than stored, so nothing (points x lights) is ever allocated.
 from __future__ import annotations
 
 from ..base.jit import kernel
-from .kinds import KIND, PX, PY, PZ, SEL_POWER, SEL_SIZE2, SUN
+from .table import KIND, PX, PY, PZ, SEL_POWER, SEL_SIZE2, SUN
 
 FLOOR = 1e-12
 """Smallest weight relative to the largest at a point (keeps every light's probability > 0)."""

@@ -6,8 +6,8 @@ sun angle 0) return pdf = inf so multiple importance sampling gives them full we
 lights, emissive triangles and the world can also be hit by continued rays, and expose
 ``pdf`` for the power heuristic.
 
-The per-ray arithmetic is in kernels: each light kind's in light_kinds.py (over one flat
-table of lights built here once), the choice among many lights in light_choice.py, the
+The per-ray arithmetic is in kernels: each light kind's in lights.kinds (over one flat
+table of lights, lights.table), the choice among many lights in lights.choice, the
 environment map's in environment.py, emissive triangles and the world below. The methods
 here call one batch loop per wave and strategy; shader programs (textured emission, the
 environment's radiance) stay NumPy.
@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..base.colour import LUMINANCE
+from ..base.constants import TINY
 from ..base.jit import kernel
 from ..base.vectors import basis
 from ..base.warps import concentric_disk
@@ -29,15 +30,8 @@ from ..scene import Light, SceneData
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_light, pick_probability
 from .environment import Environment, map_direction, map_pdf
-from .kinds import (
-    TINY,
-    hit_light,
-    light_pdf,
-    light_row,
-    light_table,
-    sample_light,
-    sun_seen,
-)
+from .kinds import hit_light, light_pdf, sample_light, sun_seen
+from .table import light_row, light_table
 
 
 class LightSample:
@@ -100,7 +94,7 @@ class Lights:
             validate_light(light)
         self.lights = [light for light in scene.lights if not light_power_zero(light)]
         self.table = light_table(self.lights)
-        """One row per light (light_kinds' columns): what every light kernel reads."""
+        """One row per light (lights.table's columns): what every light kernel reads."""
         self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
         self.geometry = geometry
         emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))

@@ -1,6 +1,6 @@
 """Each light kind as scalar kernels behind one contract, over one flat row of numbers per light.
 
-A light is one row of ``table`` (columns named below), built once from ``scene.Light``. Every
+A light is one row of ``table`` (columns named in lights.table), built once from ``scene.Light``. Every
 kind answers the same three questions for one shading point or ray:
 
 - ``sample_light``: a direction toward the light, the distance to it (inf for a distant
@@ -13,7 +13,7 @@ kind answers the same three questions for one shading point or ray:
 
 Kinds: point and spot (radius, soft falloff, cone and blend), sun (angle), rectangle
 (spherical-rectangle sampling, Urena et al. 2013), disk and ellipse (area sampling), all area
-shapes with Cycles' spread. Scalars in, scalars out: the batch loops in lights.py and a later
+shapes with Cycles' spread. Scalars in, scalars out: the batch loops in lights.collection and a later
 fused stage kernel call these. They are inlined into their callers (``inline="always"``): a
 call from one compiled function to another is not inlined by LLVM across Numba's libraries,
 and measured 3x the arithmetic of a delta point light's sample (41 against 13 ns a sample).
@@ -22,96 +22,19 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from ..base.colour import LUMINANCE
 from ..base.constants import TINY
 from ..base.jit import kernel
 from ..base.vectors import basis
 from ..base.warps import concentric_disk
-from ..scene import Light
-
-INF = math.inf
-
-# kinds
-POINT, SPOT, SUN, RECT, DISK = 0, 1, 2, 3, 4
-# columns of a light row
-KIND = 0
-PX, PY, PZ = 1, 2, 3  # position
-DX, DY, DZ = 4, 5, 6  # where the light shines (local -Z)
-EXX, EXY, EXZ = 7, 8, 9  # unit local X
-EYX, EYY, EYZ = 10, 11, 12  # unit local Y
-EZX, EZY, EZZ = 13, 14, 15  # unit local Z (area lights emit toward -Z: seen from the side ez points to)
-SIZE_X, SIZE_Y, AREA = 16, 17, 18
-RADIUS, SOFT = 19, 20
-ER, EG, EB = 21, 22, 23  # intensity (point, spot), irradiance (sun), radiance (area)
-COS_HALF, SMOOTH = 24, 25  # spot: cosine of the half cone, blend width in cosine; sun: cosine of half angle
-SOLID, SUN_SCALE = 26, 27  # sun: solid angle of its disk, radiance per irradiance 1 / (pi sin^2 half)
-SPREAD_MODE, SPREAD_TAN, SPREAD_NORM = 28, 29, 30  # area spread: 0 none, 1 narrowed, 2 zero
-SEL_POWER, SEL_SIZE2 = 31, 32  # for choosing among many lights: power, squared size
-COLUMNS = 33
+from .table import (
+    AREA, COS_HALF, DISK, DX, DY, DZ, EB, EG, ER, EXX, EXY, EXZ, EYX, EYY, EYZ, EZX, EZY, EZZ, INF, KIND, POINT,
+    PX, PY, PZ, RADIUS, RECT, SIZE_X, SIZE_Y, SMOOTH, SOFT, SOLID, SPOT, SPREAD_MODE, SPREAD_NORM, SPREAD_TAN,
+    SUN, SUN_SCALE,
+)
 
 MIN_SOLID_ANGLE = 1e-5
 """Below this a rectangle's solid angle is sampled by area instead (the spherical-rectangle
 method loses precision; both strategies are exact there)."""
-
-
-def _unit(v):
-    return v / np.linalg.norm(v)
-
-
-def light_row(light: Light) -> np.ndarray:
-    """One light as a table row (everything a kernel needs, derived once)."""
-    row = np.zeros(COLUMNS)
-    m = light.matrix
-    row[PX:PZ + 1] = m[:3, 3]
-    row[EXX:EXZ + 1], row[EYX:EYZ + 1], row[EZX:EZZ + 1] = _unit(m[:3, 0]), _unit(m[:3, 1]), _unit(m[:3, 2])
-    row[DX:DZ + 1] = -row[EZX:EZZ + 1]
-    if light.kind in ("POINT", "SPOT"):
-        row[KIND] = POINT if light.kind == "POINT" else SPOT
-        row[RADIUS], row[SOFT] = light.radius, float(light.soft_falloff)
-        row[ER:EB + 1] = light.intensity
-        cos_half = math.cos(min(light.spot_size, math.pi) / 2.0)
-        row[COS_HALF], row[SMOOTH] = cos_half, (1.0 - cos_half) * light.spot_blend
-        row[SEL_POWER], row[SEL_SIZE2] = light.intensity @ LUMINANCE, light.radius ** 2
-    elif light.kind == "SUN":
-        row[KIND] = SUN
-        row[ER:EB + 1] = light.irradiance
-        half = min(light.angle, math.pi) / 2.0
-        row[COS_HALF] = math.cos(half)
-        row[SOLID] = 2.0 * math.pi * (1.0 - math.cos(half))
-        row[SUN_SCALE] = 1.0 / (math.pi * math.sin(half) ** 2) if half > 0 else 0.0
-        row[SEL_POWER] = light.irradiance @ LUMINANCE
-    else:
-        disk = light.shape in ("DISK", "ELLIPSE")
-        row[KIND] = DISK if disk else RECT
-        sx, sy = light.size_x, light.size_y
-        row[SIZE_X], row[SIZE_Y] = sx, sy
-        row[AREA] = (math.pi / 4.0 if disk else 1.0) * sx * sy
-        row[ER:EB + 1] = light.radiance
-        row[SPREAD_MODE:SPREAD_NORM + 1] = _spread_terms(light.spread)
-        row[SEL_POWER], row[SEL_SIZE2] = (light.radiance @ LUMINANCE) * row[AREA], 0.25 * (sx * sx + sy * sy)
-    return row
-
-
-def light_table(lights) -> np.ndarray:
-    table = np.zeros((len(lights), COLUMNS))
-    for i, light in enumerate(lights):
-        table[i] = light_row(light)
-    return table
-
-
-def _spread_terms(spread: float):
-    """Cycles' area light spread (area.h): emission narrowed to a cone of half angle h,
-    normalised to keep power, factor max((tan h - tan a) / (tan h - h), 0) at emission angle a
-    (3 / h^3 for tiny h). Returns (mode, tan h, normaliser): mode 0 when there is no spread
-    (h = pi / 2), 2 when the spread is 0 (nothing leaves but along the normal)."""
-    h = min(spread, math.pi) / 2.0
-    if h >= math.pi / 2.0 - 1e-6:
-        return 0.0, 0.0, 0.0
-    if h <= 0:
-        return 2.0, 0.0, 0.0
-    return 1.0, math.tan(h), 3.0 / h ** 3 if h <= 0.05 else 1.0 / (math.tan(h) - h)
 
 
 @kernel(inline="always")

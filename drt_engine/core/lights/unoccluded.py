@@ -2,7 +2,7 @@
 shadow, for the ratio estimator (Heitz, Hill and McGuire 2018).
 
 ``unoccluded`` gives E(p, n) = integral over the light of L_e(w) max(0, n.w) dw for one row of
-light_kinds' table, in the units of light sampling: E is the mean of ``value * max(0, n.wi)``
+lights.table's table, in the units of light sampling: E is the mean of ``value * max(0, n.wi)``
 over ``sample_light``'s samples, so a diffuse lobe's unshadowed direct light is albedo / pi * E.
 
 Polygons (rectangles, emissive triangles) use Lambert's edge integral clipped to the tangent
@@ -18,40 +18,10 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
-from .kinds import (
-    COS_HALF,
-    DISK,
-    DX,
-    DY,
-    DZ,
-    EB,
-    EG,
-    ER,
-    EXX,
-    EXY,
-    EXZ,
-    EYX,
-    EYY,
-    EYZ,
-    EZX,
-    EZY,
-    EZZ,
-    KIND,
-    POINT,
-    PX,
-    PY,
-    PZ,
-    RADIUS,
-    RECT,
-    SIZE_X,
-    SIZE_Y,
-    SOFT,
-    SOLID,
-    SPOT,
-    SPREAD_MODE,
-    SUN,
-    SUN_SCALE,
-    spot_factor,
+from .kinds import spot_factor
+from .table import (
+    COS_HALF, DISK, DX, DY, DZ, EB, EG, ER, EXX, EXY, EXZ, EYX, EYY, EYZ, EZX, EZY, EZZ, KIND, POINT, PX, PY, PZ,
+    RADIUS, RECT, SIZE_X, SIZE_Y, SOFT, SOLID, SPOT, SPREAD_MODE, SUN, SUN_SCALE,
 )
 
 
