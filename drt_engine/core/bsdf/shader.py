@@ -483,7 +483,7 @@ class MaterialShader:
         f_nd = np.empty((n, 3))
         pdf = np.empty(n)
         evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
-                         _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
+                      _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
         return BsdfValue(diffuse=f_diff, glossy=f_nd, pdf=pdf)
 
     # -- sampling -------------------------------------------------------------------
@@ -504,8 +504,8 @@ class MaterialShader:
         valid = np.empty(n, bool)
         passthrough = np.empty(n, bool)
         sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
-                       _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
-                       len(self.sampled))
+                    _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
+                    len(self.sampled))
         return BsdfSample(wi_l=wi, weight=weight, pdf=pdf, delta=delta, valid=valid, passthrough=passthrough)
 
     # -- albedo passes --------------------------------------------------------------
@@ -525,7 +525,7 @@ class MaterialShader:
         spec = np.empty((n, 3))
         take = np.empty(n, bool)
         denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
-                          diff, spec, take)
+                       diff, spec, take)
         return diff, spec, take
 
     def lobe_weights(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
