@@ -7,6 +7,8 @@ the build (images must be bit-identical on every machine).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .constants import TINY
@@ -49,6 +51,33 @@ def orthonormal_basis(n):
     t = np.stack([1.0 + s * n[:, 0] ** 2 * a, s * b, -s * n[:, 0]], axis=1)
     bt = np.stack([b, s + n[:, 1] ** 2 * a, -n[:, 1]], axis=1)
     return t, bt
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Orthonormal frames, one per row: tangent ``t``, bitangent ``b`` and normal ``n``, (N, 3)
+    each. Shading works in the local frame (normal along +z); a frame carries both ways across."""
+
+    t: np.ndarray
+    b: np.ndarray
+    n: np.ndarray
+
+    @classmethod
+    def about(cls, n) -> "Frame":
+        """The frame completing each unit row of ``n`` (``orthonormal_basis``)."""
+        t, b = orthonormal_basis(n)
+        return cls(t, b, n)
+
+    def __getitem__(self, rows) -> "Frame":
+        return Frame(self.t[rows], self.b[rows], self.n[rows])
+
+    def to_local(self, v):
+        """World rows of ``v`` in each row's frame."""
+        return np.stack([dot(v, self.t), dot(v, self.b), dot(v, self.n)], axis=1)
+
+    def to_world(self, v):
+        """Local rows of ``v`` back in world space."""
+        return v[:, :1] * self.t + v[:, 1:2] * self.b + v[:, 2:] * self.n
 
 
 def normalize(v, tiny: float = TINY):

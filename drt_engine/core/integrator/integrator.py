@@ -16,6 +16,7 @@ import numpy as np
 
 from ..base import vectors as vec
 from ..base.constants import TINY
+from ..base.vectors import Frame
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.ratio_sums import NDU_CHANNELS, RATIO
@@ -255,10 +256,9 @@ class Integrator:
         ng_o, ns_o = ng * flip, ns * flip
         bad = vec.dot(wo, ns_o) <= 1e-6
         ns_o[bad] = ng_o[bad]
-        tangent, bitangent = _frame(ns_o)
+        frame = Frame.about(ns_o)
         return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material[prim], pos=pos,
-                           ng=ng_o, ns=ns_o, tangent=tangent, bitangent=bitangent, wo=wo,
-                           wo_l=_to_local(wo, tangent, bitangent, ns_o), inside=inside,
+                           ng=ng_o, frame=frame, wo=wo, wo_l=frame.to_local(wo), inside=inside,
                            scale=self.geometry.offset_scale(prim, pos), throughput=state.throughput[rows],
                            straight=state.straight[rows], time=state.time[rows], normal=ns)
 
@@ -350,9 +350,8 @@ class Integrator:
                 ng, wo = group.ng, group.wo
                 ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, group.ns)
                 ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
-                tangent, bitangent = _frame(ns)
-                group = replace(group, ns=ns, tangent=tangent, bitangent=bitangent,
-                                wo_l=_to_local(wo, tangent, bitangent, ns))
+                frame = Frame.about(ns)
+                group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
                 yield group.take(sub), u_g.take(sub), shader
 
@@ -374,7 +373,7 @@ class Integrator:
             ok = vec.max3(ls.value) > 0
             if not ok.any():
                 continue
-            wi_l = _to_local(ls.wi, hits.tangent, hits.bitangent, hits.ns)
+            wi_l = hits.frame.to_local(ls.wi)
             above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
             f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
@@ -432,7 +431,7 @@ class Integrator:
         bs = shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside)
         new_thr = hits.throughput * bs.weight
         sel = np.flatnonzero(bs.valid & (vec.max3(new_thr) > 0))
-        wi = _to_world(bs.wi_l[sel], hits.tangent[sel], hits.bitangent[sel], hits.ns[sel])
+        wi = hits.frame[sel].to_world(bs.wi_l[sel])
         # a sampled direction on the wrong side of the geometric surface would leak light
         transmit = bs.wi_l[sel, 2] < 0
         geo_ok = (vec.dot(wi, hits.ng[sel]) < 0) == transmit
@@ -467,14 +466,3 @@ def _shadow_origin(pos, ng, wi, cos_shading, lift, scale):
     amount = np.where(cos_shading > 0, amount, 0.0)
     side = np.where(cos_shading > 0, 1.0, -1.0)[:, None] * ng
     return spawn(pos + lift * amount[:, None], ng, side, scale)
-
-
-_frame = vec.orthonormal_basis
-
-
-def _to_local(v, t, b, n):
-    return np.stack([vec.dot(v, t), vec.dot(v, b), vec.dot(v, n)], axis=1)
-
-
-def _to_world(v, t, b, n):
-    return v[:, :1] * t + v[:, 1:2] * b + v[:, 2:] * n

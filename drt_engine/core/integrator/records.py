@@ -8,6 +8,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..base.vectors import Frame
+
 
 def _take(record, rows):
     """The record's rows ``rows`` (an index array, a mask or a slice), field by field."""
@@ -82,9 +84,7 @@ class SurfaceHits:
     mat: np.ndarray
     pos: np.ndarray
     ng: np.ndarray
-    ns: np.ndarray
-    tangent: np.ndarray
-    bitangent: np.ndarray
+    frame: Frame  # about the shading normal
     wo: np.ndarray
     wo_l: np.ndarray
     inside: np.ndarray
@@ -96,6 +96,11 @@ class SurfaceHits:
 
     def __len__(self):
         return len(self.path)
+
+    @property
+    def ns(self) -> np.ndarray:
+        """The shading normal, facing the incoming ray: the frame's normal."""
+        return self.frame.n
 
     take = _take
 
