@@ -10,8 +10,10 @@ Numba checks a cached kernel against its own source file only, not against the f
 kernels it calls: a kernel cached before ``microfacet.py`` changed would be loaded stale. So
 the cache lives in a folder named by a fingerprint of all of DRT's core sources (every file
 under ``core/``, subpackages included), Numba and
-Python (``_fingerprint``); a changed source means a new folder, and older folders are removed
-once the new one is complete.
+Python (``_fingerprint``); a changed source means a new folder. The newest few folders of one
+Python are kept (``KEEP``), so that two checkouts or extension versions sharing the user's cache
+folder do not wipe each other's kernels; a folder removed while a render loads from it costs a
+recompile, never an error (Numba treats a missing file as a cache miss).
 
 The cache's base folder must be chosen before the modules that define kernels are imported:
 the Blender layer calls ``use_cache_dir`` with the extension's user folder; the CLI and the
@@ -29,7 +31,9 @@ from pathlib import Path
 
 import numba
 
-_STAMP = "compiled"  # written into a cache folder once a render has filled it
+_STAMP = "compiled"  # written into a cache folder once a render has filled it; touched by each render
+KEEP = 4
+"""Fingerprint folders kept per Python, the most recently used first."""
 
 
 def default_cache_dir() -> Path:
@@ -94,16 +98,26 @@ def first_run() -> bool:
 
 
 def mark_compiled() -> None:
-    """Record that this version's kernels are in the cache and remove the folders of older versions
-    for the same Python (other Pythons' folders belong to other Blenders or venvs and stay; best
-    effort: a read-only cache folder only means the message shows again)."""
+    """Record that this version's kernels are in the cache and were used now, and remove the
+    folders of older versions for the same Python beyond the ``KEEP`` most recently used (other
+    Pythons' folders belong to other Blenders or venvs and stay; best effort: a read-only cache
+    folder only means the message shows again)."""
     try:
         folder = cache_dir()
         folder.mkdir(parents=True, exist_ok=True)
         (folder / _STAMP).touch()
-        for old in folder.parent.iterdir():
-            same_python = re.fullmatch(re.escape(_FINGERPRINT.split("-")[0]) + r"-[0-9a-f]{16}", old.name)
-            if old != folder and old.is_dir() and same_python:
-                shutil.rmtree(old, ignore_errors=True)
+        same_python = re.escape(_FINGERPRINT.split("-")[0]) + r"-[0-9a-f]{16}"
+        older = [f for f in folder.parent.iterdir()
+                 if f != folder and re.fullmatch(same_python, f.name) and f.is_dir()]
+        for old in sorted(older, key=_last_use, reverse=True)[KEEP - 1:]:
+            shutil.rmtree(old, ignore_errors=True)
     except OSError:
         pass
+
+
+def _last_use(folder: Path) -> float:
+    """When a render last used ``folder`` (its stamp's time; a folder without one counts as oldest)."""
+    try:
+        return (folder / _STAMP).stat().st_mtime
+    except OSError:
+        return 0.0

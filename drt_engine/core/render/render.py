@@ -83,7 +83,6 @@ class Renderer:
         first_id, end_id = s.sample_range()
         cap = end_id - first_id  # samples a pixel takes here: ids first_id.. of the full set
         replicas = adaptive.replicate_samplers(s.sampling_pattern, self.sampler.samples, s.seed)
-        compiling = jit.first_run()
         pool = ThreadPoolExecutor(self.threads, thread_name_prefix="DRT") if self.threads > 1 else None
 
         def trace(pixel, sample):
@@ -103,8 +102,8 @@ class Renderer:
         finally:
             if pool is not None:
                 pool.shutdown(wait=True)
-        if compiling and outcome.stopped != "cancelled":
-            jit.mark_compiled()
+        if outcome.stopped != "cancelled":
+            jit.mark_compiled()  # also when warm: the stamp's time is the folder's last use
         return self._result(outcome)
 
     def _seed_pixels(self, index):
