@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-from .cli_progress import ProgressDisplay
+from .headless.progress import ProgressDisplay
 from .core.errors import DRTError
 from .core.film import parts
 from .core.render import merge, report
