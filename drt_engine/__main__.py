@@ -1,4 +1,4 @@
-"""``python -m drt_engine ...``: the headless command line (see cli.py)."""
-from .cli import exit_now, main
+"""``python -m drt_engine ...``: the headless command line (see headless/cli.py)."""
+from .headless.cli import exit_now, main
 
 exit_now(main())

@@ -240,6 +240,6 @@ def done() -> None:
     written. Inside Blender itself (``blender --python``) and under other versions it does nothing.
     """
     if bpy.app.version[:2] == (4, 2) and not bpy.app.binary_path:
-        from drt_engine.cli import exit_now
+        from drt_engine.headless.cli import exit_now
 
         exit_now(0)

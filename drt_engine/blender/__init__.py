@@ -1,4 +1,5 @@
-"""Everything that touches Blender: settings, panels, the RenderEngine and the scene export."""
+"""Everything that touches Blender: settings, panels, the RenderEngine, the scene export, and the
+bpy calls of the headless CLI (batch.py)."""
 import bpy
 
 from ..core.base import jit

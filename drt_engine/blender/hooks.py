@@ -1,7 +1,7 @@
 """What a render leaves for, or takes from, whoever started it besides Blender's render result.
 
-The headless CLI runs Blender's render operator in its own process: this is how it gets
-the engine's reports and parts back and hears the render's progress. Persistent Data keeps
+The headless CLI runs Blender's render operator in its own process (batch.py): this is how it
+gets the engine's reports and parts back and hears the render's progress. Persistent Data keeps
 its prepared scenes here between frames.
 """
 from __future__ import annotations

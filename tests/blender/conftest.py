@@ -13,8 +13,8 @@ import pytest
 
 import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
-from drt_engine.cli import exit_now
 from drt_engine.core.settings import PASS_CHANNELS
+from drt_engine.headless.cli import exit_now
 from tests.support import sample_scene_files
 from tests.support.datablocks import new_material, new_world
 from tests.support.render_helpers import read_channels, set_exr_output
@@ -47,7 +47,7 @@ def pytest_unconfigure(config):
 
     That module crashes (SIGSEGV, exit 139) while Python tears it down once a property with an
     update callback was registered, as DRT's are, after every test has passed or failed: the
-    status must be the tests'. The CLI ends the same way (drt_engine.cli.exit_now).
+    status must be the tests'. The CLI ends the same way (drt_engine.headless.cli.exit_now).
     """
     if bpy.app.version[:2] == (4, 2) and _EXIT_STATUS in config.stash:
         exit_now(config.stash[_EXIT_STATUS])

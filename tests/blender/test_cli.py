@@ -15,7 +15,7 @@ import bpy
 import numpy as np
 import pytest
 
-from drt_engine.cli import EXIT_ERROR, EXIT_USAGE
+from drt_engine.headless.errors import EXIT_ERROR, EXIT_USAGE
 
 ROOT = Path(__file__).resolve().parents[2]
 STRENGTH = 0.5

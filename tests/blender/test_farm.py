@@ -248,7 +248,7 @@ def test_ctrl_c_cancels_and_leaves_no_process(cornell_box, tmp_path):
 
 
 def test_ranges_cover_every_sample_once():
-    from drt_engine.farm import split
+    from drt_engine.headless.farm import split
 
     for samples, tasks in ((8, 2), (7, 3), (1024, 16), (3, 5)):
         ranges = split(samples, tasks)
@@ -258,7 +258,7 @@ def test_ranges_cover_every_sample_once():
 
 
 def test_frame_outputs():
-    from drt_engine.farm import frame_output
+    from drt_engine.headless.farm import frame_output
 
     assert frame_output(Path("/o/shot_####.exr"), 12, True) == Path("/o/shot_0012.exr")
     assert frame_output(Path("/o/shot_##.exr"), 7, False) == Path("/o/shot_07.exr")
@@ -275,25 +275,27 @@ def test_frame_outputs():
 ])
 def test_bad_farm_options_are_one_line(drt, cornell_box, tmp_path, extra, words):
     """In this process (the checks come before any render or cluster)."""
-    from drt_engine import cli
+    from drt_engine.headless import cli, commands
+    from drt_engine.headless.errors import CLIError
 
-    with pytest.raises(cli.CLIError) as caught:
-        cli._render(cli.build_parser().parse_args(["render", str(cornell_box), "-o", str(tmp_path / "x.exr"),
-                                                   *map(str, OPTIONS), *extra]))
+    with pytest.raises(CLIError) as caught:
+        commands.render(cli.build_parser().parse_args(["render", str(cornell_box), "-o", str(tmp_path / "x.exr"),
+                                                       *map(str, OPTIONS), *extra]))
     for word in words:
         assert word in str(caught.value)
 
 
 def test_tls_options_make_an_encrypted_client(cornell_box, tmp_path):
-    from drt_engine import cli
-    from drt_engine.farm import _security
+    from drt_engine.headless import cli
+    from drt_engine.headless.errors import CLIError
+    from drt_engine.headless.farm import _security
 
     def args(*extra):
         return cli.build_parser().parse_args(["render", str(cornell_box), "-o", "x.exr", "--cluster", "tls://h:8786",
                                               *extra])
 
     assert not _security(args()).require_encryption  # Dask's own configuration then
-    with pytest.raises(cli.CLIError, match="no such file"):
+    with pytest.raises(CLIError, match="no such file"):
         _security(args("--tls-ca-file", str(tmp_path / "missing.pem")))
     for name in ("ca.pem", "cert.pem", "key.pem"):
         (tmp_path / name).write_text("-")

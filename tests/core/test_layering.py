@@ -148,16 +148,12 @@ def test_every_import_follows_the_layers():
     assert layering_violations(graph(PACKAGE)) == []
 
 
-KNOWN_CIRCLES = [
-    ["drt_engine.cli", "drt_engine.farm"],
-]
-"""Circles the layout issue (#21) still has to break: the RenderEngine and the viewport worker,
-the CLI and the farm (patched today with lazy imports). Listed so that no new circle comes in;
-when one is broken, this list must shrink, or the test fails."""
+KNOWN_CIRCLES = []
+"""Circles still to break; empty since issue #21's layout. Listed so that no new circle comes in."""
 
-KNOWN_BPY_OUTSIDE_BLENDER = ["drt_engine.cli"]
-"""The CLI opens the .blend and runs Blender's render operator itself until the headless package
-routes that through the Blender layer (#21)."""
+KNOWN_BPY_OUTSIDE_BLENDER = []
+"""Modules outside drt_engine/blender/ that import bpy; empty since the headless CLI reaches Blender
+through drt_engine.blender.batch (#21)."""
 
 
 def test_no_import_circle_but_the_known_ones():

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import embreex  # noqa: F401  (a worker without it must fail the check, not the first task)
 
-from .core.film import parts
+from ..core.film import parts
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]  # where `-m drt_engine` imports this checkout
 _files_lock = threading.Lock()
 
 

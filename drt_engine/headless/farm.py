@@ -15,15 +15,10 @@ import re
 import time
 from pathlib import Path
 
-from .cli import (
-    CLIError,
-    _open_scene,
-    check_splittable,
-    done_line,
-    write_merged_report,
-    write_output,
-)
-from .core.render import merge, report
+from ..core.render import merge, report
+from .errors import CLIError
+from .outputs import done_line, write_merged_report, write_output
+from .scene import check_splittable, open_scene
 
 LOCALHOST = "127.0.0.1"
 
@@ -60,7 +55,7 @@ def render(args, blend: Path, output: Path) -> str:
         shipping = time.perf_counter()
         shipped = client.scatter(blend.read_bytes(), broadcast=True, hash=False)
         timing["ship"] = time.perf_counter() - shipping
-        from . import farm_task
+        from . import farm_task  # (imports embreex, which the client needs only from here on)
 
         futures = [client.submit(farm_task.render_range, shipped, blend.name, options, frame, a, b, pure=False,
                                  key=f"drt-frame{frame}-samples{a}-{b}-{os.getpid()}")
@@ -82,7 +77,7 @@ def render(args, blend: Path, output: Path) -> str:
 
 def _plan(args, blend: Path) -> tuple[int, list[int], list[str]]:
     """(samples, frames, the render options every task passes on) from the .blend and the overrides."""
-    scene = _open_scene(args, blend)
+    scene = open_scene(args, blend)
     check_splittable(scene, blend)
     samples = scene.drt.samples
     frames = list(range(args.frames[0], args.frames[1] + 1)) if args.frames else [scene.frame_current]
@@ -181,7 +176,7 @@ def _check_workers(client, args) -> list[str]:
         client.wait_for_workers(1, timeout=args.connect_timeout)
     except (TimeoutError, OSError):
         raise CLIError(f"no Dask worker joined the scheduler within {args.connect_timeout:g} s") from None
-    results = client.run(exec, "import drt_engine.farm_task as t; t.check()", on_error="return")
+    results = client.run(exec, "import drt_engine.headless.farm_task as t; t.check()", on_error="return")
     for address, result in sorted(results.items()):
         if isinstance(result, BaseException):
             raise CLIError(f"worker {address} cannot run DRT: {_one_line(result)}")
@@ -214,4 +209,3 @@ def _close(client, cluster) -> None:
 def _one_line(error) -> str:
     text = " ".join(str(error).split()) or type(error).__name__
     return text if isinstance(error, CLIError) else f"{type(error).__name__}: {text}"
-

@@ -3,7 +3,7 @@ import io
 
 import pytest
 
-from drt_engine.cli_progress import ProgressDisplay, progress_text, time_left
+from drt_engine.headless.progress import ProgressDisplay, progress_text, time_left
 from drt_engine.core.render.render import ProgressUpdate
 
 
@@ -35,7 +35,7 @@ def test_a_terminal_gets_one_line_rewritten_in_place(monkeypatch):
     stream = Terminal()
     display = ProgressDisplay(stream)
     clock = iter([0.0, 1.0, 2.0])
-    monkeypatch.setattr("drt_engine.cli_progress.time.monotonic", lambda: next(clock))
+    monkeypatch.setattr("drt_engine.headless.progress.time.monotonic", lambda: next(clock))
     display(update(done=1000, total=4096, fraction=0.2))
     display(update(done=2, total=4096, fraction=0.5))
     display.close()
@@ -51,7 +51,7 @@ def test_a_log_gets_plain_lines_every_interval(monkeypatch, times, lines):
     stream = io.StringIO()
     display = ProgressDisplay(stream)
     clock = iter(times)
-    monkeypatch.setattr("drt_engine.cli_progress.time.monotonic", lambda: next(clock))
+    monkeypatch.setattr("drt_engine.headless.progress.time.monotonic", lambda: next(clock))
     for _ in times:
         display(update())
     display.close()

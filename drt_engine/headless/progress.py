@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 import time
 
-from .core.render import report
+from ..core.render import report
 
 TERMINAL_INTERVAL = 0.2
 PLAIN_INTERVAL = 10.0
