@@ -1,7 +1,7 @@
 """The ratio estimator of direct diffuse light (Heitz, Hill and McGuire 2018).
 
-For a light whose unoccluded light has a closed form (core.lights.unoccluded), the diffuse
-direct light of a pixel is the analytic unoccluded light times the fraction of it the
+For a light whose unoccluded light has a closed form (``unoccluded``, core.lights.kinds), the
+diffuse direct light of a pixel is the analytic unoccluded light times the fraction of it the
 shadow rays let through, both taken over the pixel's own samples:
 
     L = U * N / D,  N = sum a f V / p,  D = sum a f / p,  U = sum a E_u,
@@ -24,7 +24,8 @@ closed form.
 from __future__ import annotations
 
 from ..base.jit import kernel
-from ..lights.unoccluded import closed_forms, unoccluded
+from ..lights.collection import closed_forms
+from ..lights.kinds import unoccluded
 
 
 def delta_light(light) -> bool:
@@ -48,7 +49,7 @@ def ratio_strategies(lights, estimator: str) -> list[int]:
 def add_unoccluded(table, k, pos, normal, path, albedo, diffuse, ndu):
     """Per hit j of path ``path[j]``: D += ``diffuse[j]`` (throughput x light sample value x the
     diffuse part, unoccluded) and U += ``albedo[j]`` (throughput x albedo / pi) x E_u, light k's
-    unoccluded light at ``pos[j]`` about the unit normal ``normal[j]`` (core.lights.unoccluded)."""
+    unoccluded light at ``pos[j]`` about the unit normal ``normal[j]`` (core.lights.kinds)."""
     for j in range(len(path)):
         r, g, b = unoccluded(table, k, pos[j, 0], pos[j, 1], pos[j, 2], normal[j, 0], normal[j, 1], normal[j, 2])
         p = path[j]
