@@ -1,4 +1,4 @@
-"""Cost per call of the closed-form unoccluded irradiance (core/lights/unoccluded.py) per light kind,
+"""Cost per call of the closed-form unoccluded irradiance (``unoccluded``, core/lights/kinds.py) per light kind,
 and its worst relative error against the reference cubature of tests/core/test_unoccluded.py.
 
 Cost: ``unoccluded`` over a batch of random shading points under each light with random
@@ -21,7 +21,8 @@ sys.path.insert(0, str(ROOT))
 
 from drt_engine.core.lights.table import light_table  # noqa: E402
 from drt_engine.core.scene import Light  # noqa: E402
-from drt_engine.core.lights.unoccluded import _unoccluded_rows, unoccluded_triangles_batch  # noqa: E402
+from drt_engine.core.lights.collection import _unoccluded_rows  # noqa: E402
+from drt_engine.core.lights.triangles import unoccluded_triangles_batch  # noqa: E402
 from tests.core import test_unoccluded as t  # noqa: E402
 
 N = 200_000

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from drt_engine.core.lights.kinds import spherical_rectangle
+from drt_engine.core.lights.area import spherical_rectangle
 from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _sample_batch
 from drt_engine.core.scene import Light

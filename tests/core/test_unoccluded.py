@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from drt_engine.core.lights.table import light_table
-from drt_engine.core.lights.collection import _sample_batch, _sample_emissive_batch
+from drt_engine.core.lights.collection import _sample_batch, closed_forms, unoccluded_batch
 from drt_engine.core.scene import Light
-from drt_engine.core.lights.unoccluded import closed_forms, unoccluded_batch, unoccluded_triangles_batch
+from drt_engine.core.lights.triangles import sample_emissive_batch, unoccluded_triangles_batch
 
 REL = 1e-6
 _X, _W = np.polynomial.legendre.leggauss(10)
@@ -474,7 +474,7 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
     rng, means = np.random.default_rng(9), []
     for _ in range(32):
         u = stratified(64, rng)
-        wi, _, value, *_ = _sample_emissive_batch(verts, tris, ng, area, ids, np.cumsum(prob), prob, emission,
+        wi, _, value, *_ = sample_emissive_batch(verts, tris, ng, area, ids, np.cumsum(prob), prob, emission,
                                                   np.tile(np.asarray(p, float), (len(u), 1)), u,
                                                   rng.random(len(u)))
         means.append((value * np.maximum(wi @ unit(n), 0.0)[:, None]).mean(axis=0))

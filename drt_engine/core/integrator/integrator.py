@@ -19,12 +19,12 @@ from ..base.constants import TINY
 from ..base.vectors import Frame
 from ..film.denoising import Features
 from ..film.film import PixelFilter
-from ..film.ratio_sums import NDU_CHANNELS, RATIO
+from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..geometry.accel import spawn
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
-from .ratio import add_unoccluded
+from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
@@ -77,16 +77,16 @@ class StepSamples:
 class WaveOutput:
     """The per-sample values of every pass a wave computes: the wave's accumulator, which the
     stages add their contributions to (Combined RGB, alpha, the auxiliary passes, and the
-    ratio estimator's N, D, U when it is used, core.integrator.ratio)."""
+    ratio estimator with its N, D, U when it is used, core.integrator.ratio)."""
 
     radiance: np.ndarray
     alpha: np.ndarray
     aux: dict
     features: Features | None = None  # the denoising features' walks, when those passes are on
-    ratio: np.ndarray | None = None
+    ratio: RatioEstimator | None = None
 
     def values(self, clamp: float) -> dict:
-        radiance, ratio = self.radiance, self.ratio
+        radiance, ratio = self.radiance, None if self.ratio is None else self.ratio.ndu
         if clamp > 0:
             peak = vec.max3(radiance)
             scale = np.where(peak > clamp, clamp / np.maximum(peak, TINY), 1.0)[:, None]
@@ -132,7 +132,7 @@ class Integrator:
         n = len(state)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
                                                         if name in s.passes},
-                         ratio=np.zeros((n, NDU_CHANNELS)) if self.ratio else None)
+                         ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
@@ -357,14 +357,13 @@ class Integrator:
 
     # -- next-event estimation ----------------------------------------------------------
     def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
-        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy; for
-        the lights the ratio estimator takes, their D and U go to the wave's sums (core.integrator.ratio)."""
+        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy, each
+        batch shown to the wave's ratio estimator when there is one (core.integrator.ratio)."""
         lights = self.lights
         out = []
         time = hits.time if self.timed else None
         sel_lobes = shader.selection(hits.wo_l[:, 2]) if shader.sampled else None
         emissive = lights.light_slots if len(lights.emissive) else -1
-        albedo = self._diffuse_albedo(shader, hits, sel_lobes) if self.ratio else None
         for k in range(lights.strategies):
             u_pick = u.choice[emissive] if emissive >= 0 else None
             # the world is sampled around the shading normal, the one the BSDF's cosine follows
@@ -379,12 +378,10 @@ class Integrator:
             f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
             w_l = _power(ls.pdf, f.pdf)
             contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
-            by_ratio = k in self.ratio and albedo is not None
-            if by_ratio:
-                diffuse = hits.throughput * ls.value * f_diff
-                add_unoccluded(lights.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, wave.ratio)
             ok &= vec.max3(contrib) > 0
             sel = np.flatnonzero(ok)
+            if wave.ratio is not None:
+                wave.ratio.shadow_rays(k, shader, hits, sel_lobes, ls.value, f_diff, sel)
             if len(sel) == 0:
                 continue
             scale = hits.scale[sel]
@@ -393,21 +390,9 @@ class Integrator:
             dist = ls.dist[sel]
             stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
             tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
-            share = diffuse[sel] if by_ratio else np.zeros((len(sel), 3)) if self.ratio else None
             out.append(ShadowRays(path=hits.path[sel], origins=origin, dirs=ls.wi[sel], tmax=np.maximum(tmax, 0.0),
-                                  contrib=contrib[sel], diffuse=share))
+                                  contrib=contrib[sel]))
         return out
-
-    @staticmethod
-    def _diffuse_albedo(shader, hits: SurfaceHits, sel_lobes):
-        """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
-        the diffuse part toward the normal, since it is that times the cosine (the layers above
-        attenuate it by factors of wo alone, bsdf.mixture.eval_lobes)."""
-        n = len(hits.path)
-        normal = np.zeros((n, 3))
-        normal[:, 2] = 1.0
-        f_diff = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes).diffuse
-        return hits.throughput * f_diff if (f_diff > 0).any() else None
 
     def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
         """Trace the shadow rays of a depth step and add the unblocked ones' light."""
@@ -422,8 +407,8 @@ class Integrator:
         n = len(out.radiance)
         for c in range(3):
             out.radiance[:, c] += np.bincount(rays.path[visible], weights=rays.contrib[visible, c], minlength=n)
-            if out.ratio is not None:
-                out.ratio[:, c] += np.bincount(rays.path[visible], weights=rays.diffuse[visible, c], minlength=n)
+        if out.ratio is not None:
+            out.ratio.resolved(rays.path, visible)
 
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:

@@ -107,15 +107,13 @@ class SurfaceHits:
 
 @dataclass
 class ShadowRays:
-    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked, and
-    the share of that the ratio estimator takes (its N; zero for other lights, core.integrator.ratio)."""
+    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked."""
 
     path: np.ndarray
     origins: np.ndarray
     dirs: np.ndarray
     tmax: np.ndarray
     contrib: np.ndarray
-    diffuse: np.ndarray | None  # None when no light of the render is the ratio estimator's
 
     def __len__(self):
         return len(self.path)

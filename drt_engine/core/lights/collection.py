@@ -6,10 +6,12 @@ sun angle 0) return pdf = inf so multiple importance sampling gives them full we
 lights, emissive triangles and the world can also be hit by continued rays, and expose
 ``pdf`` for the power heuristic.
 
-The per-ray arithmetic is in kernels: each light kind's in lights.kinds (over one flat
-table of lights, lights.table), the choice among many lights in lights.choice, the
-environment map's in environment.py, emissive triangles and the world below. The methods
-here call one batch loop per wave and strategy; shader programs (textured emission, the
+The per-ray arithmetic is in kernels: each light kind's in its own module (lights.point,
+lights.sun, lights.area, behind the switch in lights.kinds, over one flat table of lights,
+lights.table), emissive triangles' in lights.triangles, the choice among many lights in
+lights.choice, the environment map's in lights.environment, the world's below. The methods
+here call one batch loop per wave and strategy (below too, with the table lights' closed-form
+unoccluded light for the ratio estimator); shader programs (textured emission, the
 environment's radiance) stay NumPy.
 """
 from __future__ import annotations
@@ -30,8 +32,9 @@ from ..scene import Light, SceneData
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_light, pick_probability
 from .environment import Environment, map_direction, map_pdf
-from .kinds import hit_light, light_pdf, sample_light, sun_seen
+from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .table import light_row, light_table
+from .triangles import pdf_emissive_batch, sample_emissive_batch
 
 
 class LightSample:
@@ -238,7 +241,7 @@ class Lights:
 
     def _sample_emissive(self, pos, u, u_pick):
         g = self.geometry
-        wi, dist, value, pdf, pick, bary, q, cos_l = _sample_emissive_batch(
+        wi, dist, value, pdf, pick, bary, q, cos_l = sample_emissive_batch(
             g.world_vertices, g.triangles, g.world_ng, g.area, self.emissive, self.emissive_cdf,
             self.emissive_prob, self.tri_emission, pos, u, np.ascontiguousarray(u_pick))
         if self.textured:  # emission from the shader program at the sampled points
@@ -309,7 +312,7 @@ class Lights:
 
     def pdf_emissive(self, prim, dirs, t):
         g = self.geometry
-        return _pdf_emissive_batch(g.world_ng, g.area, self.emissive_prob, prim, dirs, np.asarray(t, np.float64))
+        return pdf_emissive_batch(g.world_ng, g.area, self.emissive_prob, prim, dirs, np.asarray(t, np.float64))
 
     def pdf_world(self, prev_normal, dirs):
         return _pdf_world_batch(prev_normal, dirs, self._map_share, self._map[2], self._map[3])
@@ -330,63 +333,6 @@ class Lights:
                 value[k] = self.environment.radiance(dirs[k])
             return value
         return np.where(shown[:, None], self.world_constant, 0.0)
-
-
-# -- emissive triangles ------------------------------------------------------------------------
-@kernel(inline="always")
-def pick_triangle(emissive, cdf, u):
-    """An emissive triangle chosen by power (``cdf`` over the ``emissive`` triangles)."""
-    return emissive[min(np.searchsorted(cdf, u, side="right"), len(emissive) - 1)]
-
-
-@kernel(inline="always")
-def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
-    """A point uniform on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in
-    solid angle including the chance ``prob[i]`` of picking the triangle, two-sided."""
-    su = math.sqrt(u0)
-    b0, b1 = 1.0 - su, u1 * su
-    b2 = 1.0 - b0 - b1
-    a, b, c = triangles[i, 0], triangles[i, 1], triangles[i, 2]
-    qx = b0 * vertices[a, 0] + b1 * vertices[b, 0] + b2 * vertices[c, 0]
-    qy = b0 * vertices[a, 1] + b1 * vertices[b, 1] + b2 * vertices[c, 1]
-    qz = b0 * vertices[a, 2] + b1 * vertices[b, 2] + b2 * vertices[c, 2]
-    tx, ty, tz = qx - px, qy - py, qz - pz
-    dist = math.sqrt(tx * tx + ty * ty + tz * tz)
-    inv = 1.0 / max(dist, TINY)
-    wx, wy, wz = tx * inv, ty * inv, tz * inv
-    cos_l = abs(wx * ng[i, 0] + wy * ng[i, 1] + wz * ng[i, 2])
-    pdf = dist * dist / max(cos_l, TINY) * (prob[i] / area[i])
-    return wx, wy, wz, dist, pdf, b0, b1, cos_l
-
-
-@kernel
-def _sample_emissive_batch(vertices, triangles, ng, area, emissive, cdf, prob, emission, pos, u, u_pick):
-    n = len(pos)
-    wi, dist, value, pdf = np.empty((n, 3)), np.empty(n), np.zeros((n, 3)), np.empty(n)
-    pick, bary, q, cos_out = np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-    for j in range(n):
-        i = pick_triangle(emissive, cdf, u_pick[j])
-        px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
-        wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz,
-                                                          u[j, 0], u[j, 1])
-        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
-        dist[j], pdf[j], pick[j], cos_out[j] = d, p, i, cos_l
-        bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
-        q[j, 0], q[j, 1], q[j, 2] = px + wx * d, py + wy * d, pz + wz * d
-        if cos_l > 0:
-            s = 1.0 / max(p, TINY)
-            value[j, 0], value[j, 1], value[j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
-    return wi, dist, value, pdf, pick, bary, q, cos_out
-
-
-@kernel
-def _pdf_emissive_batch(ng, area, prob, prim, dirs, t):
-    out = np.empty(len(prim))
-    for j in range(len(prim)):
-        i = prim[j]
-        cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
-        out[j] = prob[i] / area[i] * t[j] * t[j] / cos_l
-    return out
 
 
 # -- the world ------------------------------------------------------------------------------------
@@ -542,3 +488,31 @@ def _suns_batch(shape_table, table, ids, slots, origins, dirs, radiance, pdf):
                 if slots > 0:
                     p *= pick_probability(table, i, origins[j, 0], origins[j, 1], origins[j, 2]) * slots
                 pdf[j] = p
+
+
+@kernel
+def _unoccluded_rows(table, rows, pos, normal, out):
+    for j in range(len(pos)):
+        r, g, b = unoccluded(table, rows[j], pos[j, 0], pos[j, 1], pos[j, 2], normal[j, 0], normal[j, 1],
+                             normal[j, 2])
+        out[j, 0], out[j, 1], out[j, 2] = r, g, b
+
+
+@kernel
+def closed_forms(table):
+    """``closed_form`` for every row of the table."""
+    out = np.empty(len(table), np.bool_)
+    for i in range(len(table)):
+        out[i] = closed_form(table, i)
+    return out
+
+
+def unoccluded_batch(table, rows, pos, normal, out):
+    """``out[j]`` = light ``rows[j]``'s unoccluded irradiance at ``pos[j]`` about ``normal[j]``
+    (a wave's arrays; ``rows`` int64, positions and unit normals (N, 3) float64)."""
+    used = np.unique(rows)
+    bad = used[~closed_forms(table)[used]]
+    if len(bad):
+        raise ValueError(f"lights {bad.tolist()} have no closed-form unoccluded irradiance (check closed_form)")
+    _unoccluded_rows(table, rows, pos, normal, out)
+    return out

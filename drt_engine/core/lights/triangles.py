@@ -1,0 +1,105 @@
+"""Emissive triangles, together one next-event strategy: pick, sample, pdf and closed form.
+
+A triangle is picked by its emitted power (``pick_triangle`` over a cdf lights.collection
+builds), then a point on it uniformly by area; both sides emit, and the solid-angle pdf includes
+the chance of the pick. Batch loops over a wave's points, since the triangles are not rows of
+the light table. The closed form (``unoccluded_triangles``) sums each triangle's projected
+solid angle (Lambert's edge integral, lights.solid_angle) times its constant emission: O(number
+of triangles) per point.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..base.constants import TINY
+from ..base.jit import kernel
+from .solid_angle import polygon4
+
+
+# -- sampling --------------------------------------------------------------------------------------
+@kernel(inline="always")
+def pick_triangle(emissive, cdf, u):
+    """An emissive triangle chosen by power (``cdf`` over the ``emissive`` triangles)."""
+    return emissive[min(np.searchsorted(cdf, u, side="right"), len(emissive) - 1)]
+
+
+@kernel(inline="always")
+def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
+    """A point uniform on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in
+    solid angle including the chance ``prob[i]`` of picking the triangle, two-sided."""
+    su = math.sqrt(u0)
+    b0, b1 = 1.0 - su, u1 * su
+    b2 = 1.0 - b0 - b1
+    a, b, c = triangles[i, 0], triangles[i, 1], triangles[i, 2]
+    qx = b0 * vertices[a, 0] + b1 * vertices[b, 0] + b2 * vertices[c, 0]
+    qy = b0 * vertices[a, 1] + b1 * vertices[b, 1] + b2 * vertices[c, 1]
+    qz = b0 * vertices[a, 2] + b1 * vertices[b, 2] + b2 * vertices[c, 2]
+    tx, ty, tz = qx - px, qy - py, qz - pz
+    dist = math.sqrt(tx * tx + ty * ty + tz * tz)
+    inv = 1.0 / max(dist, TINY)
+    wx, wy, wz = tx * inv, ty * inv, tz * inv
+    cos_l = abs(wx * ng[i, 0] + wy * ng[i, 1] + wz * ng[i, 2])
+    pdf = dist * dist / max(cos_l, TINY) * (prob[i] / area[i])
+    return wx, wy, wz, dist, pdf, b0, b1, cos_l
+
+
+@kernel
+def sample_emissive_batch(vertices, triangles, ng, area, emissive, cdf, prob, emission, pos, u, u_pick):
+    n = len(pos)
+    wi, dist, value, pdf = np.empty((n, 3)), np.empty(n), np.zeros((n, 3)), np.empty(n)
+    pick, bary, q, cos_out = np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+    for j in range(n):
+        i = pick_triangle(emissive, cdf, u_pick[j])
+        px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
+        wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz,
+                                                          u[j, 0], u[j, 1])
+        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
+        dist[j], pdf[j], pick[j], cos_out[j] = d, p, i, cos_l
+        bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
+        q[j, 0], q[j, 1], q[j, 2] = px + wx * d, py + wy * d, pz + wz * d
+        if cos_l > 0:
+            s = 1.0 / max(p, TINY)
+            value[j, 0], value[j, 1], value[j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
+    return wi, dist, value, pdf, pick, bary, q, cos_out
+
+
+@kernel
+def pdf_emissive_batch(ng, area, prob, prim, dirs, t):
+    out = np.empty(len(prim))
+    for j in range(len(prim)):
+        i = prim[j]
+        cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
+        out[j] = prob[i] / area[i] * t[j] * t[j] / cos_l
+    return out
+
+
+# -- closed form -----------------------------------------------------------------------------------
+@kernel(inline="always")
+def unoccluded_triangles(vertices, triangles, emission, ids, px, py, pz, nx, ny, nz):
+    """(r, g, b) irradiance at p about n from the two-sided emissive triangles ``ids`` of constant
+    ``emission`` (per triangle): the emissive strategy's unoccluded light, O(len(ids)) per point."""
+    r, g, b = 0.0, 0.0, 0.0
+    for i in ids:
+        v0, v1, v2 = triangles[i, 0], triangles[i, 1], triangles[i, 2]
+        ax, ay, az = vertices[v0, 0] - px, vertices[v0, 1] - py, vertices[v0, 2] - pz
+        e = 0.5 * abs(polygon4(ax, ay, az,
+                               vertices[v1, 0] - vertices[v0, 0], vertices[v1, 1] - vertices[v0, 1],
+                               vertices[v1, 2] - vertices[v0, 2],
+                               vertices[v2, 0] - vertices[v1, 0], vertices[v2, 1] - vertices[v1, 1],
+                               vertices[v2, 2] - vertices[v1, 2], 0.0, 0.0, 0.0, nx, ny, nz))
+        r += emission[i, 0] * e
+        g += emission[i, 1] * e
+        b += emission[i, 2] * e
+    return r, g, b
+
+
+@kernel
+def unoccluded_triangles_batch(vertices, triangles, emission, ids, pos, normal, out):
+    """``unoccluded_triangles`` for each point of a wave into ``out`` (N, 3)."""
+    for j in range(len(pos)):
+        r, g, b = unoccluded_triangles(vertices, triangles, emission, ids, pos[j, 0], pos[j, 1], pos[j, 2],
+                                       normal[j, 0], normal[j, 1], normal[j, 2])
+        out[j, 0], out[j, 1], out[j, 2] = r, g, b
+    return out
