@@ -9,14 +9,13 @@ lights, emissive triangles and the world can also be hit by continued rays, and 
 The per-ray arithmetic is in kernels: each light kind's in its own module (lights.point,
 lights.sun, lights.area, behind the switch in lights.kinds, over one flat table of lights,
 lights.table), emissive triangles' in lights.triangles, the choice among many lights in
-lights.choice, the environment map's in lights.environment, the world's below. The methods
+lights.choice, the environment map's in lights.environment, the world's in lights.world. The methods
 here call one batch loop per wave and strategy (below too, with the table lights' closed-form
 unoccluded light for the ratio estimator); shader programs (textured emission, the
 environment's radiance) stay NumPy.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -24,17 +23,16 @@ import numpy as np
 from ..base.colour import LUMINANCE
 from ..base.constants import TINY
 from ..base.jit import kernel
-from ..base.vectors import basis
-from ..base.warps import concentric_disk
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_light, pick_probability
-from .environment import Environment, map_direction, map_pdf
+from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch, sample_emissive_batch
+from .world import pdf_world_batch, sample_map_world_batch, sample_uniform_world_batch, world_shown_batch
 
 
 class LightSample:
@@ -255,9 +253,9 @@ class Lights:
         the map's luminance density with probability MAP_SHARE, else cosine-weighted (the
         sample's density is the mixture's, which ``pdf_world`` also gives)."""
         if self.environment is None:
-            wi, value, pdf = _sample_uniform_world_batch(normal, u, np.asarray(self.world, np.float64))
+            wi, value, pdf = sample_uniform_world_batch(normal, u, np.asarray(self.world, np.float64))
             return LightSample(wi, np.full(len(u), np.inf), value, pdf)
-        wi, pdf, lit = _sample_map_world_batch(normal, u, MAP_SHARE, *self._map)
+        wi, pdf, lit = sample_map_world_batch(normal, u, MAP_SHARE, *self._map)
         value = np.zeros((len(u), 3))
         k = np.flatnonzero(lit)
         if len(k):
@@ -315,7 +313,7 @@ class Lights:
         return pdf_emissive_batch(g.world_ng, g.area, self.emissive_prob, prim, dirs, np.asarray(t, np.float64))
 
     def pdf_world(self, prev_normal, dirs):
-        return _pdf_world_batch(prev_normal, dirs, self._map_share, self._map[2], self._map[3])
+        return pdf_world_batch(prev_normal, dirs, self._map_share, self._map[2], self._map[3])
 
     def world_radiance(self, dirs, straight, prev_normal):
         """Radiance of the world seen along ``dirs`` by camera rays (``straight``), or by rays
@@ -325,7 +323,7 @@ class Lights:
         if not self.world_seen:
             return np.zeros((n, 3))
         camera, _, glossy, transmission = self.world_visibility
-        shown = _world_shown_batch(dirs, straight, prev_normal, camera, glossy, transmission)
+        shown = world_shown_batch(dirs, straight, prev_normal, camera, glossy, transmission)
         if self.environment is not None:
             value = np.zeros((n, 3))
             k = np.flatnonzero(shown)
@@ -333,91 +331,6 @@ class Lights:
                 value[k] = self.environment.radiance(dirs[k])
             return value
         return np.where(shown[:, None], self.world_constant, 0.0)
-
-
-# -- the world ------------------------------------------------------------------------------------
-@kernel(inline="always")
-def cosine_direction(nx, ny, nz, u0, u1):
-    """A cosine-weighted direction about n (concentric disk lifted to the hemisphere)."""
-    a, b = concentric_disk(u0, u1)
-    z = math.sqrt(max(1.0 - (a * a + b * b), 0.0))
-    t0, t1, t2, b0, b1, b2 = basis(nx, ny, nz)
-    return a * t0 + b * b0 + z * nx, a * t1 + b * b1 + z * ny, a * t2 + b * b2 + z * nz, z
-
-
-@kernel(inline="always")
-def world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area):
-    """Density of world sampling: the map's share of its table density, the rest cosine."""
-    cosine = max(nx * dx + ny * dy + nz * dz, 0.0) / math.pi
-    if share <= 0:
-        return cosine
-    return share * map_pdf(cell, cell_area, dx, dy, dz) + (1.0 - share) * cosine
-
-
-@kernel(inline="always")
-def sample_world_direction(nx, ny, nz, u0, u1, share, row_cdf, col_cdf, cell, cell_area):
-    """(dx, dy, dz, pdf): from the map with probability ``share`` (the first sample coordinate
-    split), else cosine-weighted about n."""
-    if u0 < share:
-        dx, dy, dz = map_direction(row_cdf, col_cdf, min(max(u0 / share, 0.0), 1.0 - 1e-12),
-                                   min(max(u1, 0.0), 1.0 - 1e-12))
-    else:
-        c0 = min(max((u0 - share) / (1.0 - share), 0.0), 1.0 - 1e-12)
-        dx, dy, dz, _ = cosine_direction(nx, ny, nz, c0, min(max(u1, 0.0), 1.0 - 1e-12))
-    return dx, dy, dz, world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area)
-
-
-@kernel
-def _sample_uniform_world_batch(normal, u, radiance):
-    n = len(u)
-    wi, value, pdf = np.empty((n, 3)), np.zeros((n, 3)), np.empty(n)
-    for j in range(n):
-        wx, wy, wz, z = cosine_direction(normal[j, 0], normal[j, 1], normal[j, 2], u[j, 0], u[j, 1])
-        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
-        pdf[j] = z / math.pi
-        if pdf[j] > 0:
-            s = 1.0 / max(pdf[j], TINY)
-            value[j, 0], value[j, 1], value[j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
-    return wi, value, pdf
-
-
-@kernel
-def _sample_map_world_batch(normal, u, share, row_cdf, col_cdf, cell, cell_area):
-    """Directions and densities; ``lit`` marks those above the normal with density > 0 (the
-    caller evaluates the map's radiance there)."""
-    n = len(u)
-    wi, pdf, lit = np.empty((n, 3)), np.empty(n), np.zeros(n, np.bool_)
-    for j in range(n):
-        nx, ny, nz = normal[j, 0], normal[j, 1], normal[j, 2]
-        dx, dy, dz, p = sample_world_direction(nx, ny, nz, u[j, 0], u[j, 1], share, row_cdf, col_cdf, cell,
-                                               cell_area)
-        wi[j, 0], wi[j, 1], wi[j, 2], pdf[j] = dx, dy, dz, p
-        lit[j] = nx * dx + ny * dy + nz * dz > 0 and p > 0
-    return wi, pdf, lit
-
-
-@kernel
-def _pdf_world_batch(normal, dirs, share, cell, cell_area):
-    out = np.empty(len(dirs))
-    for j in range(len(dirs)):
-        out[j] = world_pdf(normal[j, 0], normal[j, 1], normal[j, 2], dirs[j, 0], dirs[j, 1], dirs[j, 2], share,
-                           cell, cell_area)
-    return out
-
-
-@kernel
-def _world_shown_batch(dirs, straight, normal, camera, glossy, transmission):
-    """Whether the world is seen along each ray: by the camera, or through reflection
-    (d on the normal's side) or refraction, as its ray visibility says."""
-    out = np.empty(len(dirs), np.bool_)
-    for j in range(len(dirs)):
-        if straight[j]:
-            out[j] = camera
-        elif dirs[j, 0] * normal[j, 0] + dirs[j, 1] * normal[j, 1] + dirs[j, 2] * normal[j, 2] >= 0:
-            out[j] = glossy
-        else:
-            out[j] = transmission
-    return out
 
 
 # -- lights of the table ------------------------------------------------------------------------------
