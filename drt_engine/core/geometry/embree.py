@@ -69,6 +69,7 @@ _SIGNATURES = {  # name: (result, arguments), from include/embree4/rtcore_*.h of
     "rtcSetDeviceErrorFunction": (None, [_p, _ERROR_FUNCTION, _p]),
     "rtcNewScene": (_p, [_p]),
     "rtcReleaseScene": (None, [_p]),
+    "rtcSetSceneFlags": (None, [_p, _i]),
     "rtcCommitScene": (None, [_p]),
     "rtcNewGeometry": (_p, [_p, _i]),
     "rtcReleaseGeometry": (None, [_p]),
@@ -98,6 +99,7 @@ _occluded1 = types.ExternalFunction("drt_rtcOccluded1", _RAY_QUERY)
 _GEOMETRY_TRIANGLE, _GEOMETRY_INSTANCE = 0, 121
 _BUFFER_INDEX, _BUFFER_VERTEX = 0, 1
 _FORMAT_UINT3, _FORMAT_FLOAT3, _FORMAT_FLOAT3X4_ROW_MAJOR = 0x5003, 0x9003, 0x9134
+_SCENE_FLAG_ROBUST = 1 << 2
 _ERROR_NAMES = {1: "unknown error", 2: "invalid argument", 3: "invalid operation",
                 4: "out of memory", 5: "unsupported CPU", 6: "cancelled"}
 MAX_TIME_STEPS = 129  # RTC_MAX_TIME_STEP_COUNT
@@ -118,7 +120,8 @@ class Device:
         _lib.rtcSetDeviceErrorFunction(self.handle, self._callback, None)
 
     def _record(self, _user, code, message):
-        self.errors.append(f"{_ERROR_NAMES.get(code, code)}: {(message or b'').decode(errors='replace')}")
+        name, text = _ERROR_NAMES.get(code, f"error {code}"), (message or b"").decode(errors="replace")
+        self.errors.append(name if text in ("", name) else f"{name}: {text}")
 
     def check(self, doing: str) -> None:
         """Raise ``EmbreeError`` for the errors Embree reported since the last check."""
@@ -143,11 +146,15 @@ def device() -> Device:
 class _Scene:
     """An Embree scene this object owns with the NumPy buffers Embree reads from it, released by
     ``close()``, at the end of a ``with`` block, or when the object is collected. ``handle`` is
-    the ``RTCScene`` as an integer, what kernels take."""
+    the ``RTCScene`` as an integer, what kernels take.
+
+    Scenes are built robust (watertight, no rays slipping between triangles), as embreex builds
+    its own: hits are then bit-identical to embreex's (tests/core/test_embree.py)."""
 
     def __init__(self):
         self.device = device()
         self.handle = _lib.rtcNewScene(self.device.handle)
+        _lib.rtcSetSceneFlags(self.handle, _SCENE_FLAG_ROBUST)
         self.device.check("creating a scene")
         self._keep: list = []  # buffers and scenes Embree reads while this scene lives
         self._release = weakref.finalize(self, _lib.rtcReleaseScene, self.handle)
@@ -156,6 +163,7 @@ class _Scene:
         _lib.rtcCommitGeometry(geometry)
         geom_id = _lib.rtcAttachGeometry(self.handle, geometry)
         _lib.rtcReleaseGeometry(geometry)  # the scene holds its own reference
+        self.device.check("adding a geometry")
         return geom_id
 
     def commit(self) -> None:
@@ -224,8 +232,12 @@ class InstanceScene(_Scene):
 
     def add(self, scene: TriangleScene, transforms) -> int:
         geometry = _lib.rtcNewGeometry(self.device.handle, _GEOMETRY_INSTANCE)
-        _lib.rtcSetGeometryInstancedScene(geometry, scene.handle)
-        self._set_transforms(geometry, transforms)
+        try:
+            _lib.rtcSetGeometryInstancedScene(geometry, scene.handle)
+            self._set_transforms(geometry, transforms)  # checks for errors
+        except DRTError:
+            _lib.rtcReleaseGeometry(geometry)
+            raise
         self._keep.append(scene)  # its vertex buffers must outlive this scene's use of them
         self._instances.append(geometry)
         return self._attach(geometry)
@@ -242,7 +254,7 @@ class InstanceScene(_Scene):
         _lib.rtcSetGeometryTimeStepCount(geometry, len(steps))
         for step, matrix in enumerate(steps):
             _lib.rtcSetGeometryTransform(geometry, step, _FORMAT_FLOAT3X4_ROW_MAJOR, matrix.ctypes.data)
-        self.device.check("setting an instance's transform")
+        self.device.check("placing an instance")
 
 
 # --- ray queries in kernels ---------------------------------------------------------------------------
