@@ -95,6 +95,11 @@ def test_tnear_and_tfar_bound_the_ray():
     np.testing.assert_array_equal(blocked, np.arange(1000) % 2 == 1)
 
 
+def test_bad_triangles_are_refused_before_embree_reads_them():
+    with pytest.raises(DRTError, match="vertex 3 of 3"):
+        embree.TriangleScene(np.zeros((3, 3)), [[0, 1, 3]])
+
+
 def test_rayhit_scratch_is_16_byte_aligned():
     assert all(embree.new_rayhit().ctypes.data % 16 == 0 for _ in range(64))
 
@@ -136,7 +141,7 @@ def test_instances_hit_like_the_mesh_transformed_by_hand():
     np.testing.assert_allclose(ours["Ng"][hit], object_ng, rtol=1e-4, atol=1e-7)
 
 
-def test_moving_one_instance_rebuilds_only_the_top_level():
+def test_moving_an_instance_moves_its_hits_once_the_top_level_is_committed():
     vertices, triangles = _sphere()
     origins, directions = np.array([[5.0, 0, 3]]), np.array([[0.0, 0, -1]])
     with embree.TriangleScene(vertices, triangles) as mesh, embree.InstanceScene() as top:

@@ -203,6 +203,8 @@ class TriangleScene(_Scene):
         if indices.ndim != 2 or indices.shape[1] != 3:
             raise DRTError(f"triangles must be (T, 3), got {indices.shape}")
         steps = _time_steps(vertices, 2)
+        if len(indices) and indices.max() >= steps.shape[1]:  # Embree would read past the buffer
+            raise DRTError(f"a triangle refers to vertex {indices.max()} of {steps.shape[1]}")
         geometry = _lib.rtcNewGeometry(self.device.handle, _GEOMETRY_TRIANGLE)
         _lib.rtcSetGeometryTimeStepCount(geometry, len(steps))
         for step, points in enumerate(steps):
