@@ -170,6 +170,27 @@ def test_motion_time_steps_interpolate(time):
                                        atol=1e-5)
 
 
+@pytest.mark.parametrize("time", [0.25, 0.5, 0.8])
+@pytest.mark.parametrize("mirror", [False, True])
+def test_a_spinning_instance_turns_by_slerp_and_keeps_its_size(time, mirror):
+    """A wall 2 from the z axis turning a quarter turn about it (scaled by 1.5 along z, mirrored in
+    z or not, moving up by 1) is met at distance 2 along the direction it faces at ``time``: the
+    rotation is slerped and the stretch and translation lerped, as geometry/motion.py does.
+    Interpolated matrices would put it at 2 cos(45 deg) halfway."""
+    wall = np.array([[2, -1, -1], [2, 1, -1], [2, 1, 1], [2, -1, 1]], np.float32)
+    quads = np.array([[0, 1, 2], [0, 2, 3]])
+    steps = np.array([_transform(angle, 1.0, (0, 0, lift)) for angle, lift in ((0, 0), (np.pi / 2, 1))])
+    steps[:, 2, 2] = -1.5 if mirror else 1.5
+    angle = time * np.pi / 2
+    direction = np.array([[np.cos(angle), np.sin(angle), 0.0]])
+    with embree.TriangleScene(wall, quads) as mesh, embree.InstanceScene() as top:
+        top.add(mesh, steps)
+        top.commit()
+        hit = embree.intersect(top, [[0, 0, time]], direction, time=time)
+    assert hit["instID"][0] == 0
+    np.testing.assert_allclose(hit["t"], 2.0, rtol=1e-5)
+
+
 def test_error_callback_reports_and_the_device_keeps_working():
     """Instancing a closed scene passes Embree a NULL scene: the callback records Embree's message,
     the call raises it, and the device goes on tracing."""

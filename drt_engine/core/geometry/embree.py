@@ -30,6 +30,7 @@ from numba import types
 
 from ..base.jit import kernel
 from ..errors import DRTError
+from .motion import quaternions
 
 
 class EmbreeError(DRTError):
@@ -79,6 +80,7 @@ _SIGNATURES = {  # name: (result, arguments), from include/embree4/rtcore_*.h of
     "rtcSetSharedGeometryBuffer": (None, [_p, _i, _u, _i, _p, _s, _s, _s]),
     "rtcSetGeometryInstancedScene": (None, [_p, _p]),
     "rtcSetGeometryTransform": (None, [_p, _u, _i, _p]),
+    "rtcSetGeometryTransformQuaternion": (None, [_p, _u, _p]),
     "rtcIntersect1": (None, [_p, _p, _p]),
     "rtcOccluded1": (None, [_p, _p, _p]),
 }
@@ -222,9 +224,13 @@ class TriangleScene(_Scene):
 
 class InstanceScene(_Scene):
     """A top-level scene of instances: each places a ``TriangleScene`` by an affine 4x4 (or 3x4)
-    matrix, or by (S, 4, 4) matrices for S time steps over ray times [0, 1] (rigid motion,
-    interpolated linearly by Embree). A hit through an instance reports the mesh scene's geomID
-    and primID, its object-space Ng, and the instance's id (the order of ``add``) as instID.
+    matrix, or by (S, 4, 4) matrices for S time steps over ray times [0, 1] (rigid motion). A hit
+    through an instance reports the mesh scene's geomID and primID, its object-space Ng, and the
+    instance's id (the order of ``add``) as instID.
+
+    Moving instances go to Embree as quaternion decompositions, which it interpolates as
+    DRT's motion does (geometry/motion.py): rotation by slerp, translation and the rest
+    linearly, so a spinning object keeps its size; interpolated matrices would shrink it.
 
     Call ``commit()`` after adding or moving instances and before tracing."""
 
@@ -251,12 +257,33 @@ class InstanceScene(_Scene):
         _lib.rtcCommitGeometry(geometry)
 
     def _set_transforms(self, geometry, transforms) -> None:
-        rows = np.asarray(transforms)[..., :3, :4]  # RTC_FORMAT_FLOAT3X4_ROW_MAJOR: the top 3 rows of a 4x4
-        steps = np.ascontiguousarray(_time_steps(rows, 2))
+        steps = _time_steps(np.asarray(transforms)[..., :3, :4], 2)
         _lib.rtcSetGeometryTimeStepCount(geometry, len(steps))
-        for step, matrix in enumerate(steps):
-            _lib.rtcSetGeometryTransform(geometry, step, _FORMAT_FLOAT3X4_ROW_MAJOR, matrix.ctypes.data)
+        if len(steps) == 1:  # RTC_FORMAT_FLOAT3X4_ROW_MAJOR: the top 3 rows of a 4x4, as given
+            _lib.rtcSetGeometryTransform(geometry, 0, _FORMAT_FLOAT3X4_ROW_MAJOR, steps[0].ctypes.data)
+        else:
+            for step, decomposition in enumerate(_quaternion_decompositions(steps)):
+                _lib.rtcSetGeometryTransformQuaternion(geometry, step, decomposition.ctypes.data)
         self.device.check("placing an instance")
+
+
+def _quaternion_decompositions(steps: np.ndarray) -> np.ndarray:
+    """(S, 3, 4) affine steps as (S, 16) RTCQuaternionDecomposition records (rtcore_quaternion.h:
+    scale xyz, skew xy xz yz, shift xyz, quaternion r i j k, translation xyz; Embree's transform is
+    translation @ rotation @ upper-triangular scale/skew). The linear part is split by QR into a
+    proper rotation and an upper-triangular factor (a mirror stays in its last diagonal entry)."""
+    rotation, upper = np.linalg.qr(steps[:, :, :3].astype(np.float64))
+    sign = np.where(np.diagonal(upper, axis1=1, axis2=2) < 0, -1.0, 1.0)
+    rotation, upper = rotation * sign[:, None, :], upper * sign[:, :, None]
+    mirror = np.linalg.det(rotation) < 0
+    rotation[mirror, :, 2] *= -1
+    upper[mirror, 2, :] *= -1
+    records = np.zeros((len(steps), 16), dtype=np.float32)  # RTC_ALIGN(16): NumPy's buffers are, rows 64 bytes apart
+    records[:, 0:3] = np.diagonal(upper, axis1=1, axis2=2)
+    records[:, 3:6] = np.stack([upper[:, 0, 1], upper[:, 0, 2], upper[:, 1, 2]], axis=1)
+    records[:, 9:13] = quaternions(rotation)
+    records[:, 13:16] = steps[:, :, 3]
+    return records
 
 
 # --- ray queries in kernels ---------------------------------------------------------------------------
