@@ -15,7 +15,9 @@ Embree is therefore required (a kernel module imports it, so that holds by const
 
 Verified against embreex 4.4 (tests/core/test_embree.py): an ``RTCRayHit`` is 96 bytes,
 16-byte aligned, 24 four-byte words (``RAY_*``/``HIT_*`` below); a miss leaves geomID at
-``INVALID``; an occluded ray comes back with tfar = -inf; the arguments pointer may be NULL.
+``INVALID``; an occluded ray comes back with tfar = -inf; the arguments pointer may be NULL
+(default arguments). Per ray this costs what embreex's own batch call does
+(bench/embree_binding.py).
 """
 from __future__ import annotations
 
@@ -288,8 +290,8 @@ def _quaternion_decompositions(steps: np.ndarray) -> np.ndarray:
 
 # --- ray queries in kernels ---------------------------------------------------------------------------
 
-INVALID = np.uint32(0xFFFFFFFF)  # RTC_INVALID_GEOMETRY_ID
-# Word offsets in an RTCRayHit (float32 or uint32 words): RTCRay then RTCHit, each 48 bytes.
+INVALID = -1  # RTC_INVALID_GEOMETRY_ID, 0xFFFFFFFF, as an int32 word
+# Word offsets in an RTCRayHit: RTCRay then RTCHit, 48 bytes each.
 RAY_ORG, RAY_TNEAR, RAY_DIR, RAY_TIME, RAY_TFAR, RAY_MASK, RAY_ID, RAY_FLAGS = 0, 3, 4, 7, 8, 9, 10, 11
 HIT_NG, HIT_U, HIT_V, HIT_PRIM, HIT_GEOM, HIT_INST = 12, 15, 16, 17, 18, 19
 RAYHIT_WORDS = 24
@@ -297,45 +299,46 @@ RAYHIT_WORDS = 24
 
 @kernel
 def new_rayhit():
-    """A 16-byte aligned scratch RTCRayHit as 24 float32 words (one per thread, reused per ray)."""
+    """A scratch RTCRayHit, 16-byte aligned, as the pair (float32 words, int32 words) over the same
+    96 bytes; one per thread, reused for every ray (views made per ray would cost ~20% of a query)."""
     room = np.empty(RAYHIT_WORDS + 4, dtype=np.float32)
     start = ((16 - room.ctypes.data % 16) % 16) // 4
-    return room[start:start + RAYHIT_WORDS]
+    floats = room[start:start + RAYHIT_WORDS]
+    return floats, floats.view(np.int32)
 
 
 @kernel
 def _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
-    words = rayhit.view(np.uint32)
-    rayhit[RAY_ORG], rayhit[RAY_ORG + 1], rayhit[RAY_ORG + 2] = ox, oy, oz
-    rayhit[RAY_DIR], rayhit[RAY_DIR + 1], rayhit[RAY_DIR + 2] = dx, dy, dz
-    rayhit[RAY_TNEAR], rayhit[RAY_TFAR], rayhit[RAY_TIME] = tnear, tfar, time
-    words[RAY_MASK] = INVALID  # every mask bit: geometries keep Embree's default mask
-    words[RAY_ID] = 0
-    words[RAY_FLAGS] = 0
+    f, w = rayhit
+    f[RAY_ORG], f[RAY_ORG + 1], f[RAY_ORG + 2], f[RAY_TNEAR] = ox, oy, oz, tnear
+    f[RAY_DIR], f[RAY_DIR + 1], f[RAY_DIR + 2], f[RAY_TIME] = dx, dy, dz, time
+    f[RAY_TFAR] = tfar
+    w[RAY_MASK] = -1  # every mask bit: geometries keep Embree's default mask
+    w[RAY_ID] = 0
+    w[RAY_FLAGS] = 0
 
 
 @kernel
 def intersect1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
     """The closest hit of one ray in (tnear, tfar) at ``time``: (t, u, v, Ng x, y, z, primID,
-    geomID, instID), ids as int32 with -1 for none; t is inf on a miss."""
+    geomID, instID), ids -1 for none; t is inf on a miss. ``rayhit`` from ``new_rayhit``."""
+    f, w = rayhit
     _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time)
-    words = rayhit.view(np.uint32)
-    words[HIT_GEOM] = INVALID
-    words[HIT_INST] = INVALID
-    _intersect1(scene, rayhit.ctypes.data, 0)
-    ids = rayhit.view(np.int32)
-    if ids[HIT_GEOM] == -1:
+    w[HIT_GEOM] = INVALID
+    w[HIT_INST] = INVALID
+    _intersect1(scene, f.ctypes.data, 0)
+    if w[HIT_GEOM] == INVALID:
         return np.inf, 0.0, 0.0, 0.0, 0.0, 0.0, -1, -1, -1
-    return (rayhit[RAY_TFAR], rayhit[HIT_U], rayhit[HIT_V], rayhit[HIT_NG], rayhit[HIT_NG + 1], rayhit[HIT_NG + 2],
-            ids[HIT_PRIM], ids[HIT_GEOM], ids[HIT_INST])
+    return (f[RAY_TFAR], f[HIT_U], f[HIT_V], f[HIT_NG], f[HIT_NG + 1], f[HIT_NG + 2],
+            w[HIT_PRIM], w[HIT_GEOM], w[HIT_INST])
 
 
 @kernel
 def occluded1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
     """Whether anything lies on the ray in (tnear, tfar) at ``time`` (Embree sets tfar to -inf)."""
     _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time)
-    _occluded1(scene, rayhit.ctypes.data, 0)
-    return rayhit[RAY_TFAR] == -np.inf
+    _occluded1(scene, rayhit[0].ctypes.data, 0)
+    return rayhit[0][RAY_TFAR] == -np.inf
 
 
 @kernel
@@ -380,5 +383,6 @@ def occluded(scene: _Scene, origins, directions, tnear=0.0, tfar=np.inf, time=0.
 def _rays(origins, directions, tnear, tfar, time):
     origins = np.ascontiguousarray(origins, dtype=np.float32)
     n = len(origins)
-    per_ray = (np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=np.float32), (n,))) for x in (tnear, tfar, time))
+    per_ray = (np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=np.float32), (n,)))
+               for x in (tnear, tfar, time))
     return (origins, np.ascontiguousarray(directions, dtype=np.float32), *per_ray)
