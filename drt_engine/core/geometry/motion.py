@@ -37,6 +37,16 @@ def _quat_from_matrix(r: np.ndarray) -> np.ndarray:
     return out / np.linalg.norm(out, axis=1, keepdims=True)
 
 
+def quaternions(rotations: np.ndarray) -> np.ndarray:
+    """(S, 3, 3) proper rotations to (S, 4) unit quaternions (w, x, y, z), each on the shorter arc
+    from the one before: what slerp between consecutive steps needs."""
+    q = _quat_from_matrix(rotations)
+    for k in range(1, len(q)):
+        if np.dot(q[k], q[k - 1]) < 0:
+            q[k] = -q[k]
+    return q
+
+
 def _polar(m3: np.ndarray):
     """m3 = R @ P with R a proper rotation and P symmetric (it carries any mirroring)."""
     u, s, vt = np.linalg.svd(m3)
@@ -57,11 +67,7 @@ class Motion:
         self.translation = matrices[:, :3, 3]
         self.linear = matrices[:, :3, :3]
         rotation, self.stretch = _polar(self.linear)
-        q = _quat_from_matrix(rotation)
-        for k in range(1, len(q)):  # shortest arcs between steps
-            if np.dot(q[k], q[k - 1]) < 0:
-                q[k] = -q[k]
-        self.quat = q
+        self.quat = quaternions(rotation)
         self.moving = self.steps > 1 and not np.allclose(matrices, matrices[:1], rtol=0, atol=1e-12)
 
     @property
