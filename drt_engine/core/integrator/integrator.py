@@ -24,36 +24,13 @@ from ..geometry import camera as camera_rays
 from ..geometry.accel import spawn
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
+from .mis import add_emitted, power_heuristic
 from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"))
-
-
-def _power(a, b):
-    """Power heuristic weight of strategy a against b (densities per solid angle)."""
-    a2 = np.where(np.isinf(a), 1.0, a * a)
-    b2 = np.where(np.isinf(a), 0.0, b * b)
-    return a2 / np.maximum(a2 + b2, TINY)
-
-
-def _add_emitted(out: "WaveOutput", path, throughput, emitted, prev_pdf, light_pdf):
-    """Emission a BSDF-sampled ray found, any emitter: weighted by the power heuristic against
-    light sampling where both could have produced the direction (``light_pdf(rows)``, the
-    light-sampling density of those rows' directions; None if light sampling never picks this
-    emitter; camera rays and delta lobes, prev_pdf = inf, take it whole). Adds it to the wave's
-    radiance and denoising features and returns throughput x weighted emission."""
-    weight = np.ones(len(path))
-    smooth = np.flatnonzero(~np.isinf(prev_pdf))
-    if len(smooth) and light_pdf is not None:
-        weight[smooth] = _power(prev_pdf[smooth], light_pdf(smooth))
-    e = throughput * emitted * weight[:, None]
-    out.radiance[path] += e
-    if out.features is not None:
-        out.features.emitted(path, emitted * weight[:, None])
-    return e
 
 
 @dataclass
@@ -219,7 +196,7 @@ class Integrator:
                 pl[sel] = self.lights.pdf(li, rays.origins[k], rays.dirs[k], t[k], rays.time[k])
             return pl
 
-        _add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
+        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
         if self.film_transparent:
             direct = rays.straight
             out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
@@ -240,11 +217,11 @@ class Integrator:
         if len(rays) and lights.world_seen:
             sampled = None if lights.world is None else (  # a world light sampling can find
                 lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
-            _add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled)
+            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled)
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
-            _add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
+            add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
 
     def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
@@ -271,7 +248,7 @@ class Integrator:
         prim = surf.prim[glowing]
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing])
-        e = _add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
+        e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
                          lambda smooth: self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]],
                                                                  hits.t[hit[smooth]]))
         if "Emit" in out.aux:
@@ -376,7 +353,7 @@ class Integrator:
             above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
             f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
-            w_l = _power(ls.pdf, f.pdf)
+            w_l = power_heuristic(ls.pdf, f.pdf)
             contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
             ok &= vec.max3(contrib) > 0
             sel = np.flatnonzero(ok)

@@ -1,0 +1,33 @@
+"""Multiple importance sampling: the power heuristic, and the one path by which emission that a
+BSDF-sampled ray finds reaches the image, whatever the emitter (lights hit, the world, suns,
+emissive triangles), as Mitsuba's path integrator has it."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..base.constants import TINY
+
+
+def power_heuristic(a, b):
+    """Power heuristic weight of strategy a against b (densities per solid angle)."""
+    a2 = np.where(np.isinf(a), 1.0, a * a)
+    b2 = np.where(np.isinf(a), 0.0, b * b)
+    return a2 / np.maximum(a2 + b2, TINY)
+
+
+def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf):
+    """Emission a BSDF-sampled ray found, any emitter: weighted by the power heuristic against
+    light sampling where both could have produced the direction (``light_pdf(rows)``, the
+    light-sampling density of those rows' directions; None if light sampling never picks this
+    emitter; camera rays and delta lobes, prev_pdf = inf, take it whole). Adds it to the wave's
+    radiance and denoising features (``out``, the wave's WaveOutput) and returns throughput x
+    weighted emission."""
+    weight = np.ones(len(path))
+    smooth = np.flatnonzero(~np.isinf(prev_pdf))
+    if len(smooth) and light_pdf is not None:
+        weight[smooth] = power_heuristic(prev_pdf[smooth], light_pdf(smooth))
+    e = throughput * emitted * weight[:, None]
+    out.radiance[path] += e
+    if out.features is not None:
+        out.features.emitted(path, emitted * weight[:, None])
+    return e
