@@ -22,6 +22,8 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "viewport-times": DOCS / "viewport.md",
     "denoise": DOCS / "denoising.md",
 }
+RESULTS_THROUGHPUT = ("<!-- throughput: begin -->", "<!-- throughput: end -->")
+"""bench/throughput.py's section of bench/RESULTS.md, which bench/run.py keeps when it rewrites the file."""
 
 
 def replace_between(path: Path, begin: str, end: str, text: str) -> None:

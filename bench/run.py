@@ -49,7 +49,7 @@ from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.render.report import plot_loglog  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
-from blocks import write_block  # noqa: E402
+from blocks import RESULTS_THROUGHPUT, write_block  # noqa: E402
 from scenes import SCENES, load, settings  # noqa: E402
 
 from tests.support.render_helpers import configure_cycles, read_channels  # noqa: E402  (the tests' Cycles set-up and EXR reader)
@@ -298,11 +298,10 @@ def adaptive_block(results, width, ref_samples, cap) -> str:
 
 def publish_table(text):
     """Write bench/RESULTS.md, keeping bench/throughput.py's section of it."""
-    from bench.throughput import MARK_BEGIN, MARK_END
-
     path = ROOT / "bench" / "RESULTS.md"
     old = path.read_text() if path.exists() else ""
-    kept = re.search(re.escape(MARK_BEGIN) + ".*?" + re.escape(MARK_END) + "\n?", old, re.S)
+    begin, end = RESULTS_THROUGHPUT
+    kept = re.search(re.escape(begin) + ".*?" + re.escape(end) + "\n?", old, re.S)
     path.write_text(text + ("\n" + kept.group(0) if kept else ""))
 
 
