@@ -2,6 +2,7 @@
 library: the RTCRayHit layout, closest hits and occlusion, tnear/tfar, instances, motion time steps,
 the error callback, the rule that finds the library in each wheel, and kernels loaded from the disk
 cache in a fresh process."""
+import ctypes
 import gc
 import os
 import subprocess
@@ -271,12 +272,23 @@ def test_missing_library_is_a_one_line_error(tmp_path):
 
 
 def test_the_installed_library_is_the_copy_embreex_uses():
+    """The kernels' rtcIntersect1 is the one in embreex's file, also in a process where Blender has
+    mapped its own libembree4 (bpy imported by other tests of the suite, or inside Blender)."""
     import embreex
+    from llvmlite import binding as llvm
+
     path = embree.library_path(Path(embreex.__file__).parent)
     assert path.name.startswith("libembree4") and path.is_file()
+    address = llvm.address_of_symbol("drt_rtcIntersect1")
+    assert address == ctypes.cast(embree._lib.rtcIntersect1, ctypes.c_void_p).value
     if sys.platform.startswith("linux"):
-        mapped = {line.split()[-1] for line in Path("/proc/self/maps").read_text().splitlines() if "embree4" in line}
-        assert mapped == {str(path)}
+        holders = set()
+        for line in Path("/proc/self/maps").read_text().splitlines():
+            fields = line.split()
+            low, high = (int(x, 16) for x in fields[0].split("-"))
+            if low <= address < high:
+                holders.add(fields[-1])
+        assert holders == {str(path)}
 
 
 _CACHED_RUN = """
