@@ -304,7 +304,8 @@ print(sum(sum(s.cache_hits.values()) for s in stats), sum(sum(s.cache_misses.val
 
 
 def test_kernels_load_from_the_disk_cache_in_a_fresh_process(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=str(ROOT))
+    path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))  # keep the caller's (Blender's site-packages)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=path)
 
     def run():
         out = subprocess.run([sys.executable, "-c", textwrap.dedent(_CACHED_RUN)], env=env, cwd=ROOT,

@@ -53,7 +53,8 @@ def _run(cache: Path) -> int:
     """Run KERNEL in a fresh process with ``cache`` as the cache's base; how often it loaded from it."""
     script = cache.parent / "kernel_script.py"
     script.write_text(KERNEL)
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
+    path = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))  # keep the caller's (Blender's site-packages)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=path)
     done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, cwd=str(ROOT))
     assert done.returncode == 0, done.stderr
     return int(done.stdout.split()[-1])
