@@ -29,14 +29,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DenoiserError
+from ..settings import DENOISING_PREFILTERS as PREFILTERS
 
 DEVICE_TYPE_CPU = 1
 FORMAT_FLOAT3 = 3
 ERROR_NONE = 0
 QUALITIES = {"FAST": 4, "BALANCED": 5, "HIGH": 6}
-"""Cycles' ``denoising_quality`` names and OIDN's OIDNQuality values."""
-PREFILTERS = ("NONE", "FAST", "ACCURATE")
-"""Cycles' ``denoising_prefilter`` names."""
+"""Cycles' ``denoising_quality`` names (settings.DENOISING_QUALITIES) and OIDN's OIDNQuality values."""
 
 _SIGNATURES = {
     "oidnNewDevice": (ctypes.c_void_p, [ctypes.c_int]),

@@ -7,6 +7,7 @@ adaptive.replicate_samplers), so the film's two halves are independent estimates
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -14,16 +15,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..base import jit
-from ..errors import SceneError
+from ..errors import SceneError, SettingsError
+from ..film.denoising import PASSES as FEATURE_PASSES
 from ..film.film import Film
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import RenderSettings
+from ..settings import NOISY_IMAGE, RenderSettings
 from ..validate import validate_camera
 from . import adaptive
+from .denoise import denoise_film
 from .driver import WAVE, ProgressUpdate, drive
 from .prepared import PreparedScene
 
@@ -45,10 +48,13 @@ class Renderer:
     """Renders one SceneData with one RenderSettings.
 
     ``prepared`` (core.render.prepared.PreparedScene) reuses the Embree scenes, lights and materials
-    built for the same scene with another camera; without it they are built here.
+    built for the same scene with another camera; without it they are built here. ``denoiser``
+    (core.film.denoiser.Denoiser) is the OpenImageDenoise that ``use_denoising`` runs; the caller
+    finds the library (the core never looks for one).
     """
 
-    def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None):
+    def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None,
+                 denoiser=None):
         if scene.camera is None:
             raise SceneError("the scene has no camera")
         if prepared is None:
@@ -59,6 +65,13 @@ class Renderer:
             validate_camera(scene.camera)
         self.prepared = prepared
         self.scene, self.settings, self.camera = scene, settings, scene.camera
+        self.denoiser = denoiser
+        self.denoising = settings.use_denoising and not settings.partial
+        if self.denoising and denoiser is None:
+            raise SettingsError("denoising is on but no OpenImageDenoise library was found")
+        if self.denoising:  # the features guide the denoiser: traced even when not asked for as passes
+            settings = dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
+                name for name in FEATURE_PASSES if name not in settings.passes))
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
@@ -146,5 +159,29 @@ class Renderer:
                  "adaptive_threshold": outcome.threshold if s.use_adaptive_sampling else None,
                  "adaptive_first_test": outcome.first if s.use_adaptive_sampling else None,
                  "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
-        return RenderResult(film.images(), stats, outcome.stopped == "cancelled", list(self.warnings),
-                            outcome.log.entries)
+        passes = film.images()
+        warnings = list(self.warnings)
+        if s.use_denoising and s.partial:
+            warnings.append("this render is one range of the samples (a farm part): it is not denoised; "
+                            "denoise the merged image")
+        if self.denoising and outcome.stopped != "cancelled":
+            passes = self._denoise(passes, stats, outcome.log.last)
+        return RenderResult(passes, stats, outcome.stopped == "cancelled", warnings, outcome.log.entries)
+
+    def _denoise(self, passes: dict, stats: dict, last: dict | None) -> dict:
+        """Combined denoised (alpha as rendered), the rendered one kept as Noisy Image, features
+        the user did not ask for dropped; the denoised image's estimated error in ``stats`` and
+        the log's last entry, beside the noisy image's (core.render.denoise)."""
+        s = self.settings
+        denoised = denoise_film(self.film, passes, self.denoiser, s.denoising_prefilter, s.denoising_quality)
+        noisy = passes["Combined"]
+        combined = noisy.copy()
+        combined[..., :3] = denoised.rgb
+        out = {name: image for name, image in passes.items() if name in s.passes}
+        out["Combined"], out[NOISY_IMAGE] = combined, noisy
+        stats.update(rmse_denoised=denoised.rmse, relmse_denoised=denoised.relmse,
+                     denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
+                                "seconds": denoised.seconds})
+        if last is not None:
+            last.update(rmse_denoised=denoised.rmse, relmse_denoised=denoised.relmse)
+        return out
