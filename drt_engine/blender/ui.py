@@ -6,6 +6,8 @@ class name and missing ones are skipped: names move between Blender 4.2 and 5.0.
 """
 import bpy
 
+from .oidn import unavailable_reason
+
 ENGINE = "DRT"
 
 SHARED_PANELS = (
@@ -123,6 +125,29 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
         col.prop(drt, "adaptive_min_samples")
 
 
+class DRT_PT_sampling_denoise(DRTButtonsPanel, bpy.types.Panel):
+    """Cycles' Render > Sampling > Denoise: greyed, with the reason, where Blender has no OIDN."""
+    bl_label = "Denoise"
+    bl_parent_id = "DRT_PT_sampling"
+
+    def draw_header(self, context):
+        row = self.layout.row()
+        row.enabled = unavailable_reason() is None
+        row.prop(context.scene.drt, "use_denoising", text="")
+
+    def draw(self, context):
+        layout = split(self.layout)
+        drt = context.scene.drt
+        reason = unavailable_reason()
+        col = layout.column()
+        col.enabled = reason is None
+        col.active = drt.use_denoising
+        col.prop(drt, "denoising_prefilter")
+        col.prop(drt, "denoising_quality")
+        if reason is not None:
+            layout.label(text=reason, icon="INFO")
+
+
 class DRT_PT_sampling_range(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Sample Range"
     bl_parent_id = "DRT_PT_sampling"
@@ -211,6 +236,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
 classes = (
     DRT_PT_sampling,
     DRT_PT_sampling_adaptive,
+    DRT_PT_sampling_denoise,
     DRT_PT_sampling_range,
     DRT_PT_light_paths,
     DRT_PT_film,

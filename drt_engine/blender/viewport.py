@@ -47,10 +47,11 @@ STOP_TIMEOUT = 5.0
 
 
 def viewport_settings(settings, preview_samples: int):
-    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules."""
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, not denoised
+    (``use_denoising`` is for final renders; the viewport's denoising is still to come)."""
     return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
-                               sample_start=0, sample_end=0)
+                               sample_start=0, sample_end=0, use_denoising=False)
 
 
 class ViewportSession:

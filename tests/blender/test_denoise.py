@@ -181,3 +181,124 @@ def test_the_cli_exr_carries_the_passes(bl, tmp_path):
     assert {"Denoising Albedo", "Denoising Normal"} <= bl.passes_in(channels, LAYER)
     np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Denoising Albedo"), 0.5, rtol=1e-5)
     np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Denoising Normal"), 0.0)
+
+
+# -- Denoising built in (scene.drt.use_denoising) ----------------------------------------------
+
+class _Recorder:
+    """Stands in for a UILayout: records what a panel's draw asks of it."""
+
+    def __init__(self, log):
+        self.log = log
+        self.enabled = self.active = True
+
+    def _child(self):
+        child = _Recorder(self.log)
+        self.log.append(child)
+        return child
+
+    row = column = lambda self, **kw: self._child()
+
+    def prop(self, data, name, **kw):
+        self.log.append(("prop", name, self))
+
+    def label(self, text="", **kw):
+        self.log.append(("label", text, self))
+
+
+def _draw(panel, scene, header=False):
+    from types import SimpleNamespace
+
+    log = []
+    fake = SimpleNamespace(layout=_Recorder(log))
+    (panel.draw_header if header else panel.draw)(fake, SimpleNamespace(scene=scene))
+    props = {entry[1]: entry[2] for entry in log if isinstance(entry, tuple) and entry[0] == "prop"}
+    labels = [entry[1] for entry in log if isinstance(entry, tuple) and entry[0] == "label"]
+    return props, labels
+
+
+def test_the_denoise_setting_greys_out_with_the_reason_where_blender_has_no_oidn(drt, monkeypatch):
+    from drt_engine.blender import oidn
+    from drt_engine.blender.ui import DRT_PT_sampling_denoise
+
+    scene = bpy.context.scene
+    assert oidn.oidn_library() is not None  # the bpy 5.0 wheel ships it
+    props, labels = _draw(DRT_PT_sampling_denoise, scene, header=True)
+    assert props["use_denoising"].enabled and not labels
+    monkeypatch.setattr(oidn, "search", lambda: None)  # as in Debian's Blender 4.3.2
+    props, _ = _draw(DRT_PT_sampling_denoise, scene, header=True)
+    assert not props["use_denoising"].enabled
+    props, labels = _draw(DRT_PT_sampling_denoise, scene)
+    assert not props["denoising_prefilter"].enabled and not props["denoising_quality"].enabled
+    assert labels == [oidn.UNAVAILABLE] and "OpenImageDenoise" in labels[0]
+
+
+def _denoise_scene(sample_scene):
+    bpy.ops.wm.open_mainfile(filepath=str(sample_scene("cornell_box")), load_ui=False)
+    scene = bpy.context.scene
+    scene.render.engine = "DRT"
+    set_resolution(scene, 48, 48)
+    drt = scene.drt
+    drt.samples, drt.seed, drt.use_adaptive_sampling, drt.time_limit, drt.target_error = 8, 1, False, 0.0, 0.0
+    return scene
+
+
+def _render_passes(scene, path):
+    from tests.support.render_helpers import read_channels as read
+
+    set_exr_output(scene, path)
+    assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
+    channels = read(path)
+    layer_passes = {key[len(LAYER) + 1:].rsplit(".", 1)[0] for key in channels if key.startswith(LAYER + ".")}
+    return channels, layer_passes
+
+
+def _rgba(channels, name):
+    return np.stack([channels[f"{LAYER}.{name}.{c}"] for c in "RGBA"], axis=-1)
+
+
+def test_a_denoised_render_keeps_the_render_as_noisy_image(drt, sample_scene, tmp_path):
+    from drt_engine.blender.hooks import render_hooks
+    from drt_engine.blender.status import done_line
+
+    scene = _denoise_scene(sample_scene)
+    plain, plain_passes = _render_passes(scene, tmp_path / "plain.exr")
+    assert "Noisy Image" not in plain_passes
+    scene.drt.use_denoising = True
+    denoised, passes = _render_passes(scene, tmp_path / "denoised.exr")
+    assert passes == {"Combined", "Noisy Image"}  # the features guide OIDN but are not written
+    np.testing.assert_array_equal(_rgba(denoised, "Noisy Image"), _rgba(plain, "Combined"))
+    assert not np.array_equal(_rgba(denoised, "Combined")[..., :3], _rgba(plain, "Combined")[..., :3])
+    stats = render_hooks.last_reports[LAYER]["stats"]
+    assert 0 < stats["relmse_denoised"] < stats["relmse"]
+    assert stats["denoising"] == {"prefilter": "ACCURATE", "quality": "HIGH", "seconds": stats["denoising"]["seconds"]}
+    assert render_hooks.last_reports[LAYER]["log"][-1]["relmse_denoised"] == stats["relmse_denoised"]
+    assert render_hooks.last_reports[LAYER]["settings"]["use_denoising"] is True
+    assert "(denoised " in done_line(stats, False)
+
+
+def test_without_oidn_a_denoised_render_is_a_warning_and_the_noisy_image(drt, sample_scene, tmp_path, monkeypatch):
+    from drt_engine.blender import final, oidn
+    from drt_engine.blender.hooks import render_hooks
+
+    warnings = []
+    monkeypatch.setattr(oidn, "search", lambda: None)
+    monkeypatch.setattr(final, "_warn", lambda engine, messages: warnings.extend(messages))
+    scene = _denoise_scene(sample_scene)
+    scene.drt.use_denoising = True
+    _, passes = _render_passes(scene, tmp_path / "no_oidn.exr")
+    assert passes == {"Combined"}
+    assert f"{oidn.UNAVAILABLE}; the image is not denoised" in warnings
+    assert "relmse_denoised" not in render_hooks.last_reports[LAYER]["stats"]
+
+
+def test_denoising_adds_the_noisy_image_socket_to_render_layers(drt):
+    scene = mirror_and_paint_scene()
+    scene.render.engine = "DRT"
+    node = new_compositor(scene).nodes.new("CompositorNodeRLayers")
+    node.scene, node.layer = scene, LAYER
+    assert "Noisy Image" not in {s.name for s in node.outputs if s.enabled}
+    scene.drt.use_denoising = True
+    assert "Noisy Image" in {s.name for s in node.outputs if s.enabled}
+    scene.drt.use_denoising = False
+    assert "Noisy Image" not in {s.name for s in node.outputs if s.enabled}
