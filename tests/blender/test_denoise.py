@@ -244,11 +244,9 @@ def _denoise_scene(sample_scene):
 
 
 def _render_passes(scene, path):
-    from tests.support.render_helpers import read_channels as read
-
     set_exr_output(scene, path)
     assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
-    channels = read(path)
+    channels = read_channels(path)
     layer_passes = {key[len(LAYER) + 1:].rsplit(".", 1)[0] for key in channels if key.startswith(LAYER + ".")}
     return channels, layer_passes
 
@@ -302,3 +300,19 @@ def test_denoising_adds_the_noisy_image_socket_to_render_layers(drt):
     assert "Noisy Image" in {s.name for s in node.outputs if s.enabled}
     scene.drt.use_denoising = False
     assert "Noisy Image" not in {s.name for s in node.outputs if s.enabled}
+
+
+def test_the_cli_denoises_a_scene_saved_with_denoise_on(drt, sample_scene, tmp_path):
+    """No --denoise flag yet: the scene's own setting is what the CLI renders with."""
+    from test_cli import run_cli
+
+    scene = _denoise_scene(sample_scene)
+    scene.drt.samples, scene.drt.use_denoising = 4, True
+    blend = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out = tmp_path / "out.exr"
+    result = run_cli("render", blend, "-o", out)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert f"{LAYER}.Noisy Image.R" in read_channels(out)
+    stats = json.loads((tmp_path / "out.drt.json").read_text())["stats"]
+    assert 0 < stats["relmse_denoised"] < stats["relmse"]

@@ -112,18 +112,27 @@ class Denoiser:
         if quality not in QUALITIES:
             raise DenoiserError(f"unknown denoising quality {quality!r} (one of {', '.join(QUALITIES)})")
         color = _image(color)
-        h, w = color.shape[:2]
-        albedo = None if albedo is None else np.clip(_image(albedo, (h, w)), 0.0, 1.0)
-        normal = None if normal is None or albedo is None else np.clip(_image(normal, (h, w)), -1.0, 1.0)
+        albedo, normal = _features(albedo, normal, color.shape[:2])
+        if prefilter == "ACCURATE":
+            albedo, normal = self.clean_features(albedo, normal, quality)
         output = np.empty_like(color)
         with self._lock:
-            if prefilter == "ACCURATE":
-                for name, aux in (("albedo", albedo), ("normal", normal)):
-                    if aux is not None:
-                        self._run({name: aux, "output": aux}, {}, quality)
             self._run({"color": color, "albedo": albedo, "normal": normal, "output": output},
                       {"hdr": True, "cleanAux": prefilter != "FAST"}, quality)
         return output
+
+    def clean_features(self, albedo, normal, quality: str = "HIGH"):
+        """(albedo, normal) denoised each by a filter of its own: the ACCURATE prefilter, which
+        ``denoise`` with prefilter NONE then takes as clean (several images guided by the same
+        features need it once)."""
+        if albedo is None:
+            return None, None
+        albedo, normal = _features(albedo, normal, np.shape(albedo)[:2])
+        with self._lock:
+            for name, aux in (("albedo", albedo), ("normal", normal)):
+                if aux is not None:
+                    self._run({name: aux, "output": aux}, {}, quality)
+        return albedo, normal
 
     def _run(self, images: dict, flags: dict, quality: str) -> None:
         lib = self._lib
@@ -155,6 +164,14 @@ class Denoiser:
                 return int(self._lib.oidnGetFilterInt(flt, b"quality"))
             finally:
                 self._lib.oidnReleaseFilter(flt)
+
+
+def _features(albedo, normal, shape):
+    """Float32 copies of the features in OIDN's ranges (albedo [0, 1], normal [-1, 1]); no normal
+    without an albedo."""
+    albedo = None if albedo is None else np.clip(_image(albedo, shape), 0.0, 1.0)
+    normal = None if normal is None or albedo is None else np.clip(_image(normal, shape), -1.0, 1.0)
+    return albedo, normal
 
 
 def _image(pixels, shape=None) -> np.ndarray:

@@ -1,23 +1,29 @@
 """Denoising a finished render with OpenImageDenoise, and the error of the denoised image.
 
-The film keeps two independent replicate halves of every pixel's samples (core.film.film). The
-Combined image is denoised three times: the whole, and each half alone, all guided by the same
-Denoising Albedo and Normal (traced over all the samples). The halves' denoised images differ by
-the noise the denoiser leaves in an image of half the samples, so, as for the noisy image
-(adaptive.image_error), the denoised image's squared error per pixel is estimated as
+The film keeps two independent replicate halves of every pixel's samples (core.film.film): noisy
+images N_A and N_B of n_A and n_B samples, N their mean over all n. Combined is denoised three
+times, all guided by the same Denoising Albedo and Normal (traced over all the samples): D from N,
+D_A from N_A, D_B from N_B. Two figures come from them, per pixel and channel:
 
-    (D_A - D_B)^2 n_A n_B / n^2
+- **the noise the denoiser leaves**, (D_A - D_B)^2 n_A n_B / n^2: the variance of D if that noise
+  falls as 1 / samples, as a linear smoother's does (the same form as the noisy image's estimate,
+  adaptive.image_error). It cannot see blur of real detail: a texture smoothed flat or a thin
+  shadow softened the same way in both halves cancels in D_A - D_B. On the sample scenes it read
+  0.4 to 0.6 of the true error (docs/denoising.md);
+- **the error of a half's denoised image, blur included**, by cross-validation against the other
+  half's noisy image, which is unbiased and independent of it:
+  E[(D_A - N_B)^2] = MSE(D_A) + Var(N_B), with Var(N_B) = (N_A - N_B)^2 n_A / n in expectation, so
+  MSE of a half ~ ((D_A - N_B)^2 + (D_B - N_A)^2 - (N_A - N_B)^2) / 2.
 
-which is its variance if the denoiser's leftover noise falls as 1 / samples, as a linear
-smoother's does. What this cannot see:
+The estimate of D's squared error is that half's error less the noise of D (a half's bias taken
+for D's: D, from twice the samples, is blurred no more than a half, so this leans high), and never
+less than the noise alone. What it still cannot see, or sees wrongly:
 
-- **bias**: detail the denoiser blurs away, or invents, the same way in both halves (a texture
-  smoothed flat, a thin shadow softened) cancels in D_A - D_B: the estimate measures noise, never
-  blur of real detail. Against a reference the true error is the estimate plus that bias squared
-  (docs/denoising.md measures how far apart they are);
+- bias of the noisy image itself (clamping, the ratio estimator's): N_B is the reference it
+  measures against;
 - noise of the albedo and normal: the three denoisings share them;
-- OIDN is not linear: it smooths a noisier image harder, so the halves' leftover noise may grow
-  by less than the factor two the formula assumes.
+- per pixel it is very noisy (a difference of squares of noisy images): only its image mean is
+  reported.
 """
 from __future__ import annotations
 
@@ -35,9 +41,8 @@ from .adaptive import RELMSE_EPSILON, TRUE_FLOOR
 @dataclass
 class Denoised:
     rgb: np.ndarray  # (h, w, 3) float32, the denoised Combined RGB, rows from the bottom
-    rmse: float  # its estimated RMSE over pixels and channels (inf while a pixel lacks a half)
-    relmse: float  # ... and relMSE, as adaptive.image_error measures the noisy image's
-    seconds: float  # the three denoisings' time
+    error: dict  # estimated rmse and relmse of it, and rmse_noise and relmse_noise (``denoised_error``)
+    seconds: float  # the denoisings' time
 
 
 def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: str) -> Denoised:
@@ -48,39 +53,36 @@ def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: st
     n, na, total, total_a, total_b = film.halves()
     nb = n - na
     albedo, normal = passes.get(ALBEDO), passes.get(NORMAL)
+    if prefilter == "ACCURATE":  # the three denoisings share the features: clean them once
+        albedo, normal = denoiser.clean_features(albedo, normal, quality)
+        prefilter = "NONE"
+    noisy = [(sums / np.maximum(count, 1)[:, None]).reshape(shape)
+             for sums, count in ((total, n), (total_a, na), (total_b, nb))]
+    full, half_a, half_b = (denoiser.denoise(image, albedo, normal, prefilter=prefilter, quality=quality)
+                            for image in noisy)
+    error = denoised_error(full, half_a, half_b, noisy[1], noisy[2], n, na)
+    return Denoised(full, error, time.perf_counter() - start)
 
-    def run(sums, count):
-        return denoiser.denoise((sums / np.maximum(count, 1)[:, None]).reshape(shape), albedo, normal,
-                                prefilter=prefilter, quality=quality)
 
-    full = run(total, n)
-    half_a, half_b = run(total_a, na), run(total_b, nb)
-    rmse, relmse = denoised_error(full, half_a, half_b, n, na)
-    return Denoised(full, rmse, relmse, time.perf_counter() - start)
-
-
-def denoised_variance(half_a, half_b, n, na) -> np.ndarray:
-    """Per pixel and channel (flat (pixels, 3)), the estimated squared error of the image denoised
-    from all n samples, from the images denoised from each half (n_A and n - n_A samples); inf
-    where a pixel has no sample in one half."""
+def denoised_error(full, half_a, half_b, noisy_a, noisy_b, n, na) -> dict:
+    """The estimated error of the denoised image ``full`` (see the module docstring) from its
+    halves' denoised and noisy images: ``rmse`` and ``relmse``, and the part that is the noise the
+    denoiser leaves, ``rmse_noise`` and ``relmse_noise``. relMSE divides by the true value squared,
+    estimated as for the noisy image: the square less the noise, at least TRUE_FLOOR of it. All inf
+    while some pixel lacks a sample in one half."""
     n = np.asarray(n, float).reshape(-1)
     na = np.asarray(na, float).reshape(-1)
     nb = n - na
-    d = np.asarray(half_a, float).reshape(-1, 3) - np.asarray(half_b, float).reshape(-1, 3)
-    var = d * d * (na * nb / np.maximum(n, 1) ** 2)[:, None]
-    var[~((na > 0) & (nb > 0))] = np.inf
-    return var
-
-
-def denoised_error(full, half_a, half_b, n, na) -> tuple[float, float]:
-    """(RMSE, relMSE) of the denoised image ``full``, estimated from its halves' denoised images
-    (see the module docstring); the true value squared is estimated as for the noisy image: the
-    image's square less the variance, at least TRUE_FLOOR of it."""
-    var = denoised_variance(half_a, half_b, n, na)
-    if var.size == 0:
-        return 0.0, 0.0
-    if not np.isfinite(var).all():
-        return math.inf, math.inf
-    square = np.asarray(full, float).reshape(-1, 3) ** 2
-    true_square = np.maximum(square - var, TRUE_FLOOR * square)
-    return float(np.sqrt(var.mean())), float((var / (true_square + RELMSE_EPSILON)).mean())
+    d, da, db, a, b = (np.asarray(x, float).reshape(-1, 3) for x in (full, half_a, half_b, noisy_a, noisy_b))
+    if d.size == 0:
+        return {"rmse": 0.0, "relmse": 0.0, "rmse_noise": 0.0, "relmse_noise": 0.0}
+    if not ((na > 0) & (nb > 0)).all():
+        return {"rmse": math.inf, "relmse": math.inf, "rmse_noise": math.inf, "relmse_noise": math.inf}
+    noise = (da - db) ** 2 * (na * nb / n ** 2)[:, None]
+    half = 0.5 * ((da - b) ** 2 + (db - a) ** 2 - (a - b) ** 2)
+    square = d * d
+    weight = 1.0 / (np.maximum(square - noise, TRUE_FLOOR * square) + RELMSE_EPSILON)
+    mse_noise, relmse_noise = float(noise.mean()), float((noise * weight).mean())
+    mse = max(float((half - noise).mean()), mse_noise)
+    relmse = max(float(((half - noise) * weight).mean()), relmse_noise)
+    return {"rmse": math.sqrt(mse), "relmse": relmse, "rmse_noise": math.sqrt(mse_noise), "relmse_noise": relmse_noise}

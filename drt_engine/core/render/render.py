@@ -179,9 +179,11 @@ class Renderer:
         combined[..., :3] = denoised.rgb
         out = {name: image for name, image in passes.items() if name in s.passes}
         out["Combined"], out[NOISY_IMAGE] = combined, noisy
-        stats.update(rmse_denoised=denoised.rmse, relmse_denoised=denoised.relmse,
-                     denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
-                                "seconds": denoised.seconds})
+        e = denoised.error
+        figures = {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
+                   "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
+        stats.update(figures, denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
+                                         "seconds": denoised.seconds})
         if last is not None:
-            last.update(rmse_denoised=denoised.rmse, relmse_denoised=denoised.relmse)
+            last.update(figures)
         return out
