@@ -246,7 +246,7 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     target_error: FloatProperty(
         name="Target Error",
         description="Stop the render once the estimated relative mean squared error of "
-        "the image (relMSE) falls below this; 0 means no target",
+        "the image (relMSE) falls below this, of the denoised image when Denoise is on; 0 means no target",
         default=0.0,
         min=0.0,
         soft_max=0.1,

@@ -125,3 +125,21 @@ def test_a_farm_part_is_not_denoised(oidn):
     part = render(oidn, samples=4, use_denoising=True, sample_start=0, sample_end=2)
     assert NOISY_IMAGE not in part.passes and "relmse_denoised" not in part.stats
     assert any("not denoised" in w for w in part.warnings)
+
+
+def test_every_step_logs_the_denoised_estimate(pair):
+    denoised, plain = pair
+    steps = [entry for entry in denoised.log if entry["spp_max"] >= 2]
+    assert steps and all(0 < entry["relmse_denoised"] <= entry["relmse"] for entry in steps)
+    assert all("relmse_denoised" not in entry for entry in plain.log)
+
+
+def test_the_target_error_applies_to_the_denoised_image(oidn):
+    """The same target stops a denoised render sooner: its image reaches it with fewer samples."""
+    target = 2e-3
+    noisy = render(samples=64, target_error=target)
+    denoised = render(oidn, samples=64, target_error=target, use_denoising=True)
+    print(f"target {target}: noisy stops at {noisy.stats['samples']} spp, denoised at {denoised.stats['samples']}")
+    assert noisy.stats["stopped_by"] == denoised.stats["stopped_by"] == "target_error"
+    assert denoised.stats["samples"] < noisy.stats["samples"]
+    assert denoised.stats["relmse_denoised"] < target < denoised.stats["relmse"]

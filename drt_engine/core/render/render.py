@@ -67,6 +67,8 @@ class Renderer:
         self.scene, self.settings, self.camera = scene, settings, scene.camera
         self.denoiser = denoiser
         self.denoising = settings.use_denoising and not settings.partial
+        self._denoised = None  # (samples in the film, core.render.denoise.Denoised) of the newest denoising
+        self._denoise_seconds = 0.0
         if self.denoising and denoiser is None:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
         if self.denoising:  # the features guide the denoiser: traced even when not asked for as passes
@@ -111,7 +113,8 @@ class Renderer:
                     self._trace(Samples(half.index, half.pixel, half.sample >> 1), sampler, r, pool)
 
         try:
-            outcome = drive(s, self.film, cap, trace, self.rays, progress)
+            outcome = drive(s, self.film, cap, trace, self.rays, progress,
+                            denoised=self._denoised_figures if self.denoising else None)
         finally:
             if pool is not None:
                 pool.shutdown(wait=True)
@@ -168,22 +171,37 @@ class Renderer:
             passes = self._denoise(passes, stats, outcome.log.last)
         return RenderResult(passes, stats, outcome.stopped == "cancelled", warnings, outcome.log.entries)
 
+    def _denoise_film(self):
+        """The film's image denoised (core.render.denoise), once per sample total: the step that ends
+        a render and the result share one denoising."""
+        s, samples = self.settings, float(self.film.count.sum())
+        if self._denoised is None or self._denoised[0] != samples:
+            features = self.film.images(FEATURE_PASSES)
+            denoised = denoise_film(self.film, features, self.denoiser, s.denoising_prefilter, s.denoising_quality)
+            self._denoised = samples, denoised
+            self._denoise_seconds += denoised.seconds
+        return self._denoised[1]
+
+    def _denoised_figures(self) -> dict:
+        """The denoised image's estimated error as the log and stats name it."""
+        e = self._denoise_film().error
+        return {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
+                "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
+
     def _denoise(self, passes: dict, stats: dict, last: dict | None) -> dict:
         """Combined denoised (alpha as rendered), the rendered one kept as Noisy Image, features
         the user did not ask for dropped; the denoised image's estimated error in ``stats`` and
-        the log's last entry, beside the noisy image's (core.render.denoise)."""
+        the log's last entry, beside the noisy image's (core.render.denoise). Every step of the
+        log has it too (driver.drive), and a target error applies to it."""
         s = self.settings
-        denoised = denoise_film(self.film, passes, self.denoiser, s.denoising_prefilter, s.denoising_quality)
+        figures = self._denoised_figures()
         noisy = passes["Combined"]
         combined = noisy.copy()
-        combined[..., :3] = denoised.rgb
+        combined[..., :3] = self._denoised[1].rgb
         out = {name: image for name, image in passes.items() if name in s.passes}
         out["Combined"], out[NOISY_IMAGE] = combined, noisy
-        e = denoised.error
-        figures = {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
-                   "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
         stats.update(figures, denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
-                                         "seconds": denoised.seconds})
+                                         "seconds": self._denoise_seconds})
         if last is not None:
             last.update(figures)
         return out
