@@ -261,6 +261,18 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         default=False,
         update=_update_scene_passes,
     )
+    use_preview_denoising: BoolProperty(
+        name="Denoise Viewport",
+        description="Denoise the viewport's Rendered shading with OpenImageDenoise from the start sample on "
+        "(Fast prefilter, Balanced quality, as Cycles' viewport defaults), on the viewport's worker thread",
+        default=False,
+    )
+    preview_denoising_start_sample: IntProperty(
+        name="Start Sample",
+        description="Samples every pixel of the viewport has before its image is denoised",
+        default=1,
+        min=1,
+    )
     denoising_prefilter: EnumProperty(
         name="Prefilter",
         description="How the albedo and normal that guide the denoiser are cleaned, as Cycles' option",

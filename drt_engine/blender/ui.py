@@ -126,24 +126,28 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
 
 
 class DRT_PT_sampling_denoise(DRTButtonsPanel, bpy.types.Panel):
-    """Cycles' Render > Sampling > Denoise: greyed, with the reason, where Blender has no OIDN."""
+    """Cycles' Denoise settings: final renders and the viewport, greyed with the reason where
+    Blender has no OpenImageDenoise."""
     bl_label = "Denoise"
     bl_parent_id = "DRT_PT_sampling"
-
-    def draw_header(self, context):
-        row = self.layout.row()
-        row.enabled = unavailable_reason() is None
-        row.prop(context.scene.drt, "use_denoising", text="")
 
     def draw(self, context):
         layout = split(self.layout)
         drt = context.scene.drt
         reason = unavailable_reason()
+        col = layout.column(heading="Denoise")
+        col.enabled = reason is None
+        col.prop(drt, "use_denoising", text="Render")
+        col.prop(drt, "use_preview_denoising", text="Viewport")
         col = layout.column()
         col.enabled = reason is None
         col.active = drt.use_denoising
         col.prop(drt, "denoising_prefilter")
         col.prop(drt, "denoising_quality")
+        col = layout.column()
+        col.enabled = reason is None
+        col.active = drt.use_preview_denoising
+        col.prop(drt, "preview_denoising_start_sample")
         if reason is not None:
             layout.label(text=reason, icon="INFO")
 

@@ -206,12 +206,11 @@ class _Recorder:
         self.log.append(("label", text, self))
 
 
-def _draw(panel, scene, header=False):
+def _draw(panel, scene):
     from types import SimpleNamespace
 
     log = []
-    fake = SimpleNamespace(layout=_Recorder(log))
-    (panel.draw_header if header else panel.draw)(fake, SimpleNamespace(scene=scene))
+    panel.draw(SimpleNamespace(layout=_Recorder(log)), SimpleNamespace(scene=scene))
     props = {entry[1]: entry[2] for entry in log if isinstance(entry, tuple) and entry[0] == "prop"}
     labels = [entry[1] for entry in log if isinstance(entry, tuple) and entry[0] == "label"]
     return props, labels
@@ -222,14 +221,14 @@ def test_the_denoise_setting_greys_out_with_the_reason_where_blender_has_no_oidn
     from drt_engine.blender.ui import DRT_PT_sampling_denoise
 
     scene = bpy.context.scene
+    names = ("use_denoising", "use_preview_denoising", "denoising_prefilter", "denoising_quality",
+             "preview_denoising_start_sample")
     assert oidn.oidn_library() is not None  # the bpy 5.0 wheel ships it
-    props, labels = _draw(DRT_PT_sampling_denoise, scene, header=True)
-    assert props["use_denoising"].enabled and not labels
-    monkeypatch.setattr(oidn, "search", lambda: None)  # as in Debian's Blender 4.3.2
-    props, _ = _draw(DRT_PT_sampling_denoise, scene, header=True)
-    assert not props["use_denoising"].enabled
     props, labels = _draw(DRT_PT_sampling_denoise, scene)
-    assert not props["denoising_prefilter"].enabled and not props["denoising_quality"].enabled
+    assert all(props[name].enabled for name in names) and not labels
+    monkeypatch.setattr(oidn, "search", lambda: None)  # as in Debian's Blender 4.3.2
+    props, labels = _draw(DRT_PT_sampling_denoise, scene)
+    assert not any(props[name].enabled for name in names)
     assert labels == [oidn.UNAVAILABLE] and "OpenImageDenoise" in labels[0]
 
 
@@ -316,3 +315,17 @@ def test_the_cli_denoises_a_scene_saved_with_denoise_on(drt, sample_scene, tmp_p
     assert f"{LAYER}.Noisy Image.R" in read_channels(out)
     stats = json.loads((tmp_path / "out.drt.json").read_text())["stats"]
     assert 0 < stats["relmse_denoised"] < stats["relmse"]
+
+
+def test_the_viewport_denoises_only_when_asked_and_where_blender_has_oidn(drt, monkeypatch):
+    from drt_engine.blender import oidn
+    from drt_engine.blender.viewport import ViewDenoise, view_denoise
+
+    scene = bpy.context.scene
+    scene.drt.use_preview_denoising, scene.drt.preview_denoising_start_sample = False, 3
+    assert view_denoise(scene) is None
+    scene.drt.use_preview_denoising = True
+    denoise = view_denoise(scene)
+    assert isinstance(denoise, ViewDenoise) and denoise.start_sample == 3
+    monkeypatch.setattr(oidn, "search", lambda: None)
+    assert view_denoise(scene) is None
