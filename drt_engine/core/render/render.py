@@ -113,8 +113,11 @@ class Renderer:
                     self._trace(Samples(half.index, half.pixel, half.sample >> 1), sampler, r, pool)
 
         try:
+            # with a target error, every step denoises (3 OIDN runs) to know whether the denoised image
+            # is there yet; without one, only the finished image is denoised
+            stepwise = self.denoising and s.target_error > 0
             outcome = drive(s, self.film, cap, trace, self.rays, progress,
-                            denoised=self._denoised_figures if self.denoising else None)
+                            denoised=self._denoised_figures if stepwise else None)
         finally:
             if pool is not None:
                 pool.shutdown(wait=True)
@@ -191,8 +194,8 @@ class Renderer:
     def _denoise(self, passes: dict, stats: dict, last: dict | None) -> dict:
         """Combined denoised (alpha as rendered), the rendered one kept as Noisy Image, features
         the user did not ask for dropped; the denoised image's estimated error in ``stats`` and
-        the log's last entry, beside the noisy image's (core.render.denoise). Every step of the
-        log has it too (driver.drive), and a target error applies to it."""
+        the log's last entry, beside the noisy image's (core.render.denoise). With a target error
+        every step of the log has it too (driver.drive), and the target applies to it."""
         s = self.settings
         figures = self._denoised_figures()
         noisy = passes["Combined"]
