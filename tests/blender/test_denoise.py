@@ -7,6 +7,7 @@ import math
 
 import bpy
 import numpy as np
+import pytest
 
 from tests.support.datablocks import new_compositor, new_material
 from tests.support.render_helpers import ROOT, read_channels, save_side_by_side, set_exr_output, set_resolution
@@ -272,6 +273,12 @@ def test_a_denoised_render_keeps_the_render_as_noisy_image(drt, sample_scene, tm
     assert render_hooks.last_reports[LAYER]["log"][-1]["relmse_denoised"] == stats["relmse_denoised"]
     assert render_hooks.last_reports[LAYER]["settings"]["use_denoising"] is True
     assert "(denoised " in done_line(stats, False)
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(tmp_path / "denoised.exr"))
+    metadata = {a.name: a.value for a in image.spec().extra_attribs}
+    image.close()
+    assert float(metadata[f"drt.{LAYER}.est_relmse_denoised"]) == pytest.approx(stats["relmse_denoised"], rel=1e-5)
 
 
 def test_without_oidn_a_denoised_render_is_a_warning_and_the_noisy_image(drt, sample_scene, tmp_path, monkeypatch):
