@@ -89,7 +89,7 @@ def _box3(image):
     return sum(pad[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9.0
 
 
-def test_the_estimate_sees_the_noise_left_and_the_blur_of_a_linear_denoiser():
+def test_the_estimate_sees_the_noise_left_and_the_blur_of_a_linear_denoiser(monkeypatch):
     """Truth: stripes one pixel wide (detail a 3x3 box blurs away) plus a gradient; two halves of
     independent noise; D = box(N). For a linear smoother both parts of the estimate are unbiased:
     the noise part is D's variance, the whole is D's mean squared error, blur included."""
@@ -113,6 +113,10 @@ def test_the_estimate_sees_the_noise_left_and_the_blur_of_a_linear_denoiser():
     assert est["relmse"] > 5 * est["relmse_noise"]
     unknown = denoised_error(d, da, db, noisy_a, noisy_b, n, np.where(np.arange(h * w) == 7, 0.0, na))
     assert unknown["relmse"] == np.inf  # a pixel without half B
+    from drt_engine.core.render import denoise
+
+    monkeypatch.setattr(denoise, "ERROR_BLOCK", 999)  # in blocks of pixels, the same sums
+    assert denoised_error(d, da, db, noisy_a, noisy_b, n, na) == pytest.approx(est, rel=1e-12)
 
 
 def test_denoising_without_a_library_is_a_settings_error():

@@ -45,23 +45,35 @@ class Denoised:
     seconds: float  # the denoisings' time
 
 
+ERROR_BLOCK = 1 << 20
+"""Pixels whose error terms are computed at a time: float64 temporaries of a whole 8K image are GBs."""
+
+
 def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: str) -> Denoised:
     """The denoised Combined image of ``film`` and its estimated error; ``passes`` are the film's
     images (Denoising Albedo and Normal among them), ``denoiser`` a core.film.denoiser.Denoiser."""
     start = time.perf_counter()
     shape = (film.height, film.width, 3)
-    n, na, total, total_a, total_b = film.halves()
-    nb = n - na
     albedo, normal = passes.get(ALBEDO), passes.get(NORMAL)
     if prefilter == "ACCURATE":  # the three denoisings share the features: clean them once
         albedo, normal = denoiser.clean_features(albedo, normal, quality)
         prefilter = "NONE"
-    noisy = [(sums / np.maximum(count, 1)[:, None]).reshape(shape)
-             for sums, count in ((total, n), (total_a, na), (total_b, nb))]
+    noisy = [image.reshape(shape) for image in noisy_images(film)]
     full, half_a, half_b = (denoiser.denoise(image, albedo, normal, prefilter=prefilter, quality=quality)
                             for image in noisy)
-    error = denoised_error(full, half_a, half_b, noisy[1], noisy[2], n, na)
+    error = denoised_error(full, half_a, half_b, noisy[1], noisy[2], film.count, film.count_a)
     return Denoised(full, error, time.perf_counter() - start)
+
+
+def noisy_images(film: Film) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flat (pixels, 3) float32 Combined RGB means of all the samples, of half A and of half B
+    (resolved with the ratio estimator, core.film.film.Film.halves), read a block at a time."""
+    images = tuple(np.empty((film.n, 3), np.float32) for _ in range(3))
+    for span in film.blocks():
+        n, na, total, total_a, total_b = film.halves(span)
+        for image, sums, count in zip(images, (total, total_a, total_b), (n, na, n - na)):
+            image[span] = sums / np.maximum(count, 1)[:, None]
+    return images
 
 
 def denoised_error(full, half_a, half_b, noisy_a, noisy_b, n, na) -> dict:
@@ -72,17 +84,20 @@ def denoised_error(full, half_a, half_b, noisy_a, noisy_b, n, na) -> dict:
     while some pixel lacks a sample in one half."""
     n = np.asarray(n, float).reshape(-1)
     na = np.asarray(na, float).reshape(-1)
-    nb = n - na
-    d, da, db, a, b = (np.asarray(x, float).reshape(-1, 3) for x in (full, half_a, half_b, noisy_a, noisy_b))
-    if d.size == 0:
+    images = [np.asarray(x).reshape(-1, 3) for x in (full, half_a, half_b, noisy_a, noisy_b)]
+    if len(n) == 0:
         return {"rmse": 0.0, "relmse": 0.0, "rmse_noise": 0.0, "relmse_noise": 0.0}
-    if not ((na > 0) & (nb > 0)).all():
+    if not ((na > 0) & (n - na > 0)).all():
         return {"rmse": math.inf, "relmse": math.inf, "rmse_noise": math.inf, "relmse_noise": math.inf}
-    noise = (da - db) ** 2 * (na * nb / n ** 2)[:, None]
-    half = 0.5 * ((da - b) ** 2 + (db - a) ** 2 - (a - b) ** 2)
-    square = d * d
-    weight = 1.0 / (np.maximum(square - noise, TRUE_FLOOR * square) + RELMSE_EPSILON)
-    mse_noise, relmse_noise = float(noise.mean()), float((noise * weight).mean())
-    mse = max(float((half - noise).mean()), mse_noise)
-    relmse = max(float(((half - noise) * weight).mean()), relmse_noise)
-    return {"rmse": math.sqrt(mse), "relmse": relmse, "rmse_noise": math.sqrt(mse_noise), "relmse_noise": relmse_noise}
+    sums = np.zeros(4)  # noise, noise / true^2, half - noise, (half - noise) / true^2
+    for a in range(0, len(n), ERROR_BLOCK):
+        span = slice(a, a + ERROR_BLOCK)
+        d, da, db, xa, xb = (image[span].astype(float) for image in images)
+        noise = (da - db) ** 2 * (na[span] * (n[span] - na[span]) / n[span] ** 2)[:, None]
+        half = 0.5 * ((da - xb) ** 2 + (db - xa) ** 2 - (xa - xb) ** 2)
+        square = d * d
+        weight = 1.0 / (np.maximum(square - noise, TRUE_FLOOR * square) + RELMSE_EPSILON)
+        sums += [noise.sum(), (noise * weight).sum(), (half - noise).sum(), ((half - noise) * weight).sum()]
+    noise, relmse_noise, mse, relmse = sums / (3 * len(n))
+    return {"rmse": math.sqrt(max(mse, noise)), "relmse": max(relmse, relmse_noise),
+            "rmse_noise": math.sqrt(noise), "relmse_noise": relmse_noise}
