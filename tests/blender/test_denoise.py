@@ -336,3 +336,12 @@ def test_the_viewport_denoises_only_when_asked_and_where_blender_has_oidn(drt, m
     assert isinstance(denoise, ViewDenoise) and denoise.start_sample == 3
     monkeypatch.setattr(oidn, "search", lambda: None)
     assert view_denoise(scene) is None
+
+
+def test_the_settings_choices_are_the_cores(drt):
+    from drt_engine.core.settings import DENOISING_PREFILTERS, DENOISING_QUALITIES
+
+    props = bpy.types.Scene.bl_rna.properties["drt"].fixed_type.properties
+    assert tuple(i.identifier for i in props["denoising_prefilter"].enum_items) == DENOISING_PREFILTERS
+    assert tuple(i.identifier for i in props["denoising_quality"].enum_items) == DENOISING_QUALITIES
+    assert props["use_denoising"].default is False and props["denoising_prefilter"].default == "ACCURATE"

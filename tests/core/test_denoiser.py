@@ -61,6 +61,9 @@ def test_colour_alone_and_rgba_input(oidn):
 def test_quality_values_are_oidns(oidn):
     """OIDN reads back the value each quality name sets (oidn.h: FAST 4, BALANCED 5, HIGH 6)."""
     assert {q: oidn.filter_quality(q) for q in denoiser.QUALITIES} == {"FAST": 4, "BALANCED": 5, "HIGH": 6}
+    from drt_engine.core.settings import DENOISING_QUALITIES
+
+    assert set(denoiser.QUALITIES) == set(DENOISING_QUALITIES)
 
 
 def test_a_missing_library_is_one_line_drt_error(tmp_path):
