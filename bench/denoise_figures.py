@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 MEASURED = ROOT / "out" / "ui" / "denoise.json"
+MAPS = ROOT / "bench" / "plots" / "denoise_cornell_box.png"
 CALIBRATION = ROOT / "bench" / "denoise_calibration.json"
 RESULTS = ROOT / "bench" / "results"
 
@@ -119,6 +120,66 @@ def measure() -> dict:
             "prefilter": "ACCURATE", "quality": "HIGH", "target": TARGET, "target_rows": targets}
 
 
+def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
+    """PNG of four panels, top row first: the noisy render, the denoised one, the estimated
+    relative squared error of the denoised image per pixel, and its true one against the
+    reference. The error maps are pooled over 9x9 pixels (the estimate per pixel is a difference
+    of noisy squares) and drawn on one log scale, 1e-6 black to 1e-2 white."""
+    import numpy as np
+    import OpenImageIO as oiio
+
+    import drt_engine
+    import scenes as bench_scenes
+    from drt_engine.blender.oidn import oidn_library
+    from drt_engine.core.film import denoiser
+    from drt_engine.core.film.denoising import ALBEDO, NORMAL, PASSES
+    from drt_engine.core.render.adaptive import RELMSE_EPSILON, box_mean
+    from drt_engine.core.render.denoise import error_terms, noisy_images
+    from drt_engine.core.render.render import Renderer
+    from drt_engine.core.settings import NOISY_IMAGE
+
+    drt_engine.register()
+    oidn = denoiser.load(oidn_library())
+    scene, data = bench_scenes.load(name, WIDTH)
+
+    def settings_for(**kw):
+        return bench_scenes.settings(scene, threads=0, use_adaptive_sampling=False, **kw)
+
+    ref, ref_var = reference(name, data, settings_for)
+    renderer = Renderer(data, settings_for(samples=samples, seed=seed, use_denoising=True), denoiser=oidn)
+    result = renderer.render()
+    film, (h, w) = renderer.film, ref.shape[:2]
+    features = film.images(PASSES)
+    albedo, normal = oidn.clean_features(features[ALBEDO], features[NORMAL])
+    full, half_a, half_b = noisy_images(film)
+    denoised = result.passes["Combined"][..., :3]
+    da, db = (oidn.denoise(x.reshape(h, w, 3), albedo, normal, prefilter="NONE") for x in (half_a, half_b))
+    _, error, weight = error_terms(denoised, da, db, half_a, half_b, film.count, film.count_a)
+    estimated = (error * weight).mean(axis=1)
+    true = (((denoised - ref) ** 2 - ref_var) / (ref ** 2 + RELMSE_EPSILON)).reshape(-1, 3).mean(axis=1)
+    scale = 1.0 / max(float(np.percentile(ref, 99)), 1e-6)
+
+    def tone(image):
+        linear = np.clip(image * scale, 0.0, 1.0)
+        return np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1 / 2.4) - 0.055)
+
+    def heat(values):
+        pooled = box_mean(values, h, w, 4).reshape(h, w)
+        level = np.clip((np.log10(np.maximum(pooled, 1e-12)) + 6.0) / 4.0, 0.0, 1.0)
+        return np.repeat(level[..., None], 3, axis=2)
+
+    gap = np.full((h, 2, 3), 0.5)
+    panels = [tone(result.passes[NOISY_IMAGE][..., :3]), tone(denoised), heat(estimated), heat(true)]
+    rows = np.concatenate([p for panel in panels for p in (panel, gap)][:-1], axis=1)[::-1]  # top row first
+    pixels = np.ascontiguousarray((rows * 255 + 0.5).astype(np.uint8))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(pixels.shape[1], pixels.shape[0], 3, "uint8"))
+    out.write_image(pixels)
+    out.close()
+    print(f"wrote {path.relative_to(ROOT)}: estimated relMSE {estimated.mean():.3g}, true {true.mean():.3g}")
+
+
 def calibration_block(m: dict) -> str:
     """One line per scene and sample count, the figures averaged over the seeds (est. / true: its range)."""
     lines = ["| scene | spp | noisy relMSE (est. / true) | denoised relMSE | denoised / noisy | "
@@ -166,12 +227,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--calibration", action="store_true",
                         help="measure DRT's built-in denoising and its error estimate (make bench-denoise)")
+    parser.add_argument("--maps", action="store_true",
+                        help="only draw bench/plots/denoise_cornell_box.png (noisy, denoised, estimated and true error)")
     parser.add_argument("--publish-only", action="store_true",
                         help="rewrite the calibration block from bench/denoise_calibration.json without rendering")
     args = parser.parse_args()
+    if args.maps:
+        maps()
+        return
     if args.calibration or args.publish_only:
         if not args.publish_only:
             CALIBRATION.write_text(json.dumps(measure(), indent=1) + "\n")
+            maps()
         write_block("denoise-calibration", calibration_block(json.loads(CALIBRATION.read_text())))
         return
     write_block("denoise", block(json.loads(MEASURED.read_text())))
