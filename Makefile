@@ -10,6 +10,8 @@
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make bench-ratio the ratio estimator against Monte Carlo: efficiency, bias, where the error is
 #                    (bench/ratio_estimator.py: docs/ratio-estimator.md, bench/ratio_estimator.json); about 30 minutes
+#   make bench-denoise built-in denoising: denoised vs noisy relMSE and the denoised error estimate against
+#                    the true error (bench/denoise_figures.py --calibration: docs/denoising.md, bench/denoise_calibration.json)
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
 #   make texture-parity  DRT vs Cycles per procedural texture and mode (bench/texture_parity.py: docs/shader-node-parity.md)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
@@ -48,7 +50,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-ratio bench-farm texture-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-ratio bench-denoise bench-farm texture-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -121,6 +123,9 @@ bench-throughput: $(STAMP)
 
 bench-ratio: $(STAMP)
 	$(PY) bench/ratio_estimator.py --publish
+
+bench-denoise: $(STAMP)
+	$(PY) bench/denoise_figures.py --calibration
 
 bench-farm: $(STAMP)
 	$(PY) bench/farm.py

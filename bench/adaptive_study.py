@@ -35,6 +35,7 @@ from drt_engine.core.render.adaptive import true_error  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
 from blocks import write_block  # noqa: E402
+from references import cached_reference  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 REFERENCE_SAMPLES = 2048
@@ -44,15 +45,8 @@ TARGETS = (3e-3, 1e-3)
 def reference(name, data, base):
     """The scene's 2048-sample reference and its estimated variance, cached per scene and size."""
     w, h = data.camera.window_size
-    path = OUT / f"reference_{name}_{w}x{h}.npz"
-    if path.exists():
-        z = np.load(path)
-        return z["image"], z["variance"]
-    res = Renderer(data, RenderSettings(samples=REFERENCE_SAMPLES, seed=1 << 20, **{**base, "passes": ("Combined", "Noise")})).render()
-    image, variance = res.passes["Combined"][..., :3].astype(float), res.passes["Noise"].astype(float) ** 2
-    OUT.mkdir(parents=True, exist_ok=True)
-    np.savez(path, image=image, variance=variance)
-    return image, variance
+    settings = RenderSettings(samples=REFERENCE_SAMPLES, seed=1 << 20, **{**base, "passes": ("Combined", "Noise")})
+    return cached_reference(OUT / f"reference_{name}_{w}x{h}.npz", Renderer(data, settings).render)
 
 
 def steps(data, settings, truth):

@@ -21,6 +21,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "ratio": DOCS / "ratio-estimator.md",
     "viewport-times": DOCS / "viewport.md",
     "denoise": DOCS / "denoising.md",
+    "denoise-calibration": DOCS / "denoising.md",
 }
 RESULTS_THROUGHPUT = ("<!-- throughput: begin -->", "<!-- throughput: end -->")
 """bench/throughput.py's section of bench/RESULTS.md, which bench/run.py keeps when it rewrites the file."""

@@ -31,6 +31,7 @@ from drt_engine.core.film.ratio_sums import RATIO  # noqa: E402
 from drt_engine.core.render.render import Renderer  # noqa: E402
 from drt_engine.core.settings import RenderSettings  # noqa: E402
 from blocks import write_block  # noqa: E402
+from references import cached_reference  # noqa: E402
 
 OUT = ROOT / "bench" / "results"
 ESTIMATORS = ("MONTE_CARLO", "RATIO")
@@ -39,17 +40,9 @@ ESTIMATORS = ("MONTE_CARLO", "RATIO")
 def reference(name, data, base, samples):
     """The scene's converged Monte Carlo image and its estimated variance, cached per scene and size."""
     w, h = data.camera.window_size
-    path = OUT / f"ratio_reference_{name}_{w}x{h}_{samples}.npz"
-    if path.exists():
-        z = np.load(path)
-        return z["image"], z["variance"]
     settings = RenderSettings(samples=samples, seed=1 << 20, shadow_estimator="MONTE_CARLO",
                               **{**base, "passes": ("Combined", "Noise"), "threads": 0})
-    res = Renderer(data, settings).render()
-    image, variance = res.passes["Combined"][..., :3].astype(float), res.passes["Noise"].astype(float) ** 2
-    OUT.mkdir(parents=True, exist_ok=True)
-    np.savez(path, image=image, variance=variance)
-    return image, variance
+    return cached_reference(OUT / f"ratio_reference_{name}_{w}x{h}_{samples}.npz", Renderer(data, settings).render)
 
 
 REGIONS = ("no closed-form light", "light wholly seen", "light hidden", "penumbra")

@@ -3,7 +3,7 @@ previews) and viewport.py (Rendered shading)."""
 import bpy
 
 from .final import render as final_render
-from .properties import enabled_passes, pass_layout
+from .properties import pass_layout, registered_passes
 from .viewport import ViewportSession
 
 
@@ -32,7 +32,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self._viewport.draw(self, context, depsgraph)
 
     def update_render_passes(self, scene=None, renderlayer=None):
-        for name in enabled_passes(renderlayer):
+        for name in registered_passes(scene, renderlayer):
             self.register_pass(scene, renderlayer, name, *pass_layout(name))
 
 

@@ -6,6 +6,7 @@ yet). With border render on, Blender's render result covers only the border (it 
 result into the full frame itself when "Crop to Render Region" is off), so the engine always
 writes the ``camera.window`` rectangle at (0, 0) of its result.
 """
+import dataclasses
 import json
 import time
 import traceback
@@ -16,6 +17,7 @@ from ..core.base import jit
 from ..core.errors import DRTError, RenderCancelled
 from ..core.render import report
 from .hooks import render_hooks
+from .oidn import UNAVAILABLE, oidn_library
 from .part_files import keep_part
 from .preview import PREVIEW_LAYER, preview_settings
 from .properties import settings_from_scene
@@ -85,6 +87,7 @@ def stamp_report(engine, view_layer: str, outcome) -> None:
         "samples": str(stats["samples"]),
         "elapsed": f"{stats['elapsed']:.3f}",
         "est_relmse": "" if stats.get("relmse") is None else f"{stats['relmse']:.6g}",
+        "est_relmse_denoised": "" if stats.get("relmse_denoised") is None else f"{stats['relmse_denoised']:.6g}",
         "error_log": json.dumps(report.json_safe(outcome.log), separators=(",", ":")),
     }
     for name, value in fields.items():
@@ -121,6 +124,7 @@ def _render(engine, depsgraph):
     settings = settings_from_scene(scene, view_layer)
     if engine.is_preview:
         settings = preview_settings(settings)
+    settings, denoiser = denoiser_for(engine, settings)
     if jit.first_run():
         engine.update_stats("", COMPILING)
         print(f"DRT: {COMPILING}", flush=True)  # the console, and the CLI's output
@@ -130,7 +134,7 @@ def _render(engine, depsgraph):
         scene_data, prepared = prepared_for(scene_data, PREVIEW_LAYER, True)
     else:
         scene_data, prepared = prepared_for(scene_data, view_layer.name, scene.render.use_persistent_data)
-    renderer = Renderer(scene_data, settings, prepared)
+    renderer = Renderer(scene_data, settings, prepared, denoiser=denoiser)
     if engine.test_break():
         return
 
@@ -158,6 +162,21 @@ def _render(engine, depsgraph):
     if not engine.is_preview:  # the console (and the CLI's output) shows what the scene left out
         rays = ", ".join(f"{k} {v}" for k, v in stats.get("rays", {}).items())
         print(f"DRT: {stats.get('plan_summary', '')}\nDRT: rays traced: {rays}", flush=True)
+
+
+def denoiser_for(engine, settings):
+    """(settings, core.film.denoiser.Denoiser or None): Blender's own OpenImageDenoise when the
+    settings ask for denoising; where this Blender has none, a warning and a render not denoised.
+    A library that is there but fails to load is a DenoiserError (one line, the render ends)."""
+    if not settings.use_denoising or settings.partial:
+        return settings, None
+    path = oidn_library()
+    if path is None:
+        _warn(engine, [f"{UNAVAILABLE}; the image is not denoised"])
+        return dataclasses.replace(settings, use_denoising=False), None
+    from ..core.film.denoiser import load
+
+    return settings, load(path)
 
 
 def _warn(engine, warnings):

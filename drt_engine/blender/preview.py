@@ -16,7 +16,7 @@ preview, of the same preview scene, so the second reuses the first's prepared sc
 
 
 def preview_settings(settings):
-    """Settings for a material or light preview: small and fast, Combined only."""
+    """Settings for a material or light preview: small and fast, Combined only, not denoised."""
     return dataclasses.replace(settings, samples=min(settings.samples, PREVIEW_SAMPLES),
                                max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",),
-                               sample_start=0, sample_end=0)
+                               sample_start=0, sample_end=0, use_denoising=False)

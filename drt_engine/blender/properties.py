@@ -13,7 +13,8 @@ from bpy.props import (
     PointerProperty,
 )
 
-from ..core.settings import PASS_CHANNELS, PASSES, RenderSettings
+from ..core.settings import NOISY_IMAGE, PASS_CHANNELS, PASSES, RenderSettings
+from .oidn import oidn_library
 
 BLENDER_PASS_TOGGLES = {
     "Depth": "use_pass_z",
@@ -51,6 +52,17 @@ def enabled_passes(view_layer) -> tuple[str, ...]:
     return tuple(name for name in PASSES if pass_enabled(view_layer, name))
 
 
+def denoising_active(scene) -> bool:
+    """Whether final renders of ``scene`` are denoised: asked for, and this Blender has OIDN."""
+    return bool(scene.drt.use_denoising) and oidn_library() is not None
+
+
+def registered_passes(scene, view_layer) -> tuple[str, ...]:
+    """The passes a render of this view layer writes: the enabled ones, and Noisy Image when denoising."""
+    extra = (NOISY_IMAGE,) if scene is not None and denoising_active(scene) else ()
+    return enabled_passes(view_layer) + extra
+
+
 def pass_layout(name: str) -> tuple[int, str, str]:
     """(channel count, channel ids, Blender pass type) for ``RenderEngine.register_pass``."""
     chan_id = PASS_CHANNELS[name]
@@ -80,6 +92,9 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         sample_start=drt.sample_offset,
         sample_end=drt.sample_offset + drt.sample_count if drt.sample_count else 0,
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),
+        use_denoising=drt.use_denoising,
+        denoising_prefilter=drt.denoising_prefilter,
+        denoising_quality=drt.denoising_quality,
     )
 
 
@@ -88,6 +103,12 @@ def _update_render_passes(self, context):
     for view_layer in self.id_data.view_layers:
         if view_layer.drt.as_pointer() == self.as_pointer():
             view_layer.update_render_passes()
+
+
+def _update_scene_passes(self, context):
+    """Denoising adds or removes the Noisy Image pass of every view layer."""
+    for view_layer in self.id_data.view_layers:
+        view_layer.update_render_passes()
 
 
 class DRTSceneSettings(bpy.types.PropertyGroup):
@@ -225,11 +246,54 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     target_error: FloatProperty(
         name="Target Error",
         description="Stop the render once the estimated relative mean squared error of "
-        "the image (relMSE) falls below this; 0 means no target",
+        "the image (relMSE) falls below this, of the denoised image when Denoise is on; 0 means no target",
         default=0.0,
         min=0.0,
         soft_max=0.1,
         precision=4,
+    )
+    use_denoising: BoolProperty(
+        name="Denoise",
+        description="Denoise final renders with the OpenImageDenoise library Blender ships, guided by "
+        "DRT's Denoising Albedo and Normal, as Cycles does; the image as rendered is kept as the Noisy "
+        "Image pass, and the render's report gives the denoised image's estimated error beside the noisy "
+        "one's. Unavailable in a Blender without OpenImageDenoise (Debian's, for one)",
+        default=False,
+        update=_update_scene_passes,
+    )
+    use_preview_denoising: BoolProperty(
+        name="Denoise Viewport",
+        description="Denoise the viewport's Rendered shading with OpenImageDenoise from the start sample on "
+        "(Fast prefilter, Balanced quality, as Cycles' viewport defaults), on the viewport's worker thread",
+        default=False,
+    )
+    preview_denoising_start_sample: IntProperty(
+        name="Start Sample",
+        description="Samples every pixel of the viewport has before its image is denoised",
+        default=1,
+        min=1,
+    )
+    denoising_prefilter: EnumProperty(
+        name="Prefilter",
+        description="How the albedo and normal that guide the denoiser are cleaned, as Cycles' option",
+        items=(
+            ("NONE", "None", "No prefiltering: the albedo and normal are taken as noise-free (sharpest "
+             "where they are, e.g. without depth of field or motion blur)"),
+            ("FAST", "Fast", "The denoiser allows for noise in the albedo and normal itself"),
+            ("ACCURATE", "Accurate", "The albedo and normal are denoised first, each on its own, then "
+             "guide the image's denoising (slowest, best detail)"),
+        ),
+        default="ACCURATE",
+    )
+    denoising_quality: EnumProperty(
+        name="Quality",
+        description="OpenImageDenoise's quality mode, as Cycles' option",
+        items=(
+            ("HIGH", "High", "Best quality (for final frames)"),
+            ("BALANCED", "Balanced", "Faster, somewhat lower quality"),
+            ("FAST", "Fast", "Fastest, lowest quality (for previews)"),
+        ),
+        default="HIGH",
     )
 
     sample_offset: IntProperty(

@@ -12,8 +12,11 @@ def stats_line(samples_done: int, samples_total: int, relmse: float, elapsed: fl
 
 
 def done_line(stats: dict, cancelled: bool) -> str:
-    """The last stats line: samples, estimated error, time, what stopped the render, the render plan."""
+    """The last stats line: samples, estimated error (and the denoised image's, when denoised), time,
+    what stopped the render, the render plan."""
     error = report.relative_error_text(stats.get("relmse"))
+    if stats.get("relmse_denoised") is not None:
+        error += f" (denoised {report.relative_error_text(stats['relmse_denoised'])})"
     state = "Cancelled" if cancelled else "Done"
     samples = f"{stats['samples']} samples"
     if stats.get("adaptive_threshold") is not None:

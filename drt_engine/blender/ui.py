@@ -6,6 +6,8 @@ class name and missing ones are skipped: names move between Blender 4.2 and 5.0.
 """
 import bpy
 
+from .oidn import unavailable_reason
+
 ENGINE = "DRT"
 
 SHARED_PANELS = (
@@ -123,6 +125,33 @@ class DRT_PT_sampling_adaptive(DRTButtonsPanel, bpy.types.Panel):
         col.prop(drt, "adaptive_min_samples")
 
 
+class DRT_PT_sampling_denoise(DRTButtonsPanel, bpy.types.Panel):
+    """Cycles' Denoise settings: final renders and the viewport, greyed with the reason where
+    Blender has no OpenImageDenoise."""
+    bl_label = "Denoise"
+    bl_parent_id = "DRT_PT_sampling"
+
+    def draw(self, context):
+        layout = split(self.layout)
+        drt = context.scene.drt
+        reason = unavailable_reason()
+        col = layout.column(heading="Denoise")
+        col.enabled = reason is None
+        col.prop(drt, "use_denoising", text="Render")
+        col.prop(drt, "use_preview_denoising", text="Viewport")
+        col = layout.column()
+        col.enabled = reason is None
+        col.active = drt.use_denoising
+        col.prop(drt, "denoising_prefilter")
+        col.prop(drt, "denoising_quality")
+        col = layout.column()
+        col.enabled = reason is None
+        col.active = drt.use_preview_denoising
+        col.prop(drt, "preview_denoising_start_sample")
+        if reason is not None:
+            layout.label(text=reason, icon="INFO")
+
+
 class DRT_PT_sampling_range(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Sample Range"
     bl_parent_id = "DRT_PT_sampling"
@@ -211,6 +240,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
 classes = (
     DRT_PT_sampling,
     DRT_PT_sampling_adaptive,
+    DRT_PT_sampling_denoise,
     DRT_PT_sampling_range,
     DRT_PT_light_paths,
     DRT_PT_film,

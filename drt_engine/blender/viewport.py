@@ -29,6 +29,8 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.errors import DRTError
+from ..core.film.denoising import PASSES as FEATURE_PASSES
+from .oidn import oidn_library
 from .properties import settings_from_scene
 from .status import done_line, one_line, stats_line
 
@@ -47,10 +49,55 @@ STOP_TIMEOUT = 5.0
 
 
 def viewport_settings(settings, preview_samples: int):
-    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules."""
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, not denoised
+    (``use_denoising`` is for final renders; the viewport's denoising is still to come)."""
     return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
-                               sample_start=0, sample_end=0)
+                               sample_start=0, sample_end=0, use_denoising=False)
+
+
+VIEWPORT_PREFILTER, VIEWPORT_QUALITY = "FAST", "BALANCED"
+"""How the viewport denoises: Cycles' defaults for its viewport denoiser (preview_denoising_prefilter
+and preview_denoising_quality), quicker than a final render's Accurate / High."""
+
+
+@dataclasses.dataclass
+class ViewDenoise:
+    """Denoising of the viewport's full-resolution images from ``start_sample`` samples on, on the
+    worker thread (Blender's UI thread never waits for it)."""
+    denoiser: object  # core.film.denoiser.Denoiser
+    start_sample: int = 1
+
+    def settings(self, settings):
+        """The viewport's settings with the features the denoiser needs traced."""
+        return dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
+            name for name in FEATURE_PASSES if name not in settings.passes))
+
+    def image(self, passes: dict, samples: int) -> tuple[np.ndarray, bool]:
+        """(RGBA image to show, whether it is denoised) of a render's passes with ``samples`` in
+        every pixel."""
+        combined = passes["Combined"]
+        if samples < self.start_sample:
+            return combined, False
+        out = combined.copy()
+        out[..., :3] = self.denoiser.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
+                                             prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+        return out, True
+
+
+def view_denoise(scene) -> ViewDenoise | None:
+    """The viewport's denoising of ``scene``: None when off, where Blender has no OpenImageDenoise, or
+    when its library fails to load (one line in the console: the viewport goes on, noisy)."""
+    path = oidn_library()
+    if not scene.drt.use_preview_denoising or path is None:
+        return None
+    from ..core.film.denoiser import load
+
+    try:
+        return ViewDenoise(load(path), scene.drt.preview_denoising_start_sample)
+    except DRTError as error:
+        print(f"DRT: the viewport is not denoised: {one_line(str(error))}")
+        return None
 
 
 class ViewportSession:
@@ -65,6 +112,7 @@ class ViewportSession:
         self.meshes = MeshCache()
         self.scene = None  # SceneData of the last view_update
         self.settings = None
+        self.denoise = None  # ViewDenoise, or None: the viewport is not denoised
         self.key = None  # region size and matrices the running render is for
         self.texture = None
         weakref.finalize(engine, self.worker.stop)  # Blender frees the engine: stop the worker
@@ -88,6 +136,7 @@ class ViewportSession:
         self.scene = scene_data
         self.settings = viewport_settings(settings_from_scene(depsgraph.scene, depsgraph.view_layer),
                                           depsgraph.scene.drt.preview_samples)
+        self.denoise = view_denoise(depsgraph.scene)
         self.key = None  # draw restarts the render with the region's camera
 
     def draw(self, engine, context, depsgraph) -> None:
@@ -102,7 +151,7 @@ class ViewportSession:
                    tuple(map(tuple, region_data.window_matrix)))
             if key != self.key:
                 cameras = level_cameras(viewport_camera(region, region_data))
-                self.worker.start(self.scene, cameras, self.settings)
+                self.worker.start(self.scene, cameras, self.settings, self.denoise)
                 self.key = key
         version, image = self.worker.latest()
         if self.worker.status:
@@ -134,14 +183,14 @@ class ViewportRender:
         self._prepared = None  # (SceneData, PreparedScene) of the newest scene prepared
         self._prepare_lock = threading.Lock()
 
-    def start(self, scene_data, cameras, settings) -> None:
+    def start(self, scene_data, cameras, settings, denoise: ViewDenoise | None = None) -> None:
         """Stop the running worker (without waiting for it) and render ``scene_data`` seen by
         ``cameras``: coarse to fine, the same view at growing resolutions, one sample each but
-        the last, which takes ``settings.samples``."""
+        the last, which takes ``settings.samples`` (denoised by ``denoise`` from its start sample)."""
         self._stop.set()
         stop = threading.Event()
         self._stop = stop
-        self._thread = threading.Thread(target=self._run, args=(scene_data, cameras, settings, stop),
+        self._thread = threading.Thread(target=self._run, args=(scene_data, cameras, settings, stop, denoise),
                                         name="DRT viewport", daemon=True)
         self._thread.start()
 
@@ -178,7 +227,7 @@ class ViewportRender:
                 self._prepared = (scene_data, self._prepared[1].update(scene_data))
             return self._prepared[1]
 
-    def _run(self, scene_data, cameras, settings, stop: threading.Event) -> None:
+    def _run(self, scene_data, cameras, settings, stop: threading.Event, denoise=None) -> None:
         from ..core.render.render import Renderer
 
         try:
@@ -194,22 +243,31 @@ class ViewportRender:
                     return
                 width, height = camera.resolution
                 self._publish(result.passes["Combined"], stop, f"Preview {width} x {height}")
-            renderer = Renderer(dataclasses.replace(scene_data, camera=cameras[-1]), settings, prepared)
+            full = denoise.settings(settings) if denoise is not None else settings
+            renderer = Renderer(dataclasses.replace(scene_data, camera=cameras[-1]), full, prepared)
             last = [0.0]
+
+            def shown(passes, samples):
+                if denoise is None:
+                    return passes["Combined"], ""
+                image, denoised = denoise.image(passes, samples)
+                return image, " | Denoised" if denoised else ""
 
             def progress(update) -> bool:
                 if stop.is_set():
                     return False
                 now = time.monotonic()
                 if update.entry is not None or (now - last[0] >= PUBLISH_INTERVAL and update.samples_everywhere):
-                    last[0] = now
-                    self._publish(update.passes()["Combined"], stop,
-                                  stats_line(update.samples_done, update.samples_total, update.error, update.elapsed))
+                    image, note = shown(update.passes(), update.samples_everywhere)
+                    last[0] = time.monotonic()  # the next image waits a whole interval after this one
+                    self._publish(image, stop, stats_line(update.samples_done, update.samples_total, update.error,
+                                                          update.elapsed) + note)
                 return not stop.is_set()
 
             result = renderer.render(progress=progress)
             if not result.cancelled:
-                self._publish(result.passes["Combined"], stop, done_line(result.stats, False))
+                image, note = shown(result.passes, result.stats["samples"])  # no adaptive sampling here
+                self._publish(image, stop, done_line(result.stats, False) + note)
         except DRTError as error:
             self._fail(" ".join(str(error).split()), stop)
         except Exception as error:  # a bug of ours: keep the UI alive, details in the console

@@ -15,3 +15,7 @@ class RenderCancelled(DRTError):
 
 class SettingsError(DRTError, ValueError):
     """Render settings that contradict each other (a sample range with adaptive sampling...)."""
+
+
+class DenoiserError(DRTError):
+    """OpenImageDenoise is missing, cannot be loaded, or reported an error."""

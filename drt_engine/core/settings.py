@@ -38,7 +38,16 @@ PASS_CHANNELS = {
     "Noise": "RGB",
     "Denoising Albedo": "RGB",
     "Denoising Normal": "XYZ",
+    "Noisy Image": "RGBA",
 }
+NOISY_IMAGE = "Noisy Image"
+"""With denoising on, the Combined image as rendered, before OIDN (Cycles' pass of that name); not
+one of ``PASSES``: the render adds it, no setting asks for it."""
+
+DENOISING_PREFILTERS = ("NONE", "FAST", "ACCURATE")
+"""Cycles' ``denoising_prefilter``: how the albedo and normal are cleaned (core.film.denoiser)."""
+DENOISING_QUALITIES = ("HIGH", "BALANCED", "FAST")
+"""Cycles' ``denoising_quality``."""
 
 
 @dataclass
@@ -64,6 +73,11 @@ class RenderSettings:
     # Cycles from Blender 5.2 on scales Denoising Normal by the feature walk's mean throughput
     # (measured: seen in a mirror of tint t, |n| = mean(t)); 5.0 and older write unit normals
     weighted_denoising_normal: bool = False
+    # OpenImageDenoise over the finished Combined image (core.render.denoise), guided by the
+    # Denoising Albedo and Normal (traced for it even when not asked for as passes)
+    use_denoising: bool = False
+    denoising_prefilter: str = "ACCURATE"
+    denoising_quality: str = "HIGH"
     extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -76,6 +90,12 @@ class RenderSettings:
         if self.shadow_estimator not in SHADOW_ESTIMATORS:
             raise SettingsError(f"unknown shadow estimator {self.shadow_estimator!r} "
                                 f"(one of {', '.join(SHADOW_ESTIMATORS)})")
+        if self.denoising_prefilter not in DENOISING_PREFILTERS:
+            raise SettingsError(f"unknown denoising prefilter {self.denoising_prefilter!r} "
+                                f"(one of {', '.join(DENOISING_PREFILTERS)})")
+        if self.denoising_quality not in DENOISING_QUALITIES:
+            raise SettingsError(f"unknown denoising quality {self.denoising_quality!r} "
+                                f"(one of {', '.join(DENOISING_QUALITIES)})")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         unknown = set(self.passes) - set(PASSES)

@@ -7,6 +7,7 @@ import math
 
 import bpy
 import numpy as np
+import pytest
 
 from tests.support.datablocks import new_compositor, new_material
 from tests.support.render_helpers import ROOT, read_channels, save_side_by_side, set_exr_output, set_resolution
@@ -181,3 +182,166 @@ def test_the_cli_exr_carries_the_passes(bl, tmp_path):
     assert {"Denoising Albedo", "Denoising Normal"} <= bl.passes_in(channels, LAYER)
     np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Denoising Albedo"), 0.5, rtol=1e-5)
     np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Denoising Normal"), 0.0)
+
+
+# -- Denoising built in (scene.drt.use_denoising) ----------------------------------------------
+
+class _Recorder:
+    """Stands in for a UILayout: records what a panel's draw asks of it."""
+
+    def __init__(self, log):
+        self.log = log
+        self.enabled = self.active = True
+
+    def _child(self):
+        child = _Recorder(self.log)
+        self.log.append(child)
+        return child
+
+    row = column = lambda self, **kw: self._child()
+
+    def prop(self, data, name, **kw):
+        self.log.append(("prop", name, self))
+
+    def label(self, text="", **kw):
+        self.log.append(("label", text, self))
+
+
+def _draw(panel, scene):
+    from types import SimpleNamespace
+
+    log = []
+    panel.draw(SimpleNamespace(layout=_Recorder(log)), SimpleNamespace(scene=scene))
+    props = {entry[1]: entry[2] for entry in log if isinstance(entry, tuple) and entry[0] == "prop"}
+    labels = [entry[1] for entry in log if isinstance(entry, tuple) and entry[0] == "label"]
+    return props, labels
+
+
+def test_the_denoise_setting_greys_out_with_the_reason_where_blender_has_no_oidn(drt, monkeypatch):
+    from drt_engine.blender import oidn
+    from drt_engine.blender.ui import DRT_PT_sampling_denoise
+
+    scene = bpy.context.scene
+    names = ("use_denoising", "use_preview_denoising", "denoising_prefilter", "denoising_quality",
+             "preview_denoising_start_sample")
+    assert oidn.oidn_library() is not None  # the bpy 5.0 wheel ships it
+    props, labels = _draw(DRT_PT_sampling_denoise, scene)
+    assert all(props[name].enabled for name in names) and not labels
+    monkeypatch.setattr(oidn, "search", lambda: None)  # as in Debian's Blender 4.3.2
+    props, labels = _draw(DRT_PT_sampling_denoise, scene)
+    assert not any(props[name].enabled for name in names)
+    assert labels == [oidn.UNAVAILABLE] and "OpenImageDenoise" in labels[0]
+
+
+def _denoise_scene(sample_scene):
+    bpy.ops.wm.open_mainfile(filepath=str(sample_scene("cornell_box")), load_ui=False)
+    scene = bpy.context.scene
+    scene.render.engine = "DRT"
+    set_resolution(scene, 48, 48)
+    drt = scene.drt
+    drt.samples, drt.seed, drt.use_adaptive_sampling, drt.time_limit, drt.target_error = 8, 1, False, 0.0, 0.0
+    return scene
+
+
+def _render_passes(scene, path):
+    set_exr_output(scene, path)
+    assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
+    channels = read_channels(path)
+    layer_passes = {key[len(LAYER) + 1:].rsplit(".", 1)[0] for key in channels if key.startswith(LAYER + ".")}
+    return channels, layer_passes
+
+
+def _rgba(channels, name):
+    return np.stack([channels[f"{LAYER}.{name}.{c}"] for c in "RGBA"], axis=-1)
+
+
+def test_a_denoised_render_keeps_the_render_as_noisy_image(drt, sample_scene, tmp_path):
+    from drt_engine.blender.hooks import render_hooks
+    from drt_engine.blender.status import done_line
+
+    scene = _denoise_scene(sample_scene)
+    plain, plain_passes = _render_passes(scene, tmp_path / "plain.exr")
+    assert "Noisy Image" not in plain_passes
+    scene.drt.use_denoising = True
+    denoised, passes = _render_passes(scene, tmp_path / "denoised.exr")
+    assert passes == {"Combined", "Noisy Image"}  # the features guide OIDN but are not written
+    np.testing.assert_array_equal(_rgba(denoised, "Noisy Image"), _rgba(plain, "Combined"))
+    assert not np.array_equal(_rgba(denoised, "Combined")[..., :3], _rgba(plain, "Combined")[..., :3])
+    stats = render_hooks.last_reports[LAYER]["stats"]
+    assert 0 < stats["relmse_denoised"] < stats["relmse"]
+    assert stats["denoising"] == {"prefilter": "ACCURATE", "quality": "HIGH", "seconds": stats["denoising"]["seconds"]}
+    assert render_hooks.last_reports[LAYER]["log"][-1]["relmse_denoised"] == stats["relmse_denoised"]
+    assert render_hooks.last_reports[LAYER]["settings"]["use_denoising"] is True
+    assert "(denoised " in done_line(stats, False)
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(tmp_path / "denoised.exr"))
+    metadata = {a.name: a.value for a in image.spec().extra_attribs}
+    image.close()
+    assert float(metadata[f"drt.{LAYER}.est_relmse_denoised"]) == pytest.approx(stats["relmse_denoised"], rel=1e-5)
+
+
+def test_without_oidn_a_denoised_render_is_a_warning_and_the_noisy_image(drt, sample_scene, tmp_path, monkeypatch):
+    from drt_engine.blender import final, oidn
+    from drt_engine.blender.hooks import render_hooks
+
+    warnings = []
+    monkeypatch.setattr(oidn, "search", lambda: None)
+    monkeypatch.setattr(final, "_warn", lambda engine, messages: warnings.extend(messages))
+    scene = _denoise_scene(sample_scene)
+    scene.drt.use_denoising = True
+    _, passes = _render_passes(scene, tmp_path / "no_oidn.exr")
+    assert passes == {"Combined"}
+    assert f"{oidn.UNAVAILABLE}; the image is not denoised" in warnings
+    assert "relmse_denoised" not in render_hooks.last_reports[LAYER]["stats"]
+
+
+def test_denoising_adds_the_noisy_image_socket_to_render_layers(drt):
+    scene = mirror_and_paint_scene()
+    scene.render.engine = "DRT"
+    node = new_compositor(scene).nodes.new("CompositorNodeRLayers")
+    node.scene, node.layer = scene, LAYER
+    assert "Noisy Image" not in {s.name for s in node.outputs if s.enabled}
+    scene.drt.use_denoising = True
+    assert "Noisy Image" in {s.name for s in node.outputs if s.enabled}
+    scene.drt.use_denoising = False
+    assert "Noisy Image" not in {s.name for s in node.outputs if s.enabled}
+
+
+def test_the_cli_denoises_a_scene_saved_with_denoise_on(drt, sample_scene, tmp_path):
+    """No --denoise flag yet: the scene's own setting is what the CLI renders with."""
+    from test_cli import run_cli
+
+    scene = _denoise_scene(sample_scene)
+    scene.drt.samples, scene.drt.use_denoising = 4, True
+    blend = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    out = tmp_path / "out.exr"
+    result = run_cli("render", blend, "-o", out)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert f"{LAYER}.Noisy Image.R" in read_channels(out)
+    stats = json.loads((tmp_path / "out.drt.json").read_text())["stats"]
+    assert 0 < stats["relmse_denoised"] < stats["relmse"]
+
+
+def test_the_viewport_denoises_only_when_asked_and_where_blender_has_oidn(drt, monkeypatch):
+    from drt_engine.blender import oidn
+    from drt_engine.blender.viewport import ViewDenoise, view_denoise
+
+    scene = bpy.context.scene
+    scene.drt.use_preview_denoising, scene.drt.preview_denoising_start_sample = False, 3
+    assert view_denoise(scene) is None
+    scene.drt.use_preview_denoising = True
+    denoise = view_denoise(scene)
+    assert isinstance(denoise, ViewDenoise) and denoise.start_sample == 3
+    monkeypatch.setattr(oidn, "search", lambda: None)
+    assert view_denoise(scene) is None
+
+
+def test_the_settings_choices_are_the_cores(drt):
+    from drt_engine.core.settings import DENOISING_PREFILTERS, DENOISING_QUALITIES
+
+    props = bpy.types.Scene.bl_rna.properties["drt"].fixed_type.properties
+    assert tuple(i.identifier for i in props["denoising_prefilter"].enum_items) == DENOISING_PREFILTERS
+    assert tuple(i.identifier for i in props["denoising_quality"].enum_items) == DENOISING_QUALITIES
+    assert props["use_denoising"].default is False and props["denoising_prefilter"].default == "ACCURATE"

@@ -56,3 +56,31 @@ def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
     viewport.start(other, [other.camera], settings)
     finish(viewport)
     assert viewport._prepared[1] is not prepared[0]
+
+
+def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_render():
+    """Below the start sample the image is as traced; from it on, denoised on the worker thread: the
+    last image is the render's Combined through the same denoiser (Fast prefilter, Balanced quality,
+    the features traced with it)."""
+    from drt_engine.blender.viewport import VIEWPORT_PREFILTER, VIEWPORT_QUALITY, ViewDenoise
+    from drt_engine.core.film import denoiser
+    from tests.support.oidn import require_oidn
+
+    oidn = denoiser.load(require_oidn())
+    base = scene()
+    settings = RenderSettings(samples=4, threads=1)
+    camera = Camera(look_at((0, -5, 2), (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (48, 32))
+    moved = dataclasses.replace(base, camera=camera)
+    denoise = ViewDenoise(oidn, start_sample=2)
+    passes = Renderer(moved, denoise.settings(settings), PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes
+    denoised = passes["Combined"].copy()
+    denoised[..., :3] = oidn.denoise(passes["Combined"], passes["Denoising Albedo"], passes["Denoising Normal"],
+                                     prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+    for start, expected, note in ((2, denoised, True), (5, passes["Combined"], False)):
+        statuses = []
+        viewport = ViewportRender(lambda: statuses.append(viewport.status))
+        viewport.start(base, level_cameras(camera), settings, dataclasses.replace(denoise, start_sample=start))
+        image = finish(viewport)
+        assert statuses[-1].startswith("Done") and statuses[-1].endswith("| Denoised") == note, statuses[-1]
+        np.testing.assert_array_equal(image, expected.astype(np.float32))
+    assert not np.array_equal(denoised[..., :3], passes["Combined"][..., :3])

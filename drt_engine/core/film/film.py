@@ -236,14 +236,15 @@ class Film:
         """Slices covering the film a bounded block of pixels at a time."""
         return [slice(a, a + _IMAGE_BLOCK) for a in range(0, self.n, _IMAGE_BLOCK)]
 
-    def images(self) -> dict[str, np.ndarray]:
-        """Each enabled pass as (height, width, channels) float32, rows from the bottom.
+    def images(self, names=None) -> dict[str, np.ndarray]:
+        """Each enabled pass (or those of ``names``) as (height, width, channels) float32, rows
+        from the bottom.
 
         Computed a block of pixels at a time into the float32 result, so no float64 copy
         of a whole pass is ever held (an 8K Combined pass is 1 GB in float64).
         """
         out = {}
-        for name in self.passes:
+        for name in self.passes if names is None else [n for n in self.passes if n in names]:
             img = np.empty((self.n, len(PASS_CHANNELS[name])), np.float32)
             for span in self.blocks():
                 img[span] = self._pass_block(name, span)

@@ -47,7 +47,7 @@ class DriveOutcome:
     elapsed: float
 
 
-def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None) -> DriveOutcome:
+def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None, denoised=None) -> DriveOutcome:
     """Trace rounds of samples up to each checkpoint, then log, test and apply the stop rules.
 
     Only active pixels are traced: a round gives every active pixel the samples it lacks to
@@ -55,7 +55,9 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None) -> D
     the render, adaptive.allocate), sample after sample over the active pixels (so a round cut
     short leaves an even image), in waves of at most WAVE. Each pixel draws sample ids 0, 1,
     2, ... in order, so its sequence stays stratified. ``trace(pixel, sample)`` adds a wave to
-    ``film``; ``rays`` is the ray count by kind the log reports.
+    ``film``; ``rays`` is the ray count by kind the log reports. ``denoised()``, when given (denoising
+    on), returns the denoised image's estimated error (core.render.denoise) for the log entry of each
+    step once every pixel has a sample in both halves; the target error then applies to it.
     """
     start = time.perf_counter()
     log = ErrorLog()
@@ -117,11 +119,14 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None) -> D
             active = np.flatnonzero(mask & (film.count < cap))
             allocating = s.adaptive_mode == "NOISE"
         entry = log.record(time.perf_counter() - start, film, rays, unconverged)
+        if denoised is not None and film.count.min() >= 2:
+            entry.update(denoised())
+        error = entry.get("relmse_denoised", entry["relmse"])
         if film.count.min() >= cap if allocating else target == cap:
             stopped = "samples"
         elif len(active) == 0:
             stopped = "threshold"
-        elif s.target_error > 0 and film.count.min() >= 4 and entry["relmse"] < s.target_error:
+        elif s.target_error > 0 and film.count.min() >= 4 and error < s.target_error:
             stopped = "target_error"
         elif s.time_limit > 0 and entry["elapsed"] >= s.time_limit:
             stopped = "time_limit"
@@ -131,7 +136,9 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None) -> D
             entry["stopped"] = stopped
             break
     if stopped in ("time_limit", "cancelled") and (not log.last or "stopped" not in log.last):
-        log.record(time.perf_counter() - start, film, rays, unconverged, stopped)
+        entry = log.record(time.perf_counter() - start, film, rays, unconverged, stopped)
+        if denoised is not None and stopped == "time_limit" and film.count.min() >= 2:
+            entry.update(denoised())
     return DriveOutcome(stopped or "samples", log, threshold, first, time.perf_counter() - start)
 
 

@@ -7,6 +7,7 @@ adaptive.replicate_samplers), so the film's two halves are independent estimates
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -14,16 +15,18 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..base import jit
-from ..errors import SceneError
+from ..errors import SceneError, SettingsError
+from ..film.denoising import PASSES as FEATURE_PASSES
 from ..film.film import Film
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import RenderSettings
+from ..settings import NOISY_IMAGE, RenderSettings
 from ..validate import validate_camera
 from . import adaptive
+from .denoise import denoise_film
 from .driver import WAVE, ProgressUpdate, drive
 from .prepared import PreparedScene
 
@@ -45,10 +48,13 @@ class Renderer:
     """Renders one SceneData with one RenderSettings.
 
     ``prepared`` (core.render.prepared.PreparedScene) reuses the Embree scenes, lights and materials
-    built for the same scene with another camera; without it they are built here.
+    built for the same scene with another camera; without it they are built here. ``denoiser``
+    (core.film.denoiser.Denoiser) is the OpenImageDenoise that ``use_denoising`` runs; the caller
+    finds the library (the core never looks for one).
     """
 
-    def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None):
+    def __init__(self, scene: SceneData, settings: RenderSettings, prepared: PreparedScene | None = None,
+                 denoiser=None):
         if scene.camera is None:
             raise SceneError("the scene has no camera")
         if prepared is None:
@@ -59,6 +65,15 @@ class Renderer:
             validate_camera(scene.camera)
         self.prepared = prepared
         self.scene, self.settings, self.camera = scene, settings, scene.camera
+        self.denoiser = denoiser
+        self.denoising = settings.use_denoising and not settings.partial
+        self._denoised = None  # (samples in the film, core.render.denoise.Denoised) of the newest denoising
+        self._denoise_seconds = 0.0
+        if self.denoising and denoiser is None:
+            raise SettingsError("denoising is on but no OpenImageDenoise library was found")
+        if self.denoising:  # the features guide the denoiser: traced even when not asked for as passes
+            settings = dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
+                name for name in FEATURE_PASSES if name not in settings.passes))
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
@@ -98,7 +113,11 @@ class Renderer:
                     self._trace(Samples(half.index, half.pixel, half.sample >> 1), sampler, r, pool)
 
         try:
-            outcome = drive(s, self.film, cap, trace, self.rays, progress)
+            # with a target error, every step denoises (3 OIDN runs) to know whether the denoised image
+            # is there yet; without one, only the finished image is denoised
+            stepwise = self.denoising and s.target_error > 0
+            outcome = drive(s, self.film, cap, trace, self.rays, progress,
+                            denoised=self._denoised_figures if stepwise else None)
         finally:
             if pool is not None:
                 pool.shutdown(wait=True)
@@ -146,5 +165,46 @@ class Renderer:
                  "adaptive_threshold": outcome.threshold if s.use_adaptive_sampling else None,
                  "adaptive_first_test": outcome.first if s.use_adaptive_sampling else None,
                  "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
-        return RenderResult(film.images(), stats, outcome.stopped == "cancelled", list(self.warnings),
-                            outcome.log.entries)
+        passes = film.images()
+        warnings = list(self.warnings)
+        if s.use_denoising and s.partial:
+            warnings.append("this render is one range of the samples (a farm part): it is not denoised; "
+                            "denoise the merged image")
+        if self.denoising and outcome.stopped != "cancelled":
+            passes = self._denoise(passes, stats, outcome.log.last)
+        return RenderResult(passes, stats, outcome.stopped == "cancelled", warnings, outcome.log.entries)
+
+    def _denoise_film(self):
+        """The film's image denoised (core.render.denoise), once per sample total: the step that ends
+        a render and the result share one denoising."""
+        s, samples = self.settings, float(self.film.count.sum())
+        if self._denoised is None or self._denoised[0] != samples:
+            features = self.film.images(FEATURE_PASSES)
+            denoised = denoise_film(self.film, features, self.denoiser, s.denoising_prefilter, s.denoising_quality)
+            self._denoised = samples, denoised
+            self._denoise_seconds += denoised.seconds
+        return self._denoised[1]
+
+    def _denoised_figures(self) -> dict:
+        """The denoised image's estimated error as the log and stats name it."""
+        e = self._denoise_film().error
+        return {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
+                "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
+
+    def _denoise(self, passes: dict, stats: dict, last: dict | None) -> dict:
+        """Combined denoised (alpha as rendered), the rendered one kept as Noisy Image, features
+        the user did not ask for dropped; the denoised image's estimated error in ``stats`` and
+        the log's last entry, beside the noisy image's (core.render.denoise). With a target error
+        every step of the log has it too (driver.drive), and the target applies to it."""
+        s = self.settings
+        figures = self._denoised_figures()
+        noisy = passes["Combined"]
+        combined = noisy.copy()
+        combined[..., :3] = self._denoised[1].rgb
+        out = {name: image for name, image in passes.items() if name in s.passes}
+        out["Combined"], out[NOISY_IMAGE] = combined, noisy
+        stats.update(figures, denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
+                                         "seconds": self._denoise_seconds})
+        if last is not None:
+            last.update(figures)
+        return out

@@ -3,8 +3,9 @@
 Every adaptive step of ``Renderer.render`` appends one entry: seconds since the start
 (wall clock, and CPU seconds of the process, which a loaded machine disturbs less),
 camera samples traced, rays by kind, the fraction of pixels still sampling and the
-estimated RMSE and relMSE of the image (``adaptive.image_error``). The CLI writes the
-log as ``<stem>.drt.json`` and draws it as ``<stem>.error.png``.
+estimated RMSE and relMSE of the image (``adaptive.image_error``); with denoising on, the last
+entry also holds the denoised image's (``rmse_denoised``, ``relmse_denoised``: core.render.denoise).
+The CLI writes the log as ``<stem>.drt.json`` and draws it as ``<stem>.error.png``.
 """
 from __future__ import annotations
 
@@ -195,4 +196,7 @@ def plot_log(path, logs: dict[str, list[dict]], title: str = "") -> None:
     for layer, log in logs.items():
         suffix = f" {layer}" if len(logs) > 1 else ""
         curves += [(f"est. relMSE{suffix}", error_curve(log, "relmse")), (f"est. RMSE{suffix}", error_curve(log, "rmse"))]
+        denoised = error_curve(log, "relmse_denoised")
+        if denoised:  # one point: the finished image denoised
+            curves.append((f"est. relMSE denoised{suffix}", denoised))
     plot_loglog(path, curves, title or "estimated error vs time", ylabel="error")

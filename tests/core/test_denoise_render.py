@@ -1,0 +1,151 @@
+"""A render with ``use_denoising``: Combined denoised, the image as traced kept as Noisy Image, and
+the denoised image's error estimated from the film's two replicate halves (core.render.denoise).
+
+The scene is the soft-shadow scene (a sphere and a cube under a rectangular area light, 48x36
+pixels): its error sits in the penumbrae, where OIDN has real work to do. The reference is a
+512-sample render of another seed, its own variance taken off the true errors.
+"""
+import numpy as np
+import pytest
+
+from drt_engine.core.errors import SettingsError
+from drt_engine.core.film import denoiser
+from drt_engine.core.render.adaptive import true_error
+from drt_engine.core.render.denoise import denoised_error
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.settings import NOISY_IMAGE, RenderSettings
+from tests.support.oidn import require_oidn
+from tests.support.scenes import soft_shadow_scene
+
+WIDTH, SPP, REFERENCE_SPP = 48, 8, 512
+ESTIMATE_FACTOR = 2.0
+"""The denoised error estimate is within this factor of the true error (issue 25's target); measured
+here: 0.86 of it (its noise part alone, the halves' denoised difference, 0.68)."""
+DENOISED_GAIN = 0.65
+"""The denoised image's true relMSE is under this fraction of the noisy one's (measured 0.48 at 8 spp;
+this small scene's penumbrae and edges leave OIDN less to gain than a larger image would)."""
+
+
+@pytest.fixture(scope="module")
+def oidn():
+    return denoiser.load(require_oidn())
+
+
+def render(oidn=None, samples=SPP, seed=1, **kw):
+    scene, base = soft_shadow_scene(WIDTH)
+    settings = RenderSettings(**{**base, "samples": samples, "seed": seed, "passes": ("Combined", "Noise"), **kw})
+    return Renderer(scene, settings, denoiser=oidn).render()
+
+
+@pytest.fixture(scope="module")
+def reference():
+    result = render(samples=REFERENCE_SPP, seed=7)
+    return result.passes["Combined"][..., :3], result.passes["Noise"] ** 2
+
+
+@pytest.fixture(scope="module")
+def pair(oidn):
+    return render(oidn, use_denoising=True), render()
+
+
+def test_noisy_image_is_the_render_without_denoising(pair):
+    denoised, plain = pair
+    np.testing.assert_array_equal(denoised.passes[NOISY_IMAGE], plain.passes["Combined"])
+    np.testing.assert_array_equal(denoised.passes["Noise"], plain.passes["Noise"])
+    assert denoised.stats["relmse"] == plain.stats["relmse"]  # the noisy estimate is unchanged
+    combined = denoised.passes["Combined"]
+    assert not np.array_equal(combined[..., :3], plain.passes["Combined"][..., :3])
+    np.testing.assert_array_equal(combined[..., 3], plain.passes["Combined"][..., 3])  # alpha as rendered
+    assert np.isfinite(combined).all()
+
+
+def test_features_are_traced_for_the_denoiser_but_written_only_when_asked(oidn, pair):
+    denoised, _ = pair
+    assert set(denoised.passes) == {"Combined", "Noise", NOISY_IMAGE}
+    asked = render(oidn, samples=2, use_denoising=True,
+                   passes=("Combined", "Denoising Albedo", "Denoising Normal"))
+    assert set(asked.passes) == {"Combined", "Denoising Albedo", "Denoising Normal", NOISY_IMAGE}
+
+
+def test_denoised_is_closer_to_the_reference_and_its_estimate_is_calibrated(pair, reference):
+    denoised, plain = pair
+    ref, ref_var = reference
+    noisy_true = true_error(plain.passes["Combined"][..., :3], ref, ref_var)[1]
+    denoised_true = true_error(denoised.passes["Combined"][..., :3], ref, ref_var)[1]
+    estimate = denoised.stats["relmse_denoised"]
+    print(f"{SPP} spp relMSE: noisy {noisy_true:.3g} (est. {plain.stats['relmse']:.3g}), "
+          f"denoised {denoised_true:.3g} (est. {estimate:.3g}, its noise part {denoised.stats['relmse_denoised_noise']:.3g})")
+    assert denoised_true < DENOISED_GAIN * noisy_true
+    assert 1 / ESTIMATE_FACTOR < estimate / denoised_true < ESTIMATE_FACTOR
+    assert 0 < denoised.stats["relmse_denoised_noise"] <= estimate
+    assert denoised.log[-1]["relmse_denoised"] == estimate  # in the log beside the noisy estimate
+    assert denoised.stats["denoising"]["prefilter"] == "ACCURATE"
+
+
+def _box3(image):
+    """A linear 'denoiser': the 3x3 box mean (edges repeated), which blurs detail as well as noise."""
+    h, w = image.shape[:2]
+    pad = np.pad(image, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    return sum(pad[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9.0
+
+
+def test_the_estimate_sees_the_noise_left_and_the_blur_of_a_linear_denoiser(monkeypatch):
+    """Truth: stripes one pixel wide (detail a 3x3 box blurs away) plus a gradient; two halves of
+    independent noise; D = box(N). For a linear smoother both parts of the estimate are unbiased:
+    the noise part is D's variance, the whole is D's mean squared error, blur included."""
+    rng = np.random.default_rng(5)
+    h, w = 200, 200
+    y, x = np.mgrid[0:h, 0:w]
+    truth = (0.3 + 0.4 * (x % 2) + 0.2 * y / h)[..., None] * np.ones(3)
+    sigma = 0.3
+    noisy_a = truth + sigma * rng.standard_normal(truth.shape)
+    noisy_b = truth + sigma * rng.standard_normal(truth.shape)
+    noisy = 0.5 * (noisy_a + noisy_b)
+    d, da, db = _box3(noisy), _box3(noisy_a), _box3(noisy_b)
+    n, na = np.full(h * w, 8.0), np.full(h * w, 4.0)
+    est = denoised_error(d, da, db, noisy_a, noisy_b, n, na)
+    true_mse = float(((d - truth) ** 2).mean())
+    blur = float(((_box3(truth) - truth) ** 2).mean())
+    variance = (sigma ** 2 / 2) / 9  # the box of 9 independent pixels of the full image's noise
+    assert est["rmse_noise"] ** 2 == pytest.approx(variance, rel=0.05)
+    assert est["rmse"] ** 2 == pytest.approx(true_mse, rel=0.05)
+    assert blur > 5 * variance  # the blur dominates: the noise part alone would miss most of the error
+    assert est["relmse"] > 5 * est["relmse_noise"]
+    unknown = denoised_error(d, da, db, noisy_a, noisy_b, n, np.where(np.arange(h * w) == 7, 0.0, na))
+    assert unknown["relmse"] == np.inf  # a pixel without half B
+    from drt_engine.core.render import denoise
+
+    monkeypatch.setattr(denoise, "ERROR_BLOCK", 999)  # in blocks of pixels, the same sums
+    assert denoised_error(d, da, db, noisy_a, noisy_b, n, na) == pytest.approx(est, rel=1e-12)
+
+
+def test_denoising_without_a_library_is_a_settings_error():
+    scene, base = soft_shadow_scene(8)
+    with pytest.raises(SettingsError, match="OpenImageDenoise"):
+        Renderer(scene, RenderSettings(**base, samples=2, use_denoising=True))
+
+
+def test_a_farm_part_is_not_denoised(oidn):
+    part = render(oidn, samples=4, use_denoising=True, sample_start=0, sample_end=2)
+    assert NOISY_IMAGE not in part.passes and "relmse_denoised" not in part.stats
+    assert any("not denoised" in w for w in part.warnings)
+
+
+def test_the_denoised_estimate_is_logged_at_the_end_or_with_a_target_at_every_step(oidn, pair):
+    denoised, plain = pair
+    assert [("relmse_denoised" in entry) for entry in denoised.log] == [False] * (len(denoised.log) - 1) + [True]
+    assert all("relmse_denoised" not in entry for entry in plain.log)
+    targeted = render(oidn, samples=32, use_denoising=True, target_error=1e-9)  # never reached
+    steps = [entry for entry in targeted.log if entry["spp_max"] >= 2]
+    assert len(steps) >= 2 and all(0 < entry["relmse_denoised"] <= entry["relmse"] for entry in steps)
+
+
+def test_the_target_error_applies_to_the_denoised_image(oidn):
+    """The same target stops a denoised render sooner: its image reaches it with fewer samples."""
+    target = 2e-3
+    noisy = render(samples=64, target_error=target)
+    denoised = render(oidn, samples=64, target_error=target, use_denoising=True)
+    print(f"target {target}: noisy stops at {noisy.stats['samples']} spp, denoised at {denoised.stats['samples']}")
+    assert noisy.stats["stopped_by"] == denoised.stats["stopped_by"] == "target_error"
+    assert denoised.stats["samples"] < noisy.stats["samples"]
+    assert denoised.stats["relmse_denoised"] < target < denoised.stats["relmse"]
