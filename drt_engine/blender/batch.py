@@ -14,7 +14,7 @@ from pathlib import Path
 
 import bpy
 
-from . import register
+from . import oidn, register
 from .engine import DRTRenderEngine
 from .hooks import render_hooks
 
@@ -52,6 +52,11 @@ def use_drt(scene, resolution: tuple[int, int] | None = None) -> None:
     if resolution:
         render.resolution_x, render.resolution_y = resolution
         render.resolution_percentage = 100
+
+
+def denoising_unavailable() -> str | None:
+    """Why this Blender cannot denoise (it ships no OpenImageDenoise), or None when it can."""
+    return oidn.unavailable_reason()
 
 
 def set_settings(scene, **settings) -> None:

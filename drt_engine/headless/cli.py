@@ -104,6 +104,9 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--shadow-estimator", type=_one_of(SHADOW_ESTIMATORS), metavar="MONTE_CARLO|RATIO",
                         help="diffuse direct light of lights with a closed form: per shadow ray, or the "
                         "analytic light times the pixel's visible fraction (scene.drt.shadow_estimator)")
+    render.add_argument("--denoise", action="store_true",
+                        help="denoise Combined with the OpenImageDenoise library Blender ships, keeping the image "
+                        "as rendered as the Noisy Image pass (scene.drt.use_denoising); not with split renders")
     farm = render.add_argument_group(
         "render farm", "Split the render over processes or machines: sample ranges of a frame, frames of an "
         "animation. Parts need a fixed sample count (no adaptive sampling, time limit or target error).")

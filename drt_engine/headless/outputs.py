@@ -39,6 +39,8 @@ def write_output(output: Path, merger) -> None:
 
 def done_line(output: Path, width: int, height: int, stats: dict, elapsed: float, samples: str | None = None) -> str:
     error = report.relative_error_text(stats["relmse"])
+    if stats.get("relmse_denoised") is not None:
+        error += f" (denoised {report.relative_error_text(stats['relmse_denoised'])})"
     samples = samples or f"{stats['samples']} samples"
     return (f"DRT: wrote {output} ({width}x{height}, {samples}, est. error {error}, "
             f"stopped by {report.STOP_REASONS[stats['stopped_by']]}, {elapsed:.1f} s) and its report")

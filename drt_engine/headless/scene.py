@@ -40,12 +40,15 @@ def open_scene(args, blend: Path):
     if scene.camera is None:
         raise CLIError(f"scene {scene.name!r} in {blend.name} has no camera")
     adaptive = (args.adaptive_threshold, args.adaptive_min_samples, args.adaptive_mode)
+    if args.denoise and batch.denoising_unavailable():
+        raise CLIError(f"--denoise: {batch.denoising_unavailable()}")
     batch.use_drt(scene, args.resolution)
     batch.set_settings(scene, samples=args.samples, seed=args.seed, threads=args.engine_threads,
                        time_limit=args.time_limit, target_error=args.target_error,
                        use_adaptive_sampling=True if any(v is not None for v in adaptive) else None,
                        adaptive_threshold=args.adaptive_threshold, adaptive_min_samples=args.adaptive_min_samples,
-                       adaptive_mode=args.adaptive_mode, shadow_estimator=args.shadow_estimator)
+                       adaptive_mode=args.adaptive_mode, shadow_estimator=args.shadow_estimator,
+                       use_denoising=True if args.denoise else None)
     return scene
 
 
