@@ -17,6 +17,8 @@ from ...core.shading import proctex
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
+RAMP_TABLE_SIZE = 256
+"""Cycles' RAMP_TABLE_SIZE: colour ramps and curves reach its kernel as this many + 1 samples."""
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
                      "Generic Data")
 
@@ -342,8 +344,6 @@ class Compiler:
         return i, names.index(output.identifier) if output.identifier in names else 0
 
     def _node_ShaderNodeSeparateColor(self, node, output):
-        if node.mode not in ("RGB", "HSV"):
-            return self._unsupported(node, f"Separate Color {node.mode}")
         return self._separate(node, output, node.mode, ("Red", "Green", "Blue"))
 
     def _node_ShaderNodeSeparateXYZ(self, node, output):
@@ -354,8 +354,6 @@ class Compiler:
         return self.op("combine", args, mode=mode), 0
 
     def _node_ShaderNodeCombineColor(self, node, output):
-        if node.mode not in ("RGB", "HSV"):
-            return self._unsupported(node, f"Combine Color {node.mode}")
         return self._combine(node, node.mode)
 
     def _node_ShaderNodeCombineXYZ(self, node, output):
@@ -363,13 +361,19 @@ class Compiler:
 
     def _node_ShaderNodeValToRGB(self, node, output):
         ramp = node.color_ramp
+        fac = self._in(node, "Fac", "float")
+        out = 0 if output.identifier == "Color" else 1
         if ramp.interpolation not in ("LINEAR", "CONSTANT", "EASE") or ramp.color_mode != "RGB":
-            self.issues.add(f"'{node.name}' Color Ramp {ramp.interpolation.title()} (rendered as Linear)")
+            # B-Spline, Cardinal, HSV and HSL blending: Blender's own values baked as Cycles bakes
+            # every ramp (blender/util.h colorramp_to_array), read back linearly
+            table = [ramp.evaluate(i / RAMP_TABLE_SIZE)[:] for i in range(RAMP_TABLE_SIZE + 1)]
+            return self.op("ramp", (fac,), interpolation="TABLE", table=np.array(table, float),
+                           interpolate=ramp.interpolation != "CONSTANT"), out
         elements = sorted(ramp.elements, key=lambda e: e.position)
         interpolation = ramp.interpolation if ramp.interpolation in ("CONSTANT", "EASE") else "LINEAR"
-        i = self.op("ramp", (self._in(node, "Fac", "float"),), positions=[e.position for e in elements],
+        i = self.op("ramp", (fac,), positions=[e.position for e in elements],
                     colors=[list(e.color) for e in elements], interpolation=interpolation)
-        return i, 0 if output.identifier == "Color" else 1
+        return i, out
 
     def _node_ShaderNodeTexChecker(self, node, output):
         args = (self._vector_or(node, "generated"), self._in(node, "Color1", "color"),
@@ -435,8 +439,99 @@ class Compiler:
         return self.op("clamp", args, type=node.clamp_type), 0
 
     def _node_ShaderNodeMapRange(self, node, output):
-        if node.data_type != "FLOAT":
-            return self._unsupported(node, "Map Range Vector")
+        if node.data_type == "FLOAT_VECTOR":
+            names = ("Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3")
+            args = [self.value(next(s for s in node.inputs if s.identifier == n), "vector") for n in names]
+            return self.op("map_range_vector", args, type=node.interpolation_type, clamp=node.clamp), 0
         names = ("Value", "From Min", "From Max", "To Min", "To Max", "Steps")
         args = [self._in(node, n, "float") for n in names]
         return self.op("map_range", args, type=node.interpolation_type, clamp=node.clamp), 0
+
+    # -- converters, colour and vector nodes that need tables or the shading point ----------------
+    def _normal_in(self, node):
+        """The node's Normal input when linked; unlinked, the hit's shading normal (no input)."""
+        socket = node.inputs.get("Normal")
+        return [self.ref(self.value(socket, "vector"))] if socket is not None and socket.is_linked else []
+
+    def _node_ShaderNodeFresnel(self, node, output):
+        return self.op("fresnel", [self._in(node, "IOR", "float")] + self._normal_in(node)), 0
+
+    def _node_ShaderNodeLayerWeight(self, node, output):
+        i = self.op("layer_weight", [self._in(node, "Blend", "float")] + self._normal_in(node))
+        return i, 0 if output.identifier == "Fresnel" else 1
+
+    def _node_ShaderNodeBrightContrast(self, node, output):
+        args = (self._in(node, "Color", "color"), self._in(node, "Bright", "float"),
+                self._in(node, "Contrast", "float"))
+        return self.op("brightness", args), 0
+
+    def _curve_table(self, node, curves):
+        """Blender's own curves sampled as Cycles samples them (blender/util.h's
+        curvemapping_*_to_array): RAMP_TABLE_SIZE + 1 points over the x range of the curves'
+        end points, the RGB Curves' combined curve applied before each channel's."""
+        mapping = node.mapping
+        mapping.initialize()
+        mapping.update()
+        maps = list(mapping.curves)[:curves]
+        lo = min(m.points[0].location[0] for m in maps)
+        hi = max(m.points[-1].location[0] for m in maps)
+        xs = lo + np.arange(RAMP_TABLE_SIZE + 1) / RAMP_TABLE_SIZE * (hi - lo)
+        if curves == 1:
+            table = [[mapping.evaluate(maps[0], float(x))] for x in xs]
+        elif curves == 4:
+            table = [[mapping.evaluate(m, mapping.evaluate(maps[3], float(x))) for m in maps[:3]] for x in xs]
+        else:
+            table = [[mapping.evaluate(m, float(x)) for m in maps] for x in xs]
+        return dict(table=np.array(table, float), min=float(lo), max=float(hi),
+                    extrapolate=mapping.extend == "EXTRAPOLATED")
+
+    def _node_ShaderNodeRGBCurve(self, node, output):
+        args = (self._in(node, "Fac", "float"), self._in(node, "Color", "color"))
+        return self.op("curves", args, **self._curve_table(node, 4)), 0
+
+    def _node_ShaderNodeVectorCurve(self, node, output):
+        args = (self._in(node, "Fac", "float"), self._in(node, "Vector", "vector"))
+        return self.op("curves", args, **self._curve_table(node, 3)), 0
+
+    def _node_ShaderNodeFloatCurve(self, node, output):
+        args = (self._in(node, "Factor", "float"), self._in(node, "Value", "float"))
+        params = self._curve_table(node, 1)
+        params["table"] = params["table"][:, 0]
+        return self.op("float_curve", args, **params), 0
+
+    def _node_ShaderNodeVectorRotate(self, node, output):
+        args = [self._in(node, n, "vector") for n in ("Vector", "Center", "Axis")]
+        rotation = self._in(node, "Rotation", "vector") if node.rotation_type == "EULER_XYZ" else None
+        args += [self._in(node, "Angle", "float"), np.zeros(3) if rotation is None else rotation]
+        return self.op("vector_rotate", args, type=node.rotation_type, invert=bool(node.invert)), 0
+
+    def _node_ShaderNodeVectorTransform(self, node, output):
+        if self.world and "CAMERA" in (node.convert_from, node.convert_to):
+            return self._unsupported(node, "Vector Transform to or from camera space in the world")
+        return self.op("vector_transform", (self._in(node, "Vector", "vector"),), type=node.vector_type,
+                       **{"from": node.convert_from, "to": node.convert_to}), 0
+
+    def _node_ShaderNodeNormal(self, node, output):
+        direction = _const(node.outputs["Normal"].default_value)
+        if output.identifier == "Normal":
+            return direction / max(float(np.linalg.norm(direction)), 1e-30)
+        return self.op("normal", (self._in(node, "Normal", "vector"),), direction=direction), 1
+
+    def _node_ShaderNodeBlackbody(self, node, output):
+        return self.op("blackbody", (self._in(node, "Temperature", "float"),)), 0
+
+    def _node_ShaderNodeWavelength(self, node, output):
+        return self.op("wavelength", (self._in(node, "Wavelength", "float"),)), 0
+
+    # Blender 4.x's legacy colour nodes (5.0 opens them as Separate/Combine Color)
+    def _node_ShaderNodeSeparateRGB(self, node, output):
+        return self._separate(node, output, "RGB", ("R", "G", "B"))
+
+    def _node_ShaderNodeSeparateHSV(self, node, output):
+        return self._separate(node, output, "HSV", ("H", "S", "V"))
+
+    def _node_ShaderNodeCombineRGB(self, node, output):
+        return self._combine(node, "RGB")
+
+    def _node_ShaderNodeCombineHSV(self, node, output):
+        return self._combine(node, "HSV")

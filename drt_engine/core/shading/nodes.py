@@ -20,6 +20,7 @@ from ..base.colour import LUMINANCE
 from ..base.constants import TINY
 from ..base.vectors import orthonormal_basis
 from ..scene import Program
+from . import colornodes as cn
 from . import proctex
 from .textures import Texture, equirect_uv
 
@@ -159,11 +160,36 @@ def _blend(mode, t, c1, c2):
             return tm * c1 + t * ((1.0 - c1) * c2 * c1 + c1 * scr)
         if mode == "LINEAR_LIGHT":
             return c1 + t * (2.0 * c2 - 1.0)
+        if mode in HSV_BLENDS:
+            return _blend_hsv(mode, t, c1, c2)
     raise KeyError(mode)
 
 
+HSV_BLENDS = ("HUE", "SATURATION", "VALUE", "COLOR")
+
+
+def _blend_hsv(mode, t, c1, c2):
+    """Cycles' svm_mix_hue, _sat, _val and _color: c1's HSV with c2's hue, saturation or value
+    (hue and saturation for Color) blended in; Hue and Color keep c1 where c2 is grey,
+    Saturation where c1 is."""
+    hsv1, hsv2 = rgb_to_hsv(c1), rgb_to_hsv(c2)
+    t1 = t[:, 0]
+    if mode == "VALUE":
+        hsv1[:, 2] = (1.0 - t1) * hsv1[:, 2] + t1 * hsv2[:, 2]
+        return hsv_to_rgb(hsv1)
+    if mode == "SATURATION":
+        keep = hsv1[:, 1] == 0
+        hsv1[:, 1] = (1.0 - t1) * hsv1[:, 1] + t1 * hsv2[:, 1]
+        return np.where(keep[:, None], c1, hsv_to_rgb(hsv1))
+    hsv1[:, 0] = hsv2[:, 0]
+    if mode == "COLOR":
+        hsv1[:, 1] = hsv2[:, 1]
+    out = c1 + t * (hsv_to_rgb(hsv1) - c1)
+    return np.where((hsv2[:, 1] == 0)[:, None], c1, out)
+
+
 BLEND_MODES = ("MIX", "ADD", "MULTIPLY", "SUBTRACT", "SCREEN", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN",
-               "LIGHTEN", "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT")
+               "LIGHTEN", "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT") + HSV_BLENDS
 
 
 def rgb_to_hsv(c):
@@ -234,6 +260,31 @@ def _ramp(fac, positions, colors, interpolation):
     return out[:, :3], out[:, 3]
 
 
+def rotate_about_axis(v, axis, angle):
+    """Cycles' rotate_around_axis (Rodrigues' formula, right-handed) for unit axes (N, 3)."""
+    cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return v * cos + np.cross(axis, v) * sin + axis * (vec.dot(axis, v)[:, None] * (1.0 - cos))
+
+
+AXES = {"X_AXIS": (1.0, 0.0, 0.0), "Y_AXIS": (0.0, 1.0, 0.0), "Z_AXIS": (0.0, 0.0, 1.0)}
+
+
+def _vector_rotate(kind, invert, v, center, axis, angle, rotation):
+    """Cycles' svm_node_vector_rotate: about ``center``, by Euler angles (inverted: the
+    transposed rotation) or an angle (negated when inverted) about an axis; a zero axis
+    leaves the vector as it is."""
+    d = v - center
+    if kind == "EULER_XYZ":
+        m = euler_matrix(rotation)
+        return np.einsum("nji,nj->ni" if invert else "nij,nj->ni", m, d) + center
+    if kind in AXES:
+        axis = np.broadcast_to(AXES[kind], v.shape)
+    length = vec.norm(axis)
+    unit = axis / np.where(length > 0, length, 1.0)[:, None]
+    out = rotate_about_axis(d, unit, -angle if invert else angle) + center
+    return np.where((length != 0)[:, None], out, v)
+
+
 def _checker(p, c1, c2, scale):
     p = (p * scale[:, None] + 0.000001) * 0.999999
     i = np.abs(np.floor(p)).astype(np.int64) % 2
@@ -242,6 +293,16 @@ def _checker(p, c1, c2, scale):
 
 
 def _map_range(kind, v, a, b, c, d, steps, clamp):
+    """Cycles' svm_node_map_range (0 where From Min equals From Max), then the Clamp node its
+    compiler adds for Linear and Stepped."""
+    out = np.where(a != b, _map_range_vector(kind, v, a, b, c, d, steps, False), 0.0)
+    if clamp and kind in ("LINEAR", "STEPPED"):
+        out = np.clip(out, np.minimum(c, d), np.maximum(c, d))
+    return out
+
+
+def _map_range_vector(kind, v, a, b, c, d, steps, clamp):
+    """Cycles' svm_node_vector_map_range, per component (also the float node's factor)."""
     t = _safe_div(v - a, b - a)
     if kind == "STEPPED":
         t = np.where(steps > 0, np.floor(t * (steps + 1)) / np.where(steps > 0, steps, 1.0), 0.0)
@@ -333,13 +394,41 @@ class Evaluator:
         if op == "rgb_to_bw":
             return (x[0] @ LUMINANCE,)
         if op == "separate":
-            c = rgb_to_hsv(x[0]) if p.get("mode") == "HSV" else x[0]
+            mode = p.get("mode")
+            c = rgb_to_hsv(x[0]) if mode == "HSV" else cn.rgb_to_hsl(x[0]) if mode == "HSL" else x[0]
             return c[:, 0], c[:, 1], c[:, 2]
         if op == "combine":
             c = np.stack(x[:3], axis=1)
-            return (hsv_to_rgb(c) if p.get("mode") == "HSV" else c,)
+            mode = p.get("mode")
+            return (hsv_to_rgb(c) if mode == "HSV" else cn.hsl_to_rgb(c) if mode == "HSL" else c,)
         if op == "ramp":
+            if p["interpolation"] == "TABLE":  # baked by the export, as Cycles bakes every ramp
+                rgba = cn.table_lookup(p["table"], x[0], p.get("interpolate", True))
+                return rgba[:, :3], rgba[:, 3]
             return _ramp(x[0], p["positions"], p["colors"], p["interpolation"])
+        if op in ("fresnel", "layer_weight"):
+            normal = x[1] if len(x) > 1 else self.ctx.normal
+            cosi = vec.dot(self.ctx.coord("incoming"), normal)
+            back = self.ctx.backfacing()
+            return (cn.fresnel(x[0], cosi, back),) if op == "fresnel" else cn.layer_weight(x[0], cosi, back)
+        if op == "brightness":
+            return (cn.brightness_contrast(*x),)
+        if op == "curves":
+            return (cn.curves(x[0], x[1], np.asarray(p["table"], float), p["min"], p["max"], p["extrapolate"]),)
+        if op == "float_curve":
+            return (cn.float_curve(x[0], x[1], p["table"], p["min"], p["max"], p["extrapolate"]),)
+        if op == "blackbody":
+            return (cn.blackbody(x[0]),)
+        if op == "wavelength":
+            return (cn.wavelength(x[0]),)
+        if op == "normal":
+            d = np.asarray(p["direction"], float)
+            d = d / max(np.linalg.norm(d), TINY)
+            return np.broadcast_to(d, (n, 3)).copy(), _normalize(x[0]) @ d
+        if op == "vector_rotate":
+            return (_vector_rotate(p["type"], p.get("invert", False), *x),)
+        if op == "vector_transform":
+            return (self._vector_transform(p, x[0]),)
         if op == "checker":
             return _checker(x[0], x[1], x[2], x[3])
         if op in proctex.OPS:
@@ -357,6 +446,8 @@ class Evaluator:
             return (np.minimum(np.maximum(v, lo), hi),)
         if op == "map_range":
             return (_map_range(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
+        if op == "map_range_vector":
+            return (_map_range_vector(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
         if op == "convert":
             return (_convert(p["kind"], x[0]),)
         raise KeyError(f"unknown program op {op!r}")
@@ -374,6 +465,46 @@ class Evaluator:
             return a + t * (b - a)
         out = _blend(p.get("blend", "MIX"), t, a, b)
         return np.clip(out, 0, 1) if p.get("clamp_result") else out
+
+    def _vector_transform(self, p, v):
+        """Cycles' svm_node_vector_transform between world, object and camera space (camera
+        space as Cycles': Blender's camera axes with z looking forward); a point, a direction, or
+        a normal (carried by the inverse transpose and normalised)."""
+        kind, src, dst = p["type"], p["from"], p["to"]
+        obj = self.ctx.object_matrix()
+        cam = self.ctx.camera_matrix()
+        if cam is not None:
+            cam = np.broadcast_to(cam, (self.ctx.n, 4, 4))
+
+        def carry(m, v, inverse):
+            if m is None:
+                return v
+            a, t = m[:, :3, :3], m[:, :3, 3]
+            if kind == "NORMAL":
+                a = a if inverse else np.linalg.inv(a)
+                return _normalize(np.einsum("nji,nj->ni", a, v))
+            if inverse:
+                a = np.linalg.inv(a)
+                v = v - t if kind == "POINT" else v
+                return np.einsum("nij,nj->ni", a, v)
+            return np.einsum("nij,nj->ni", a, v) + (t if kind == "POINT" else 0.0)
+
+        if src == "WORLD":
+            if dst == "CAMERA":
+                v = carry(cam, v, True)
+            elif dst == "OBJECT":
+                v = carry(obj, v, True)
+        elif src == "CAMERA":
+            if dst in ("WORLD", "OBJECT"):
+                v = carry(cam, v, False)
+            if dst == "OBJECT":
+                v = carry(obj, v, True)
+        elif src == "OBJECT":
+            if dst in ("WORLD", "CAMERA"):
+                v = carry(obj, v, False)
+            if dst == "CAMERA":
+                v = carry(cam, v, True)
+        return v
 
     def _image(self, p, vector_ref, uv3):
         tex = self.textures[p["image"]]
@@ -497,6 +628,15 @@ class DirectionContext:
 
     def shifted(self, dp):
         return DirectionContext(self.dirs + dp)
+
+    def backfacing(self):
+        return np.zeros(self.n, bool)
+
+    def object_matrix(self):
+        return None  # the world has no object (Cycles' is_object is false there)
+
+    def camera_matrix(self):
+        return None
 
     def tangent(self, uv_map):
         t, _ = orthonormal_basis(self.dirs)

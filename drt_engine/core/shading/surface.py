@@ -70,6 +70,22 @@ class SurfaceContext:
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
 
+    def backfacing(self):
+        """Whether each hit sees the back of its triangle (Cycles' SD_BACKFACING): the ray
+        against the triangle's world normal at mid-shutter."""
+        if self.direction is None:
+            return np.zeros(self.n, bool)
+        return np.einsum("ij,ij->i", self.direction, self.attrs.geometry.world_ng[self.prim]) > 0
+
+    def object_matrix(self):
+        """(N, 4, 4) object-to-world transforms of the hits' objects."""
+        return self.attrs.object_matrix(self.prim)
+
+    def camera_matrix(self):
+        """(4, 4) camera-to-world transform in Cycles' camera space (Blender's camera axes with z
+        negated: z looks forward), at mid-shutter."""
+        return self.attrs.scene.camera.matrix @ np.diag([1.0, 1.0, -1.0, 1.0])
+
     def footprint(self):
         """World-space vectors spanning a pixel's footprint on the surface (major, minor axis)."""
         if self.width is None:
@@ -130,6 +146,12 @@ class SurfaceAttributes:
         out = np.zeros((len(prim), 3))
         for sel, _, mesh, tri in self._groups(prim):
             out[sel] = np.einsum("ni,nij->nj", bary[sel], mesh.vertices[mesh.triangles[tri]])
+        return out
+
+    def object_matrix(self, prim):
+        out = np.empty((len(prim), 4, 4))
+        for sel, inst, _, _ in self._groups(prim):
+            out[sel] = inst.matrix
         return out
 
     def object_normal(self, prim, normal):
@@ -211,6 +233,24 @@ class SurfaceAttributes:
         return t, sign
 
 
+VIEW_OPS = ("fresnel", "layer_weight")
+
+
+def views(program, refs) -> bool:
+    """Whether the program outputs ``refs`` depend on the direction the hit is seen from."""
+    stack, seen = [r[0] for r in refs], set()
+    while stack:
+        i = stack.pop()
+        if i in seen:
+            continue
+        seen.add(i)
+        node = program.nodes[i]
+        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") == "incoming"):
+            return True
+        stack.extend(r[0] for r in node.inputs if r is not None)
+    return False
+
+
 class MaterialShading:
     """One material: its constant shader, or its program and the shaders bound per hit."""
 
@@ -226,6 +266,11 @@ class MaterialShading:
         self._cache: dict[bytes, MaterialShader] = {}
         self.coarsened = False
         self.warnings = warnings if warnings is not None else []  # the renderer's, added to while rendering
+        if self.varying_emission and views(material.program, [r for c in self.emitters for k, r in c.inputs.items()
+                                                               if k in ("emission", "weight")]):
+            self.warnings.append(f"material '{material.name}': its emission uses Fresnel, Layer Weight or the "
+                                 "incoming direction, which DRT's emission does not see yet: evaluated as if "
+                                 "seen along the surface normal")
 
     @property
     def emission(self):
