@@ -198,8 +198,11 @@ def grid_shape(n: int) -> tuple[int, int]:
     return cols, int(np.ceil(n / cols))
 
 
-def grid_scene(cases=CASES):
-    """The cases as a grid of emissive tiles (row-major from the top left) under a black world."""
+def grid_scene(cases=CASES, material=None):
+    """The cases as a grid of emissive tiles (row-major from the top left) under a black world;
+    ``material(case)`` makes each tile's material (this module's texture cases by default), and
+    a case whose ``backfacing`` is true shows the camera its tile's back."""
+    material = material or _material
     cols, rows = grid_shape(len(cases))
     scene = _scene(cols * TILE, rows * TILE)
     cam = scene.camera
@@ -211,8 +214,9 @@ def grid_scene(cases=CASES):
     for i, case in enumerate(cases):
         row, col = divmod(i, cols)
         mesh = bpy.data.meshes.new(case.name)
-        mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
-        mesh.materials.append(_material(case))
+        face = (3, 2, 1, 0) if getattr(case, "backfacing", False) else (0, 1, 2, 3)
+        mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [face])
+        mesh.materials.append(material(case))
         obj = bpy.data.objects.new(case.name, mesh)
         obj.location = (2.0 * col - cols + 1.0, rows - 1.0 - 2.0 * row, 0.0)
         scene.collection.objects.link(obj)

@@ -1,0 +1,70 @@
+"""Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
+and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
+Weight as the colour of diffuse spheres seen at every angle, from the front and the back. The rule is the procedural textures' (procedural_scenes.parity):
+DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
+1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
+leaves out keeps its one warning.
+"""
+from __future__ import annotations
+
+import pytest
+
+from tests.support import node_scenes as ns
+from tests.support import procedural_scenes as ps
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material
+from tests.support.export_helpers import render_export
+
+
+@pytest.fixture(scope="module")
+def grid(drt, tmp_path_factory):
+    """Tiles of DRT seed 0, Cycles seeds 0 and 1, per case."""
+    scene = ns.grid_scene()
+    out = tmp_path_factory.mktemp("nodes")
+    renders = [rh.render(scene, engine, ps.SAMPLES, seed, out, name="nodes")
+               for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))]
+    return [ps.tiles(r.rgb, len(ns.CASES)) for r in renders]
+
+
+def _cannot(data):
+    return [w for w in data.warnings if "cannot evaluate" in w]
+
+
+def test_every_case_exports_without_a_warning(drt):
+    assert not _cannot(render_export(ns.grid_scene()))
+    assert not _cannot(render_export(ns.facing_scene()))
+
+
+def test_a_node_left_out_keeps_its_one_warning(drt):
+    """Light Path still has no handler: the socket it feeds keeps its value, with one warning naming it."""
+    scene = ns.grid_scene(ns.CASES[:1])
+    mat = new_material("Light Path")  # Light Path -> Fresnel's IOR -> Principled roughness
+    tree = mat.node_tree
+    path = tree.nodes.new("ShaderNodeLightPath")
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    tree.links.new(path.outputs["Ray Length"], fresnel.inputs["IOR"])
+    tree.links.new(fresnel.outputs[0], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    scene.objects[ns.CASES[0].name].data.materials[0] = mat
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Light Path" in warnings[0] and "Fresnel" not in warnings[0], warnings
+
+
+@pytest.mark.parametrize("index", range(len(ns.CASES)), ids=[c.name for c in ns.CASES])
+def test_node_matches_cycles(grid, index):
+    drt, cycles0, cycles1 = (tiles[index] for tiles in grid)
+    figures = ps.parity(drt, cycles0, cycles1)
+    assert figures["ok"], (f"{ns.CASES[index].name}: worst block {figures['worst']:.4f} > "
+                           f"{figures['limit']:.4f} (Cycles' seeds: {figures['cycles_seeds']:.4f})")
+
+
+def test_fresnel_and_layer_weight_on_spheres_match_cycles(drt, tmp_path):
+    scene = ns.facing_scene()
+    drt_render, c0, c1 = (rh.render(scene, engine, ps.SAMPLES, seed, tmp_path, name="facing")
+                          for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
+    rh.save_side_by_side("fresnel-layer-weight", drt_render.rgb, c0.rgb)
+    size = c0.rgb.shape[0] // 2
+    for row, side in enumerate(("front", "back")):
+        for i, (name, _) in enumerate(ns.FACING):
+            part = (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size))
+            figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
+            assert figures["ok"], (name, side, figures)

@@ -1,0 +1,335 @@
+"""Shader-node cases (converters, colour and vector nodes, Fresnel and Layer Weight) and the
+scenes that show them, for the Cycles parity test: the procedural texture grid's machinery
+(procedural_scenes: emissive 2 x 2 m tiles seen straight down, each case's output as the
+emission colour through Vector Math Absolute) with a material per case that links every input
+it can to the tile's mapped Object coordinates, so each node is evaluated over a range of
+inputs. Fresnel and Layer Weight depend on the direction a hit is seen from, which DRT's
+emission does not see: ``facing_scene`` shows them as the colour of diffuse spheres seen at
+every angle, from the front and from the back.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import bpy
+import mathutils
+
+from tests.support import procedural_scenes as ps
+from tests.support.datablocks import new_material, new_world
+
+
+@dataclass(frozen=True)
+class NodeCase:
+    name: str
+    build: Callable  # (tree, vector socket) -> the output socket shown
+    strength: float = 1.0
+
+
+def _node(tree, kind, **props):
+    node = tree.nodes.new(kind)
+    for key, value in props.items():
+        setattr(node, key, value)
+    return node
+
+
+def _link(tree, node, **inputs):
+    """Link or set the node's inputs by identifier; returns the node."""
+    sockets = {s.identifier: s for s in node.inputs}
+    for key, value in inputs.items():
+        if isinstance(value, bpy.types.NodeSocket):
+            tree.links.new(value, sockets[key])
+        else:
+            sockets[key].default_value = value
+    return node
+
+
+def _affine(tree, v, scale, offset):
+    """v * scale + offset, per component (Vector Math Multiply Add)."""
+    node = _node(tree, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    tree.links.new(v, node.inputs[0])
+    node.inputs[1].default_value = (scale,) * 3
+    node.inputs[2].default_value = (offset,) * 3
+    return node.outputs["Vector"]
+
+
+def _unit(tree, v):
+    """The tile's coordinates squeezed to about [0, 1]."""
+    return _affine(tree, v, 0.3, 0.5)
+
+
+def _component(tree, v, axis):
+    split = _node(tree, "ShaderNodeSeparateXYZ")
+    tree.links.new(v, split.inputs[0])
+    return split.outputs[axis]
+
+
+def _scaled(tree, value, scale, offset):
+    node = _node(tree, "ShaderNodeMath", operation="MULTIPLY_ADD")
+    tree.links.new(value, node.inputs[0])
+    node.inputs[1].default_value = scale
+    node.inputs[2].default_value = offset
+    return node.outputs[0]
+
+
+def _normalized(tree, v):
+    node = _node(tree, "ShaderNodeVectorMath", operation="NORMALIZE")
+    tree.links.new(v, node.inputs[0])
+    return node.outputs["Vector"]
+
+
+def _brightness(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeBrightContrast"), Color=_unit(tree, v),
+                 Bright=_scaled(tree, _component(tree, v, "X"), 0.2, 0.0),
+                 Contrast=_scaled(tree, _component(tree, v, "Y"), 0.5, 0.1))
+    return node.outputs[0]
+
+
+def _shape(mapping, curve, points):
+    """Give curve ``curve`` of a curve mapping these (x, y) points, the first and last moved."""
+    cmap = mapping.curves[curve]
+    cmap.points[0].location = points[0]
+    cmap.points[-1].location = points[-1]
+    for x, y in points[1:-1]:
+        cmap.points.new(x, y)
+
+
+def _rgb_curves(tree, v):
+    node = _node(tree, "ShaderNodeRGBCurve")
+    _shape(node.mapping, 3, [(0.0, 0.1), (0.5, 0.7), (1.0, 0.9)])
+    _shape(node.mapping, 0, [(0.0, 0.0), (0.3, 0.1), (1.0, 1.0)])
+    _shape(node.mapping, 2, [(0.0, 0.3), (0.6, 0.5), (1.0, 0.8)])
+    node.mapping.update()
+    return _link(tree, node, Color=_affine(tree, v, 0.45, 0.5),
+                 Fac=_scaled(tree, _component(tree, v, "Z"), 0.2, 0.8)).outputs[0]
+
+
+def _vector_curves(tree, v):
+    node = _node(tree, "ShaderNodeVectorCurve")
+    _shape(node.mapping, 0, [(-1.0, -0.5), (0.0, 0.4), (1.0, 1.0)])
+    _shape(node.mapping, 1, [(-1.0, 1.0), (0.2, -0.3), (1.0, 0.2)])
+    node.mapping.extend = "EXTRAPOLATED"
+    node.mapping.update()
+    return _link(tree, node, Vector=v, Fac=0.9).outputs[0]
+
+
+def _float_curve(tree, v):
+    node = _node(tree, "ShaderNodeFloatCurve")
+    _shape(node.mapping, 0, [(0.0, 0.2), (0.4, 0.9), (0.7, 0.3), (1.0, 0.6)])
+    node.mapping.update()
+    unit = _unit(tree, v)
+    return _link(tree, node, Value=_component(tree, unit, "X"), Factor=_component(tree, unit, "Y")).outputs[0]
+
+
+def _rotate(kind, invert):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeVectorRotate", rotation_type=kind, invert=invert)
+        inputs = {"Vector": v, "Center": (0.2, -0.3, 0.1), "Angle": _scaled(tree, _component(tree, v, "Y"), 1.2, 0.4)}
+        if kind == "AXIS_ANGLE":
+            inputs["Axis"] = _unit(tree, v)
+        if kind == "EULER_XYZ":
+            inputs["Rotation"] = _affine(tree, v, 0.8, 0.3)
+        return _link(tree, node, **inputs).outputs[0]
+    return build
+
+
+def _transform(kind, src, dst, scale=1.0):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeVectorTransform", vector_type=kind, convert_from=src, convert_to=dst)
+        # offset, so that the Absolute before the emission does not hide a sign
+        return _affine(tree, _link(tree, node, Vector=v).outputs[0], scale, 0.5)
+    return build
+
+
+def _normal_dot(tree, v):
+    node = _node(tree, "ShaderNodeNormal")
+    node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
+    return _link(tree, node, Normal=v).outputs["Dot"]
+
+
+def _blackbody(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeBlackbody"),
+                 Temperature=_scaled(tree, _component(tree, v, "X"), 2500.0, 5000.0))
+    return node.outputs[0]
+
+
+def _wavelength(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeWavelength"),
+                 Wavelength=_scaled(tree, _component(tree, v, "X"), 120.0, 560.0))
+    return node.outputs[0]
+
+
+def _separate_hsl(tree, v):
+    # inside [0, 1]: HSL's saturation divides by 2 - max - min, singular at white
+    split = _link(tree, _node(tree, "ShaderNodeSeparateColor", mode="HSL"), Color=_affine(tree, v, 0.25, 0.5))
+    join = _node(tree, "ShaderNodeCombineXYZ")
+    for i, name in enumerate(("Red", "Green", "Blue")):
+        tree.links.new(split.outputs[name], join.inputs[i])
+    return join.outputs[0]
+
+
+def _combine_hsl(tree, v):
+    unit = _unit(tree, v)
+    node = _node(tree, "ShaderNodeCombineColor", mode="HSL")
+    for axis, name in zip("XYZ", ("Red", "Green", "Blue")):
+        tree.links.new(_component(tree, unit, axis), node.inputs[name])
+    return node.outputs[0]
+
+
+def _mix(blend):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMix", data_type="RGBA", blend_type=blend)
+        return _link(tree, node, A_Color=_unit(tree, v), B_Color=_affine(tree, v, -0.35, 0.5),
+                     Factor_Float=_component(tree, _unit(tree, v), "X")).outputs[2]
+    return build
+
+
+def _map_range_vector(kind, clamp=True):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMapRange", data_type="FLOAT_VECTOR", interpolation_type=kind, clamp=clamp)
+        return _link(tree, node, Vector=v, Steps_FLOAT3=(3.0, 4.0, 5.0), From_Min_FLOAT3=(-1.0, -1.2, -0.8),
+                     From_Max_FLOAT3=(1.0, 0.9, 1.1),
+                     To_Min_FLOAT3=(0.1, 0.9, 0.0), To_Max_FLOAT3=_unit(tree, v)).outputs["Vector"]
+    return build
+
+
+def _map_range_float(kind):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMapRange", data_type="FLOAT", interpolation_type=kind)
+        return _link(tree, node, Value=_component(tree, v, "X"), Steps=4.0, **{"From Min": -1.2, "From Max": 1.0,
+                     "To Min": 0.1, "To Max": _component(tree, _unit(tree, v), "Y")}).outputs["Result"]
+    return build
+
+
+def _ramp(interpolation, color_mode="RGB"):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeValToRGB")
+        ramp = node.color_ramp
+        ramp.interpolation = interpolation
+        ramp.color_mode = color_mode
+        ramp.elements[0].color = (0.9, 0.1, 0.1, 1.0)
+        ramp.elements[1].color = (0.1, 0.2, 0.9, 1.0)
+        for position, color in ((0.3, (0.1, 0.9, 0.2, 1.0)), (0.55, (1.0, 0.9, 0.1, 1.0))):
+            ramp.elements.new(position).color = color
+        return _link(tree, node, Fac=_component(tree, _affine(tree, v, 0.4, 0.5), "X")).outputs["Color"]
+    return build
+
+
+CASES = (
+    NodeCase("Brightness/Contrast", _brightness),
+    NodeCase("RGB Curves, extrapolated", _rgb_curves),
+    NodeCase("Vector Curves", _vector_curves),
+    NodeCase("Float Curve", _float_curve),
+    NodeCase("Vector Rotate X axis", _rotate("X_AXIS", False)),
+    NodeCase("Vector Rotate Y axis inverted", _rotate("Y_AXIS", True)),
+    NodeCase("Vector Rotate Z axis", _rotate("Z_AXIS", False)),
+    NodeCase("Vector Rotate axis angle", _rotate("AXIS_ANGLE", False)),
+    NodeCase("Vector Rotate Euler inverted", _rotate("EULER_XYZ", True)),
+    NodeCase("Vector Transform point object to world", _transform("POINT", "OBJECT", "WORLD", 0.25)),
+    NodeCase("Vector Transform normal world to camera", _transform("NORMAL", "WORLD", "CAMERA")),
+    NodeCase("Vector Transform vector camera to object", _transform("VECTOR", "CAMERA", "OBJECT")),
+    NodeCase("Vector Transform point world to camera", _transform("POINT", "WORLD", "CAMERA", 0.1)),
+    NodeCase("Normal Dot", _normal_dot),
+    NodeCase("Blackbody", _blackbody, strength=0.3),
+    NodeCase("Wavelength", _wavelength),
+    NodeCase("Separate Color HSL", _separate_hsl),
+    NodeCase("Combine Color HSL", _combine_hsl),
+    NodeCase("Mix Hue", _mix("HUE")),
+    NodeCase("Mix Saturation", _mix("SATURATION")),
+    NodeCase("Mix Value", _mix("VALUE")),
+    NodeCase("Mix Color", _mix("COLOR")),
+    NodeCase("Map Range vector linear", _map_range_vector("LINEAR")),
+    NodeCase("Map Range vector stepped", _map_range_vector("STEPPED")),
+    NodeCase("Map Range vector smoothstep", _map_range_vector("SMOOTHSTEP")),
+    NodeCase("Map Range vector smootherstep, unclamped", _map_range_vector("SMOOTHERSTEP", False)),
+    NodeCase("Map Range stepped", _map_range_float("STEPPED")),
+    NodeCase("Map Range smootherstep", _map_range_float("SMOOTHERSTEP")),
+    NodeCase("Color Ramp B-Spline", _ramp("B_SPLINE")),
+    NodeCase("Color Ramp Cardinal", _ramp("CARDINAL")),
+    NodeCase("Color Ramp linear in HSV", _ramp("LINEAR", "HSV")),
+)
+
+
+def _emissive(tree, color, strength):
+    absolute = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+    tree.links.new(color, absolute.inputs[0])
+    emission = _node(tree, "ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = strength
+    tree.links.new(absolute.outputs["Vector"], emission.inputs["Color"])
+    out = _node(tree, "ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+
+
+def material(case: NodeCase):
+    """The case's node fed by the tile's Object coordinates turned by a Mapping, as emission."""
+    mat = new_material(case.name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    coords = _node(tree, "ShaderNodeTexCoord")
+    mapping = _node(tree, "ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.31, -0.17, 0.43)
+    mapping.inputs["Rotation"].default_value = (0.5, 0.35, 0.2)
+    tree.links.new(coords.outputs["Object"], mapping.inputs["Vector"])
+    _emissive(tree, case.build(tree, mapping.outputs["Vector"]), case.strength)
+    return mat
+
+
+def grid_scene(cases=CASES):
+    return ps.grid_scene(cases, material)
+
+
+def _sphere_normal(tree):
+    """The sphere's normal tilted (normalised object-space normal plus a constant): a linked Normal."""
+    coords = _node(tree, "ShaderNodeTexCoord")
+    add = _node(tree, "ShaderNodeVectorMath", operation="ADD")
+    tree.links.new(coords.outputs["Normal"], add.inputs[0])
+    add.inputs[1].default_value = (0.4, -0.3, 0.2)
+    return _normalized(tree, add.outputs["Vector"])
+
+
+def _generated_z(tree, scale, offset):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _scaled(tree, _component(tree, coords.outputs["Generated"], "Z"), scale, offset)
+
+
+FACING = (
+    ("Fresnel", lambda tree: _link(tree, _node(tree, "ShaderNodeFresnel"), IOR=1.45).outputs[0]),
+    ("Fresnel, IOR and normal linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeFresnel"), IOR=_generated_z(tree, 1.0, 1.2), Normal=_sphere_normal(tree)).outputs[0]),
+    ("Layer Weight Fresnel, blend linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeLayerWeight"), Blend=_generated_z(tree, 0.6, 0.2)).outputs[0]),
+    ("Layer Weight Facing, normal linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeLayerWeight"), Blend=0.3, Normal=_sphere_normal(tree)).outputs[1]),
+)
+"""Fresnel and Layer Weight, which see the direction a hit is seen from: a diffuse sphere each,
+coloured by the node, in front (top row) and, with the normals turned inwards, from the back."""
+
+
+def facing_scene(size=32):
+    """The FACING cases on smooth diffuse spheres under a uniform white world (each point of a
+    sphere then reflects its colour), seen in perspective: the incoming direction meets the
+    shading normal at every angle. The bottom row's spheres have their normals flipped, so the
+    camera sees their backs (Cycles' backfacing hits: the IOR inverted)."""
+    scene = ps._scene(size * len(FACING), 2 * size)
+    cam = scene.camera
+    cam.location = (0.0, -14.0, 0.0)
+    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
+    cam.data.lens = 50.0
+    scene.world = new_world("World")
+    for row, flipped in enumerate((False, True)):
+        for i, (name, build) in enumerate(FACING):
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(2.1 * (i - 1.5), 0.0, 1.05 - 2.1 * row),
+                                                 segments=48, ring_count=24)
+            bpy.ops.object.shade_smooth()
+            obj = bpy.context.active_object
+            if flipped:
+                obj.data.flip_normals()
+            mat = new_material(name)
+            tree = mat.node_tree
+            tree.nodes.clear()
+            bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
+            tree.links.new(build(tree), bsdf.inputs["Color"])
+            out = _node(tree, "ShaderNodeOutputMaterial")
+            tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+            obj.data.materials.append(mat)
+    return scene
