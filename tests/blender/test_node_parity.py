@@ -19,11 +19,7 @@ from tests.support.export_helpers import render_export
 @pytest.fixture(scope="module")
 def grid(drt, tmp_path_factory):
     """Tiles of DRT seed 0, Cycles seeds 0 and 1, per case."""
-    scene = ns.grid_scene()
-    out = tmp_path_factory.mktemp("nodes")
-    renders = [rh.render(scene, engine, ps.SAMPLES, seed, out, name="nodes")
-               for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))]
-    return [ps.tiles(r.rgb, len(ns.CASES)) for r in renders]
+    return ps.grid_tiles(ns.grid_scene(), len(ns.CASES), tmp_path_factory.mktemp("nodes"), "nodes")
 
 
 def _cannot(data):
@@ -51,20 +47,17 @@ def test_a_node_left_out_keeps_its_one_warning(drt):
 
 @pytest.mark.parametrize("index", range(len(ns.CASES)), ids=[c.name for c in ns.CASES])
 def test_node_matches_cycles(grid, index):
-    drt, cycles0, cycles1 = (tiles[index] for tiles in grid)
-    figures = ps.parity(drt, cycles0, cycles1)
-    assert figures["ok"], (f"{ns.CASES[index].name}: worst block {figures['worst']:.4f} > "
-                           f"{figures['limit']:.4f} (Cycles' seeds: {figures['cycles_seeds']:.4f})")
+    figures = ps.tile_figures(grid, index)
+    assert figures["ok"], ps.message(ns.CASES[index].name, figures)
 
 
 def test_fresnel_and_layer_weight_on_spheres_match_cycles(drt, tmp_path):
     scene = ns.facing_scene()
-    drt_render, c0, c1 = (rh.render(scene, engine, ps.SAMPLES, seed, tmp_path, name="facing")
-                          for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "facing")
     rh.save_side_by_side("fresnel-layer-weight", drt_render.rgb, c0.rgb)
     size = c0.rgb.shape[0] // 2
     for row, side in enumerate(("front", "back")):
         for i, (name, _) in enumerate(ns.FACING):
             part = (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size))
             figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
-            assert figures["ok"], (name, side, figures)
+            assert figures["ok"], ps.message(f"{name} ({side})", figures)

@@ -17,6 +17,7 @@ import bpy
 import mathutils
 import numpy as np
 
+from tests.support import render_helpers as rh
 from tests.support.datablocks import new_material, new_world
 from tests.support.export_helpers import empty_scene
 
@@ -244,6 +245,31 @@ def parity(drt: np.ndarray, cycles0: np.ndarray, cycles1: np.ndarray) -> dict:
     worst = worst_block(drt, cycles0)
     own = worst_block(cycles0, cycles1)
     return {"worst": worst, "cycles_seeds": own, "limit": 1.5 * own + 0.002, "ok": worst <= 1.5 * own + 0.002}
+
+
+RUNS = (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))
+"""The renders a parity figure compares: DRT seed 0 against Cycles seed 0, Cycles seeds 0 and 1."""
+
+
+def parity_renders(scene, out, name):
+    """DRT seed 0, Cycles seeds 0 and 1 of ``scene`` (render_helpers.Render each)."""
+    return [rh.render(scene, engine, SAMPLES, seed, out, name=name) for engine, seed in RUNS]
+
+
+def grid_tiles(scene, n: int, out, name) -> list:
+    """The ``n`` case tiles of a grid scene's three ``parity_renders``: [DRT, Cycles 0, Cycles 1]."""
+    return [tiles(r.rgb, n) for r in parity_renders(scene, out, name)]
+
+
+def tile_figures(grid, index) -> dict:
+    """``parity`` of case ``index`` from the tiles of the three ``parity_renders``."""
+    return parity(*(tiles[index] for tiles in grid))
+
+
+def message(name: str, figures: dict) -> str:
+    """A failed case's figures, for an assertion."""
+    return (f"{name}: worst block {figures['worst']:.4f} > {figures['limit']:.4f} "
+            f"(Cycles' seeds: {figures['cycles_seeds']:.4f})")
 
 
 def _diffuse(name, color_from):
