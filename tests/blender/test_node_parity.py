@@ -7,6 +7,7 @@ leaves out keeps its one warning.
 """
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from tests.support import node_scenes as ns
@@ -61,3 +62,42 @@ def test_fresnel_and_layer_weight_on_spheres_match_cycles(drt, tmp_path):
             part = (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size))
             figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
             assert figures["ok"], ps.message(f"{name} ({side})", figures)
+
+
+class _Socket:
+    def __init__(self, identifier, value=0.0):
+        self.identifier = self.name = identifier
+        self.default_value = value
+        self.is_linked = False
+        self.enabled = True
+        self.type = "RGBA" if isinstance(value, tuple) else "VALUE"
+
+
+class _LegacyNode:
+    """Stands in for Blender 4.x's Separate/Combine RGB and HSV nodes (5.0 opens them as
+    Separate/Combine Color): their sockets, unlinked."""
+
+    def __init__(self, inputs, outputs):
+        self.inputs = [_Socket(k, v) for k, v in inputs.items()]
+        self.outputs = [_Socket(k) for k in outputs]
+        self.name = "legacy"
+
+
+def test_legacy_separate_and_combine_nodes_compile_as_their_colour_modes(drt):
+    from drt_engine.blender.export.nodes import Issues
+    from drt_engine.blender.export.shader_graph import Compiler, ImageTable
+    from drt_engine.core.shading.nodes import DirectionContext, Evaluator, rgb_to_hsv
+
+    def evaluate(kind, inputs, outputs, output):
+        compiler = Compiler(ImageTable([]), Issues())
+        node = _LegacyNode(inputs, outputs)
+        ref = getattr(compiler, "_node_" + kind)(node, node.outputs[outputs.index(output)])
+        return Evaluator(compiler.program, DirectionContext(np.zeros((1, 3))), [])(ref)[0]
+    colour = (0.2, 0.5, 0.9, 1.0)
+    assert np.isclose(evaluate("ShaderNodeSeparateRGB", {"Image": colour}, ("R", "G", "B"), "G"), 0.5)
+    hsv = [evaluate("ShaderNodeSeparateHSV", {"Color": colour}, ("H", "S", "V"), k) for k in "HSV"]
+    assert np.allclose(hsv, rgb_to_hsv(np.array([colour[:3]]))[0])
+    rgb = evaluate("ShaderNodeCombineRGB", {"R": 0.1, "G": 0.2, "B": 0.3}, ("Image",), "Image")
+    assert np.allclose(rgb, [0.1, 0.2, 0.3])
+    back = evaluate("ShaderNodeCombineHSV", dict(zip("HSV", hsv)), ("Color",), "Color")
+    assert np.allclose(back, colour[:3])
