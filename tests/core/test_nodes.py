@@ -265,3 +265,9 @@ def test_view_dependent_emission_is_named_in_a_warning():
     warned = shading("EMISSION", "emission").warnings
     assert len(warned) == 1 and "Fresnel" in warned[0]
     assert not shading("DIFFUSE", "color").warnings
+
+
+def test_backfacing_output_is_the_side_seen():
+    ctx = FacingContext(N, back=True)
+    back = run_in(ctx, lambda p, k: (p.add("backfacing"), 0))
+    assert back == 1.0 and run(lambda p, k: (p.add("backfacing"), 0)) == 0.0

@@ -141,6 +141,11 @@ def _transform(kind, src, dst, scale=1.0):
     return build
 
 
+def _camera_coordinates(tree, v):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _affine(tree, coords.outputs["Camera"], 0.1, 0.5)
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -229,6 +234,7 @@ CASES = (
     NodeCase("Vector Transform normal world to camera", _transform("NORMAL", "WORLD", "CAMERA")),
     NodeCase("Vector Transform vector camera to object", _transform("VECTOR", "CAMERA", "OBJECT")),
     NodeCase("Vector Transform point world to camera", _transform("POINT", "WORLD", "CAMERA", 0.1)),
+    NodeCase("Texture Coordinate Camera", _camera_coordinates),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),
     NodeCase("Wavelength", _wavelength),
@@ -292,6 +298,23 @@ def _generated_z(tree, scale, offset):
     return _scaled(tree, _component(tree, coords.outputs["Generated"], "Z"), scale, offset)
 
 
+def _true_normal_and_backfacing(tree):
+    """|True Normal| / 2 plus Backfacing / 2."""
+    geometry = _node(tree, "ShaderNodeNewGeometry")
+    absolute = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+    tree.links.new(geometry.outputs["True Normal"], absolute.inputs[0])
+    node = _node(tree, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    tree.links.new(absolute.outputs["Vector"], node.inputs[0])
+    node.inputs[1].default_value = (0.5, 0.5, 0.5)
+    tree.links.new(_scaled(tree, geometry.outputs["Backfacing"], 0.5, 0.0), node.inputs[2])
+    return node.outputs["Vector"]
+
+
+def _reflection(tree):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _affine(tree, coords.outputs["Reflection"], 0.4, 0.5)
+
+
 FACING = (
     ("Fresnel", lambda tree: _link(tree, _node(tree, "ShaderNodeFresnel"), IOR=1.45).outputs[0]),
     ("Fresnel, IOR and normal linked", lambda tree: _link(
@@ -300,9 +323,12 @@ FACING = (
         tree, _node(tree, "ShaderNodeLayerWeight"), Blend=_generated_z(tree, 0.6, 0.2)).outputs[0]),
     ("Layer Weight Facing, normal linked", lambda tree: _link(
         tree, _node(tree, "ShaderNodeLayerWeight"), Blend=0.3, Normal=_sphere_normal(tree)).outputs[1]),
+    ("Geometry True Normal and Backfacing", _true_normal_and_backfacing),
+    ("Texture Coordinate Reflection", _reflection),
 )
-"""Fresnel and Layer Weight, which see the direction a hit is seen from: a diffuse sphere each,
-coloured by the node, in front (top row) and, with the normals turned inwards, from the back."""
+"""Nodes that see the direction a hit is seen from or its side (Fresnel, Layer Weight, Geometry's
+True Normal and Backfacing, Texture Coordinate's Reflection): a diffuse sphere each, coloured by the
+node, in front (top row) and, with the normals turned inwards, from the back."""
 
 
 def facing_scene(size=32):
@@ -312,13 +338,13 @@ def facing_scene(size=32):
     camera sees their backs (Cycles' backfacing hits: the IOR inverted)."""
     scene = ps._scene(size * len(FACING), 2 * size)
     cam = scene.camera
-    cam.location = (0.0, -14.0, 0.0)
+    cam.location = (0.0, -17.5, 0.0)  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 pixels
     cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
     cam.data.lens = 50.0
     scene.world = new_world("World")
     for row, flipped in enumerate((False, True)):
         for i, (name, build) in enumerate(FACING):
-            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(2.1 * (i - 1.5), 0.0, 1.05 - 2.1 * row),
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(2.1 * (i - 2.5), 0.0, 1.05 - 2.1 * row),
                                                  segments=48, ring_count=24)
             bpy.ops.object.shade_smooth()
             obj = bpy.context.active_object

@@ -217,7 +217,8 @@ class Compiler:
             return self._coord("generated")
         if getattr(node, "object", None) is not None and name == "Object":
             return self._unsupported(node, "Texture Coordinate from another object")
-        table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal"}
+        table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal", "Camera": "camera",
+                 "Reflection": "reflection"}
         if name not in table:
             return self._unsupported(node, f"Texture Coordinate {name}")
         return self._coord(table[name])
@@ -226,7 +227,10 @@ class Compiler:
         return self._coord("uv", node.uv_map)
 
     def _node_ShaderNodeNewGeometry(self, node, output):
-        table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming"}
+        if output.identifier == "Backfacing":
+            return self.op("backfacing"), 0
+        table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming",
+                 "True Normal": "true_normal"}
         name = table.get(output.identifier)
         if name is None:
             return self._unsupported(node, f"Geometry {output.identifier}")

@@ -411,6 +411,8 @@ class Evaluator:
             cosi = vec.dot(self.ctx.coord("incoming"), normal)
             back = self.ctx.backfacing()
             return (cn.fresnel(x[0], cosi, back),) if op == "fresnel" else cn.layer_weight(x[0], cosi, back)
+        if op == "backfacing":
+            return (self.ctx.backfacing().astype(float),)
         if op == "brightness":
             return (cn.brightness_contrast(*x),)
         if op == "curves":

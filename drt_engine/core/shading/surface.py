@@ -61,6 +61,15 @@ class SurfaceContext:
             return -self.direction if self.direction is not None else self.normal
         if name == "normal":
             return a.object_normal(self.prim, self.normal)
+        if name == "true_normal":  # the triangle's normal, turned to face the ray as Cycles' Ng
+            ng = a.geometry.world_ng[self.prim]
+            return np.where(self.backfacing()[:, None], -ng, ng)
+        if name == "reflection":  # the incoming direction mirrored about the shading normal
+            wi = self.coord("incoming")
+            return 2.0 * np.einsum("ij,ij->i", self.normal, wi)[:, None] * self.normal - wi
+        if name == "camera":  # Cycles' camera space: z looks forward
+            m = np.linalg.inv(self.camera_matrix())
+            return self.pos @ m[:3, :3].T + m[:3, 3]
         p = a.object_position(self.prim, self.bary)
         if name == "generated":
             lo, size = a.texspace(self.prim)
@@ -233,7 +242,8 @@ class SurfaceAttributes:
         return t, sign
 
 
-VIEW_OPS = ("fresnel", "layer_weight")
+VIEW_OPS = ("fresnel", "layer_weight", "backfacing")
+VIEW_COORDS = ("incoming", "reflection", "true_normal")
 
 
 def views(program, refs) -> bool:
@@ -245,7 +255,7 @@ def views(program, refs) -> bool:
             continue
         seen.add(i)
         node = program.nodes[i]
-        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") == "incoming"):
+        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") in VIEW_COORDS):
             return True
         stack.extend(r[0] for r in node.inputs if r is not None)
     return False
@@ -268,9 +278,9 @@ class MaterialShading:
         self.warnings = warnings if warnings is not None else []  # the renderer's, added to while rendering
         if self.varying_emission and views(material.program, [r for c in self.emitters for k, r in c.inputs.items()
                                                                if k in ("emission", "weight")]):
-            self.warnings.append(f"material '{material.name}': its emission uses Fresnel, Layer Weight or the "
-                                 "incoming direction, which DRT's emission does not see yet: evaluated as if "
-                                 "seen along the surface normal")
+            self.warnings.append(f"material '{material.name}': its emission uses Fresnel, Layer Weight, the "
+                                 "incoming or reflected direction or which side is seen, which DRT's emission "
+                                 "does not see yet: evaluated as if seen along the surface normal")
 
     @property
     def emission(self):
