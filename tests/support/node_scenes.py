@@ -146,6 +146,22 @@ def _camera_coordinates(tree, v):
     return _affine(tree, coords.outputs["Camera"], 0.1, 0.5)
 
 
+def _window_coordinates(tree, v=None):
+    return _node(tree, "ShaderNodeTexCoord").outputs["Window"]
+
+
+def _other_object_coordinates(tree, v):
+    """Object coordinates of an empty turned, scaled and moved in the scene."""
+    empty = bpy.data.objects.new("Frame", None)
+    empty.location = (1.5, -0.7, 0.4)
+    empty.rotation_euler = (0.3, -0.5, 0.9)
+    empty.scale = (1.5, 0.7, 1.2)
+    bpy.context.scene.collection.objects.link(empty)
+    coords = _node(tree, "ShaderNodeTexCoord")
+    coords.object = empty
+    return _affine(tree, coords.outputs["Object"], 0.15, 0.5)
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -235,6 +251,8 @@ CASES = (
     NodeCase("Vector Transform vector camera to object", _transform("VECTOR", "CAMERA", "OBJECT")),
     NodeCase("Vector Transform point world to camera", _transform("POINT", "WORLD", "CAMERA", 0.1)),
     NodeCase("Texture Coordinate Camera", _camera_coordinates),
+    NodeCase("Texture Coordinate Window", _window_coordinates),
+    NodeCase("Texture Coordinate from another object", _other_object_coordinates),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),
     NodeCase("Wavelength", _wavelength),
@@ -325,10 +343,12 @@ FACING = (
         tree, _node(tree, "ShaderNodeLayerWeight"), Blend=0.3, Normal=_sphere_normal(tree)).outputs[1]),
     ("Geometry True Normal and Backfacing", _true_normal_and_backfacing),
     ("Texture Coordinate Reflection", _reflection),
+    ("Texture Coordinate Window (perspective)", _window_coordinates),
 )
 """Nodes that see the direction a hit is seen from or its side (Fresnel, Layer Weight, Geometry's
-True Normal and Backfacing, Texture Coordinate's Reflection): a diffuse sphere each, coloured by the
-node, in front (top row) and, with the normals turned inwards, from the back."""
+True Normal and Backfacing, Texture Coordinate's Reflection), and Window coordinates in
+perspective: a diffuse sphere each, coloured by the node, in front (top row) and, with the
+normals turned inwards, from the back."""
 
 
 def facing_scene(size=32):
@@ -338,14 +358,15 @@ def facing_scene(size=32):
     camera sees their backs (Cycles' backfacing hits: the IOR inverted)."""
     scene = ps._scene(size * len(FACING), 2 * size)
     cam = scene.camera
-    cam.location = (0.0, -17.5, 0.0)  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 pixels
+    cam.location = (0.0, -7.0 * len(FACING) / 2.4, 0.0)  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 pixels
     cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
     cam.data.lens = 50.0
     scene.world = new_world("World")
     for row, flipped in enumerate((False, True)):
         for i, (name, build) in enumerate(FACING):
-            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(2.1 * (i - 2.5), 0.0, 1.05 - 2.1 * row),
-                                                 segments=48, ring_count=24)
+            x = 2.1 * (i - (len(FACING) - 1) / 2)
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(x, 0.0, 1.05 - 2.1 * row), segments=48,
+                                                 ring_count=24)
             bpy.ops.object.shade_smooth()
             obj = bpy.context.active_object
             if flipped:

@@ -216,9 +216,11 @@ class Compiler:
         if self.world:
             return self._coord("generated")
         if getattr(node, "object", None) is not None and name == "Object":
-            return self._unsupported(node, "Texture Coordinate from another object")
+            # Cycles: the world position in the other object's space (its inverse world matrix)
+            matrix = np.linalg.inv(np.array(node.object.matrix_world, float))[:3]
+            return self.op("affine", (self._coord("position"),), matrix=matrix), 0
         table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal", "Camera": "camera",
-                 "Reflection": "reflection"}
+                 "Reflection": "reflection", "Window": "window"}
         if name not in table:
             return self._unsupported(node, f"Texture Coordinate {name}")
         return self._coord(table[name])

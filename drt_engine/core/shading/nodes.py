@@ -411,6 +411,9 @@ class Evaluator:
             cosi = vec.dot(self.ctx.coord("incoming"), normal)
             back = self.ctx.backfacing()
             return (cn.fresnel(x[0], cosi, back),) if op == "fresnel" else cn.layer_weight(x[0], cosi, back)
+        if op == "affine":  # a fixed transform (3, 4) of points
+            m = np.asarray(p["matrix"], float)
+            return (x[0] @ m[:3, :3].T + m[:3, 3],)
         if op == "backfacing":
             return (self.ctx.backfacing().astype(float),)
         if op == "brightness":

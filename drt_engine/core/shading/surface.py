@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..base import vectors as vec
+from ..base.constants import TINY
 from ..bsdf.shader import MaterialShader, Tables
 from ..scene import Closure, Material, SceneData
 from .nodes import Evaluator
@@ -70,6 +71,8 @@ class SurfaceContext:
         if name == "camera":  # Cycles' camera space: z looks forward
             m = np.linalg.inv(self.camera_matrix())
             return self.pos @ m[:3, :3].T + m[:3, 3]
+        if name == "window":
+            return self._window()
         p = a.object_position(self.prim, self.bary)
         if name == "generated":
             lo, size = a.texspace(self.prim)
@@ -78,6 +81,17 @@ class SurfaceContext:
 
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
+
+    def _window(self):
+        """Cycles' camera_world_to_ndc: the point projected into the camera's full frame, (0, 0)
+        at its bottom left and (1, 1) at its top right, z 0."""
+        cam = self.attrs.scene.camera
+        m = np.linalg.inv(cam.matrix)
+        p = self.pos @ m[:3, :3].T + m[:3, 3]
+        s = p[:, :2] / np.where(p[:, 2:] < 0, -p[:, 2:], TINY) if cam.type == "PERSP" else p[:, :2]
+        left, right, bottom, top = cam.frame
+        return np.stack([(s[:, 0] - left) / (right - left), (s[:, 1] - bottom) / (top - bottom),
+                         np.zeros(self.n)], axis=1)
 
     def backfacing(self):
         """Whether each hit sees the back of its triangle (Cycles' SD_BACKFACING): the ray
