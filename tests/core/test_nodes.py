@@ -271,3 +271,13 @@ def test_backfacing_output_is_the_side_seen():
     ctx = FacingContext(N, back=True)
     back = run_in(ctx, lambda p, k: (p.add("backfacing"), 0))
     assert back == 1.0 and run(lambda p, k: (p.add("backfacing"), 0)) == 0.0
+
+
+def test_image_sphere_and_tube_projections():
+    from drt_engine.core.shading.nodes import project
+    points = np.array([[1.0, 0.5, 0.5], [0.5, 0.0, 0.5], [0.5, 1.0, 0.8], [0.5, 0.5, 1.0], [0.5, 0.5, 0.5]])
+    # u once around z from -y (0) through +x (0.25) to +y (0.5); v from the bottom pole (0) up
+    assert np.allclose(project("SPHERE", points), [[0.25, 0.5], [0.0, 0.5], [0.5, 1 - np.arccos(0.6 / np.hypot(1, 0.6)) / np.pi],
+                                                   [0.0, 1.0], [0.0, 0.0]])
+    assert np.allclose(project("TUBE", points), [[0.25, 0.5], [0.0, 0.5], [0.5, 0.8], [0.0, 0.0], [0.0, 0.0]])
+    assert np.allclose(project("FLAT", points), points[:, :2])

@@ -14,6 +14,7 @@ from typing import Callable
 
 import bpy
 import mathutils
+import numpy as np
 
 from tests.support import procedural_scenes as ps
 from tests.support.datablocks import new_material, new_world
@@ -162,6 +163,25 @@ def _other_object_coordinates(tree, v):
     return _affine(tree, coords.outputs["Object"], 0.15, 0.5)
 
 
+def _texels():
+    """An 8 x 8 packed image of random colours (one per texel, read Closest), made once."""
+    image = bpy.data.images.get("Texels")
+    if image is None:
+        image = bpy.data.images.new("Texels", 8, 8, float_buffer=True)
+        texels = np.random.default_rng(5).uniform(0.05, 1.0, (8, 8, 4)).astype(np.float32)
+        texels[..., 3] = 1.0
+        image.pixels.foreach_set(texels.ravel())
+        image.pack()  # a generated image would be generated again (blank) for the render
+    return image
+
+
+def _projected(projection):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeTexImage", image=_texels(), interpolation="Closest", projection=projection)
+        return _link(tree, node, Vector=_unit(tree, v)).outputs["Color"]
+    return build
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -181,8 +201,14 @@ def _wavelength(tree, v):
 
 
 def _separate_hsl(tree, v):
-    # inside [0, 1]: HSL's saturation divides by 2 - max - min, singular at white
-    split = _link(tree, _node(tree, "ShaderNodeSeparateColor", mode="HSL"), Color=_affine(tree, v, 0.25, 0.5))
+    # green the largest channel: hue away from its wrap from 1 to 0, whose edge pixels the two
+    # renderers' pixel samples split differently; saturation away from white, where it is singular
+    unit = _affine(tree, v, 0.2, 0.4)
+    colour = _node(tree, "ShaderNodeCombineXYZ")
+    tree.links.new(_component(tree, unit, "X"), colour.inputs[0])
+    colour.inputs[1].default_value = 0.9
+    tree.links.new(_component(tree, unit, "Z"), colour.inputs[2])
+    split = _link(tree, _node(tree, "ShaderNodeSeparateColor", mode="HSL"), Color=colour.outputs[0])
     join = _node(tree, "ShaderNodeCombineXYZ")
     for i, name in enumerate(("Red", "Green", "Blue")):
         tree.links.new(split.outputs[name], join.inputs[i])
@@ -253,6 +279,8 @@ CASES = (
     NodeCase("Texture Coordinate Camera", _camera_coordinates),
     NodeCase("Texture Coordinate Window", _window_coordinates),
     NodeCase("Texture Coordinate from another object", _other_object_coordinates),
+    NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
+    NodeCase("Image Texture Tube projection", _projected("TUBE")),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),
     NodeCase("Wavelength", _wavelength),

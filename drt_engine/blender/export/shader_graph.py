@@ -264,8 +264,6 @@ class Compiler:
     def _node_ShaderNodeTexImage(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection not in ("FLAT", "BOX"):
-            self.issues.add(f"'{node.name}' {node.projection.title()} projection (rendered as Flat)")
         interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
         if node.interpolation not in ("Linear", "Closest"):
             self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")

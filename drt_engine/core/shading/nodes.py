@@ -513,12 +513,15 @@ class Evaluator:
 
     def _image(self, p, vector_ref, uv3):
         tex = self.textures[p["image"]]
-        uv = uv3[:, :2]
+        projection = p.get("projection", "FLAT")
+        uv = project(projection, uv3)
         footprint = None
         if p.get("interpolation", "Linear") != "Closest":
             shifted = self._footprint_evaluators()
             if shifted is not None:
-                footprint = tuple(e(vector_ref)[:, :2] - uv for e in shifted)
+                footprint = tuple(project(projection, e(vector_ref)) - uv for e in shifted)
+                if projection in ("SPHERE", "TUBE"):  # across the seam, the short way round
+                    footprint = tuple(np.stack([d[:, 0] - np.round(d[:, 0]), d[:, 1]], axis=1) for d in footprint)
         rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
         return rgba[:, :3], rgba[:, 3]
 
@@ -571,6 +574,23 @@ class Evaluator:
         grad = ((hx - h) / eps)[:, None] * t + ((hy - h) / eps)[:, None] * b
         out = _normalize(n - dist[:, None] * grad)
         return _normalize(strength * out + (1.0 - strength) * n)
+
+
+def project(projection, co):
+    """(N, 2) image coordinates of Image Texture's Flat, Sphere and Tube projections (Cycles'
+    svm_node_tex_image: the vector from the [0, 1] box to [-1, 1], then map_to_sphere or
+    map_to_tube; u turns once around z, starting at -y)."""
+    if projection not in ("SPHERE", "TUBE"):
+        return co[:, :2]
+    c = (co - 0.5) * 2.0
+    x, y, z = c[:, 0], c[:, 1], c[:, 2]
+    axis = np.hypot(x, y)
+    u = np.where(axis > 0, (1.0 - np.arctan2(x, y) / np.pi) * 0.5, 0.0)
+    if projection == "TUBE":
+        return np.stack([u, np.where(axis > 0, (z + 1.0) * 0.5, 0.0)], axis=1)
+    length = vec.norm(c)
+    v = 1.0 - np.arccos(np.clip(z / np.where(length > 0, length, 1.0), -1.0, 1.0)) / np.pi
+    return np.stack([np.where(length > 0, u, 0.0), np.where(length > 0, v, 0.0)], axis=1)
 
 
 def box_weights(normal, blend):
