@@ -182,6 +182,12 @@ def _projected(projection):
     return build
 
 
+def _geometry(output, scale=1.0, offset=0.0):
+    def build(tree, v):
+        return _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs[output], scale, offset)
+    return build
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -281,6 +287,10 @@ CASES = (
     NodeCase("Texture Coordinate from another object", _other_object_coordinates),
     NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
     NodeCase("Image Texture Tube projection", _projected("TUBE")),
+    # scaled down: Parametric jumps across the quad's diagonal, whose edge pixels the renderers'
+    # pixel samples split differently (by up to 0.08 of the jump), as they would any edge
+    NodeCase("Geometry Parametric", _geometry("Parametric", 0.3)),
+    NodeCase("Geometry Tangent", _geometry("Tangent", 0.5, 0.5)),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),
     NodeCase("Wavelength", _wavelength),

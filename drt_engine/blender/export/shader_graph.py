@@ -232,7 +232,7 @@ class Compiler:
         if output.identifier == "Backfacing":
             return self.op("backfacing"), 0
         table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming",
-                 "True Normal": "true_normal"}
+                 "True Normal": "true_normal", "Parametric": "parametric", "Tangent": "tangent"}
         name = table.get(output.identifier)
         if name is None:
             return self._unsupported(node, f"Geometry {output.identifier}")

@@ -73,6 +73,10 @@ class SurfaceContext:
             return self.pos @ m[:3, :3].T + m[:3, 3]
         if name == "window":
             return self._window()
+        if name == "parametric":  # Cycles' (1 - u - v, u, 0): the weights of the triangle's first two corners
+            return np.concatenate([self.bary[:, :2], np.zeros((self.n, 1))], axis=1)
+        if name == "tangent":
+            return self._radial_tangent()
         p = a.object_position(self.prim, self.bary)
         if name == "generated":
             lo, size = a.texspace(self.prim)
@@ -81,6 +85,15 @@ class SurfaceContext:
 
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
+
+    def _radial_tangent(self):
+        """Cycles' primitive_tangent: the direction around the object's z axis through its Generated
+        coordinates' centre, carried to the world as a normal and made perpendicular to the shading normal."""
+        g = self.coord("generated")
+        around = np.stack([-(g[:, 1] - 0.5), g[:, 0] - 0.5, np.zeros(self.n)], axis=1)
+        world = np.einsum("nji,nj->ni", np.linalg.inv(self.object_matrix()[:, :3, :3]), around)
+        side = vec.normalize(np.cross(world, self.normal), 1e-300)
+        return np.cross(self.normal, side)
 
     def _window(self):
         """Cycles' camera_world_to_ndc: the point projected into the camera's full frame, (0, 0)
