@@ -188,6 +188,13 @@ def _geometry(output, scale=1.0, offset=0.0):
     return build
 
 
+def _interpolated(interpolation, extension):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeTexImage", image=_texels(), interpolation=interpolation, extension=extension)
+        return _link(tree, node, Vector=_affine(tree, v, 0.6, 0.5)).outputs["Color"]  # past the edges
+    return build
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -287,6 +294,10 @@ CASES = (
     NodeCase("Texture Coordinate from another object", _other_object_coordinates),
     NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
     NodeCase("Image Texture Tube projection", _projected("TUBE")),
+    NodeCase("Image Texture Cubic, repeat", _interpolated("Cubic", "REPEAT")),
+    NodeCase("Image Texture Cubic, clip", _interpolated("Cubic", "CLIP")),
+    NodeCase("Image Texture Cubic, extend", _interpolated("Cubic", "EXTEND")),
+    NodeCase("Image Texture Smart, mirror", _interpolated("Smart", "MIRROR")),
     # scaled down: Parametric jumps across the quad's diagonal, whose edge pixels the renderers'
     # pixel samples split differently (by up to 0.08 of the jump), as they would any edge
     NodeCase("Geometry Parametric", _geometry("Parametric", 0.3)),

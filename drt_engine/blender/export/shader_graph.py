@@ -264,9 +264,7 @@ class Compiler:
     def _node_ShaderNodeTexImage(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
-        if node.interpolation not in ("Linear", "Closest"):
-            self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")
+        interpolation = node.interpolation
         vector = self._vector_or(node, "generated" if self.world else "uv")
         i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
                              extension=node.extension, projection=node.projection,

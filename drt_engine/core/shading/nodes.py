@@ -516,7 +516,7 @@ class Evaluator:
         projection = p.get("projection", "FLAT")
         uv = project(projection, uv3)
         footprint = None
-        if p.get("interpolation", "Linear") != "Closest":
+        if p.get("interpolation", "Linear") == "Linear":
             shifted = self._footprint_evaluators()
             if shifted is not None:
                 footprint = tuple(project(projection, e(vector_ref)) - uv for e in shifted)
@@ -532,7 +532,7 @@ class Evaluator:
         normal = self.ctx.coord("normal")
         weights = box_weights(normal, p.get("blend", 0.0))
         footprint = None
-        if p.get("interpolation", "Linear") != "Closest":
+        if p.get("interpolation", "Linear") == "Linear":
             shifted = self._footprint_evaluators()
             if shifted is not None:
                 footprint = tuple(e(vector_ref) - co for e in shifted)
