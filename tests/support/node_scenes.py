@@ -25,6 +25,7 @@ class NodeCase:
     name: str
     build: Callable  # (tree, vector socket) -> the output socket shown
     strength: float = 1.0
+    mesh: tuple | None = None  # (vertices, faces) instead of the tile's one quad
 
 
 def _node(tree, kind, **props):
@@ -195,6 +196,22 @@ def _interpolated(interpolation, extension):
     return build
 
 
+def _islands():
+    """Four quads filling the tile, the two on the left sharing an edge, the vertices listed in a
+    shuffled order: three islands whose roots are not simply their first vertices."""
+    corners = [(x, y, 0.0) for y in (-1.0, 0.0, 1.0) for x in (-1.0, 0.0, 1.0)]
+    quads = [[(0, 1, 4, 3), (3, 4, 7, 6)], [(1, 2, 5, 4)], [(4, 5, 8, 7)]]
+    vertices, faces = [], []
+    for island in quads:  # each island its own copies of the corners it uses
+        used = sorted({c for quad in island for c in quad})
+        base = len(vertices)
+        vertices += [corners[c] for c in used]
+        faces += [tuple(base + used.index(c) for c in quad) for quad in island]
+    order = np.random.default_rng(0).permutation(len(vertices))  # no island rooted at its smallest index
+    where = np.argsort(order)
+    return [vertices[i] for i in order], [tuple(int(where[c]) for c in face) for face in faces]
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -302,6 +319,7 @@ CASES = (
     # pixel samples split differently (by up to 0.08 of the jump), as they would any edge
     NodeCase("Geometry Parametric", _geometry("Parametric", 0.3)),
     NodeCase("Geometry Tangent", _geometry("Tangent", 0.5, 0.5)),
+    NodeCase("Geometry Random Per Island", _geometry("Random Per Island"), mesh=_islands()),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),
     NodeCase("Wavelength", _wavelength),

@@ -17,7 +17,9 @@ import bpy
 import numpy as np
 
 from ...core.scene import Instance, Mesh
+from ...core.shading.proctex.hash import hash_uint, to_unit
 from .materials import MaterialTable
+from .shader_graph import ISLANDS
 
 
 def _read(collection, attribute, count, width, dtype):
@@ -77,7 +79,43 @@ def _tangents(mesh, uv_maps, tri_loops, attributes, warnings):
         mesh.free_tangents()
 
 
-def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None) -> Mesh | None:
+def island_roots(edges: np.ndarray, vertex_count: int) -> np.ndarray:
+    """Per vertex, the root of its island (the vertices its edges connect) as Cycles' DisjointSet
+    finds it after joining the edges in order: union by rank, the first set's root kept on ties,
+    path compression. The root, not just the island, decides Random Per Island's value."""
+    parents = list(range(vertex_count))
+    ranks = [0] * vertex_count
+
+    def find(x):
+        root = x
+        while parents[root] != root:
+            root = parents[root]
+        while parents[x] != root:
+            parents[x], x = root, parents[x]
+        return root
+
+    for a, b in edges.tolist():
+        ra, rb = find(a), find(b)
+        if ra == rb:
+            continue
+        if ranks[ra] < ranks[rb]:
+            ra, rb = rb, ra
+        parents[rb] = ra
+        if ranks[ra] == ranks[rb]:
+            ranks[ra] += 1
+    return np.array([find(v) for v in range(vertex_count)], np.int64)
+
+
+def random_per_island(mesh, tri_vertices) -> np.ndarray:
+    """(T,) Cycles' Random Per Island of each loop triangle: the hash of its first vertex's island root."""
+    edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+    roots = island_roots(edges, len(mesh.vertices))[tri_vertices[:, 0]]
+    values = {r: to_unit(hash_uint(r)) for r in np.unique(roots).tolist()}
+    return np.array([values[r] for r in roots.tolist()], np.float32)
+
+
+def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None,
+                      islands=False) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
@@ -96,6 +134,8 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
     attributes, uvs, colors = _corner_attributes(mesh, tri_vertices, tri_loops)
     if tangent_maps and len(mesh.loops):
         _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
+    if islands:  # the same value at the three corners: read back exactly
+        attributes[ISLANDS] = np.repeat(random_per_island(mesh, tri_vertices)[:, None, None], 3, axis=1).repeat(4, axis=2)
     return Mesh(
         name=name,
         vertices=vertices,
@@ -209,23 +249,29 @@ class GeometryExporter:
                 maps |= {n.params.get("map", "") for n in program.nodes if n.op == "normal_map"}
         return maps
 
+    def _needs_islands(self, slot_materials) -> bool:
+        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+        return any(n.op == "attribute" and n.params.get("name") == ISLANDS
+                   for p in programs if p is not None for n in p.nodes)
+
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
+        islands = self._needs_islands(slot_materials)
         warnings = self.materials.warnings
         cache_key = None
         if self.cache is not None and obj.type != "META":
-            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)))
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands)
             mesh = self.cache.get(cache_key)
             if mesh is not None:
                 self.meshes.append(mesh)
                 return len(self.meshes) - 1
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands)
         if mesh is None:
             return -1
         if cache_key is not None:

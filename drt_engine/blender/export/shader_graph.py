@@ -17,6 +17,8 @@ from ...core.shading import proctex
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
+ISLANDS = "geometry:random_per_island"
+"""The corner attribute the geometry export adds for Geometry's Random Per Island (RGBA all the value)."""
 RAMP_TABLE_SIZE = 256
 """Cycles' RAMP_TABLE_SIZE: colour ramps and curves reach its kernel as this many + 1 samples."""
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
@@ -231,6 +233,8 @@ class Compiler:
     def _node_ShaderNodeNewGeometry(self, node, output):
         if output.identifier == "Backfacing":
             return self.op("backfacing"), 0
+        if output.identifier == "Random Per Island":
+            return self.program.add("attribute", name=ISLANDS), 2  # its alpha: the value itself
         table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming",
                  "True Normal": "true_normal", "Parametric": "parametric", "Tangent": "tangent"}
         name = table.get(output.identifier)
