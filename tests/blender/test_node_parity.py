@@ -101,3 +101,14 @@ def test_legacy_separate_and_combine_nodes_compile_as_their_colour_modes(drt):
     assert np.allclose(rgb, [0.1, 0.2, 0.3])
     back = evaluate("ShaderNodeCombineHSV", dict(zip("HSV", hsv)), ("Color",), "Color")
     assert np.allclose(back, colour[:3])
+
+
+def test_pointiness_matches_cycles(drt, tmp_path):
+    """Pointiness of a bumpy icosphere whose sharp edges are split: Cycles' per-vertex angle,
+    blur and welding of the split vertices."""
+    scene = ns.pointiness_scene()
+    assert not _cannot(render_export(scene))
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "pointiness")
+    rh.save_side_by_side("pointiness", drt_render.rgb, c0.rgb)
+    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
+    assert figures["ok"], ps.message("Pointiness", figures)

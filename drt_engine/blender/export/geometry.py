@@ -19,7 +19,7 @@ import numpy as np
 from ...core.scene import Instance, Mesh
 from ...core.shading.proctex.hash import hash_uint, to_unit
 from .materials import MaterialTable
-from .shader_graph import ISLANDS
+from .shader_graph import ISLANDS, POINTINESS
 
 
 def _read(collection, attribute, count, width, dtype):
@@ -114,8 +114,64 @@ def random_per_island(mesh, tri_vertices) -> np.ndarray:
     return np.array([values[r] for r in roots.tolist()], np.float32)
 
 
+FLT_EPSILON = float(np.finfo(np.float32).eps)
+
+
+def welded(positions: np.ndarray) -> np.ndarray:
+    """Per vertex, the vertex it is welded to for Pointiness (itself if none), as Cycles'
+    attr_create_pointiness: in order of coordinate sums, each vertex points to the first later
+    one whose sum is within 3 FLT_EPSILON and whose squared distance is below FLT_EPSILON, and
+    chains are followed to their end."""
+    n = len(positions)
+    order = np.argsort(positions.sum(axis=1), kind="stable")
+    sums = positions.sum(axis=1)[order]
+    found = np.full(n, -1, np.int64)
+    for j in range(1, n):
+        k = np.flatnonzero((found[:n - j] < 0) & (sums[j:] - sums[:n - j] <= 3 * FLT_EPSILON))
+        if len(k) == 0:
+            break
+        close = ((positions[order[k + j]] - positions[order[k]]) ** 2).sum(axis=1) < FLT_EPSILON
+        found[k[close]] = order[k[close] + j]
+    orig = np.arange(n)
+    orig[order] = np.where(found >= 0, found, order)
+    while True:
+        nxt = orig[orig]
+        if np.array_equal(nxt, orig):
+            return orig
+        orig = nxt
+
+
+def pointiness(positions: np.ndarray, normals: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(V,) Cycles' Pointiness (blender/mesh.cpp attr_create_pointiness): duplicate vertices
+    welded, per vertex the angle between its (welded) normal and the mean direction of its edges
+    over pi, then blurred with its edge neighbours."""
+    n = len(positions)
+    orig = welded(positions)
+    normal = np.zeros((n, 3))
+    np.add.at(normal, orig, normals)
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = (normal / np.where(length > 0, length, 1.0))[orig]
+    pairs = np.unique(np.sort(orig[edges], axis=1), axis=0)  # each welded edge once
+    v0, v1 = pairs[:, 0], pairs[:, 1]
+    d = positions[v1] - positions[v0]
+    dl = np.linalg.norm(d, axis=1, keepdims=True)
+    d = np.where(dl > 0, d / np.where(dl > 0, dl, 1.0), 0.0)
+    accum = np.zeros((n, 3))
+    np.add.at(accum, v0, d)
+    np.add.at(accum, v1, -d)
+    count = np.bincount(v0, minlength=n) + np.bincount(v1, minlength=n)
+    mean = accum / np.maximum(count, 1)[:, None]
+    raw = np.where((count > 0) & (orig == np.arange(n)),
+                   np.arccos(np.clip((normal * mean).sum(axis=1), -1.0, 1.0)) / np.pi, 0.0)
+    data = raw.copy()
+    np.add.at(data, v0, raw[v1])
+    np.add.at(data, v1, raw[v0])
+    data /= count + 1
+    return data[orig].astype(np.float32)
+
+
 def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None,
-                      islands=False) -> Mesh | None:
+                      islands=False, pointy=False) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
@@ -136,6 +192,11 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
         _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
     if islands:  # the same value at the three corners: read back exactly
         attributes[ISLANDS] = np.repeat(random_per_island(mesh, tri_vertices)[:, None, None], 3, axis=1).repeat(4, axis=2)
+    if pointy:
+        edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+        normals = _read(mesh.vertex_normals, "vector", len(mesh.vertices), 3, np.float32)
+        per_vertex = pointiness(vertices.astype(np.float64), normals.astype(np.float64), edges)
+        attributes[POINTINESS] = np.repeat(per_vertex[tri_vertices][:, :, None], 4, axis=2)
     return Mesh(
         name=name,
         vertices=vertices,
@@ -249,29 +310,30 @@ class GeometryExporter:
                 maps |= {n.params.get("map", "") for n in program.nodes if n.op == "normal_map"}
         return maps
 
-    def _needs_islands(self, slot_materials) -> bool:
+    def _needs(self, slot_materials, name) -> bool:
+        """Whether the materials of these slots read the attribute ``name``."""
         programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
-        return any(n.op == "attribute" and n.params.get("name") == ISLANDS
+        return any(n.op == "attribute" and n.params.get("name") == name
                    for p in programs if p is not None for n in p.nodes)
 
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
-        islands = self._needs_islands(slot_materials)
+        islands, pointy = self._needs(slot_materials, ISLANDS), self._needs(slot_materials, POINTINESS)
         warnings = self.materials.warnings
         cache_key = None
         if self.cache is not None and obj.type != "META":
-            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands)
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy)
             mesh = self.cache.get(cache_key)
             if mesh is not None:
                 self.meshes.append(mesh)
                 return len(self.meshes) - 1
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy)
         if mesh is None:
             return -1
         if cache_key is not None:

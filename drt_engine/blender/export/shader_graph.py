@@ -18,7 +18,9 @@ from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
 ISLANDS = "geometry:random_per_island"
-"""The corner attribute the geometry export adds for Geometry's Random Per Island (RGBA all the value)."""
+POINTINESS = "geometry:pointiness"
+"""The corner attributes the geometry export adds for Geometry's Random Per Island and Pointiness
+(RGBA all the value)."""
 RAMP_TABLE_SIZE = 256
 """Cycles' RAMP_TABLE_SIZE: colour ramps and curves reach its kernel as this many + 1 samples."""
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
@@ -233,8 +235,9 @@ class Compiler:
     def _node_ShaderNodeNewGeometry(self, node, output):
         if output.identifier == "Backfacing":
             return self.op("backfacing"), 0
-        if output.identifier == "Random Per Island":
-            return self.program.add("attribute", name=ISLANDS), 2  # its alpha: the value itself
+        if output.identifier in ("Random Per Island", "Pointiness"):
+            name = ISLANDS if output.identifier == "Random Per Island" else POINTINESS
+            return self.program.add("attribute", name=name), 2  # its alpha: the value itself
         table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming",
                  "True Normal": "true_normal", "Parametric": "parametric", "Tangent": "tangent"}
         name = table.get(output.identifier)
