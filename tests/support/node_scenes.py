@@ -26,6 +26,7 @@ class NodeCase:
     build: Callable  # (tree, vector socket) -> the output socket shown
     strength: float = 1.0
     mesh: tuple | None = None  # (vertices, faces) instead of the tile's one quad
+    setup: Callable | None = None  # adds what the case reads to the tile's mesh
 
 
 def _node(tree, kind, **props):
@@ -212,6 +213,22 @@ def _islands():
     return [vertices[i] for i in order], [tuple(int(where[c]) for c in face) for face in faces]
 
 
+def _paint(mesh):
+    """A corner colour attribute "Paint" and a second UV map "Extra", a value per corner."""
+    colours = mesh.color_attributes.new("Paint", "FLOAT_COLOR", "CORNER")
+    for i, value in enumerate(colours.data):
+        value.color = ((0.9, 0.1, 0.3, 1.0), (0.2, 0.8, 0.1, 0.5), (0.1, 0.3, 0.9, 1.0), (1.0, 0.9, 0.2, 0.7))[i]
+    uv = mesh.uv_layers.new(name="Extra")
+    for i, value in enumerate(uv.data):
+        value.uv = ((0.1, 0.9), (0.8, 0.3), (0.5, 0.5), (0.2, 0.1))[i]
+
+
+def _attribute_fac(name):
+    def build(tree, v):
+        return _node(tree, "ShaderNodeAttribute", attribute_name=name).outputs["Fac"]
+    return build
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -319,6 +336,8 @@ CASES = (
     # pixel samples split differently (by up to 0.08 of the jump), as they would any edge
     NodeCase("Geometry Parametric", _geometry("Parametric", 0.3)),
     NodeCase("Geometry Tangent", _geometry("Tangent", 0.5, 0.5)),
+    NodeCase("Attribute Fac of a colour attribute", _attribute_fac("Paint"), setup=_paint),
+    NodeCase("Attribute Fac of a UV map", _attribute_fac("Extra"), setup=_paint),
     NodeCase("Geometry Random Per Island", _geometry("Random Per Island"), mesh=_islands()),
     NodeCase("Normal Dot", _normal_dot),
     NodeCase("Blackbody", _blackbody, strength=0.3),

@@ -202,7 +202,8 @@ def grid_shape(n: int) -> tuple[int, int]:
 def grid_scene(cases=CASES, material=None):
     """The cases as a grid of emissive tiles (row-major from the top left) under a black world;
     ``material(case)`` makes each tile's material (this module's texture cases by default), and
-    a case with a ``mesh`` ((vertices, faces) within the tile's 2 x 2 m) has it instead of one quad."""
+    a case with a ``mesh`` ((vertices, faces) within the tile's 2 x 2 m) has it instead of one quad,
+    and a case's ``setup(mesh)`` adds to its tile's mesh what it needs (attributes)."""
     material = material or _material
     cols, rows = grid_shape(len(cases))
     scene = _scene(cols * TILE, rows * TILE)
@@ -217,6 +218,8 @@ def grid_scene(cases=CASES, material=None):
         mesh = bpy.data.meshes.new(case.name)
         shape = getattr(case, "mesh", None) or ([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [(0, 1, 2, 3)])
         mesh.from_pydata(shape[0], [], shape[1])
+        if getattr(case, "setup", None) is not None:
+            case.setup(mesh)
         mesh.materials.append(material(case))
         obj = bpy.data.objects.new(case.name, mesh)
         obj.location = (2.0 * col - cols + 1.0, rows - 1.0 - 2.0 * row, 0.0)

@@ -361,7 +361,9 @@ class Evaluator:
             return (self.ctx.coord(p["name"], p.get("map", "")),)
         if op == "attribute":
             rgba = self.ctx.attribute(p["name"])
-            return rgba[:, :3], rgba[:, :3] @ LUMINANCE, rgba[:, 3]
+            # Fac as Cycles' svm attribute node: a 2-component attribute's first, else the mean
+            pair = self.ctx.attribute_width(p["name"]) == 2
+            return rgba[:, :3], np.where(pair, rgba[:, 0], rgba[:, :3].mean(axis=1)), rgba[:, 3]
         if op == "image":
             if p.get("projection") == "BOX":
                 return self._image_box(p, node.inputs[0], x[0])
@@ -647,6 +649,9 @@ class DirectionContext:
 
     def attribute(self, name):
         return np.zeros((self.n, 4))
+
+    def attribute_width(self, name):
+        return np.zeros(self.n, np.int64)
 
     def footprint(self):
         return None, None

@@ -86,6 +86,10 @@ class SurfaceContext:
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
 
+    def attribute_width(self, name):
+        """(N,) components of attribute ``name`` on each hit's mesh (0 where it has none)."""
+        return self.attrs.width(self.prim, name)
+
     def _radial_tangent(self):
         """Cycles' primitive_tangent: the direction around the object's z axis through its Generated
         coordinates' centre, carried to the world as a normal and made perpendicular to the shading normal."""
@@ -176,6 +180,13 @@ class SurfaceAttributes:
             out[sel, :values.shape[1]] = values[:, :width]
             if kind == "color" and values.shape[1] < 4:
                 out[sel, 3] = 1.0
+        return out
+
+    def width(self, prim, name):
+        out = np.zeros(len(prim), np.int64)
+        for sel, _, mesh, _ in self._groups(prim):
+            data = mesh.attributes.get(name) if name else mesh.colors
+            out[sel] = 0 if data is None else data.shape[2]
         return out
 
     def object_position(self, prim, bary):
