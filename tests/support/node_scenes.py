@@ -494,3 +494,54 @@ def pointiness_scene(size=48):
     _emissive(tree, _affine(tree, geometry.outputs["Pointiness"], 4.0, -1.5), 1.0)
     obj.data.materials.append(mat)
     return scene
+
+
+def _plane(name, x, material, collection):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([(-0.9, -0.9, 0), (0.9, -0.9, 0), (0.9, 0.9, 0), (-0.9, 0.9, 0)], [], [(0, 1, 2, 3)])
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = (x, 0.0, 0.0)
+    collection.objects.link(obj)
+    return obj
+
+
+def _attribute_material(name, kind, attribute, output="Color"):
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    node = _node(tree, "ShaderNodeAttribute", attribute_type=kind, attribute_name=attribute)
+    _emissive(tree, node.outputs[output], 1.0)
+    return mat
+
+
+def attribute_scene():
+    """Five emissive squares in a row, seen from above, coloured by Attribute nodes of the
+    Object, Instancer and View Layer types: an object's custom property, an RNA path (its
+    location), its mesh's custom property, an instanced object's instancer's property, the
+    scene's custom property (through the view layer)."""
+    scene = ps._scene(5 * ps.TILE, ps.TILE)
+    cam = scene.camera
+    cam.data.type = "ORTHO"
+    cam.data.ortho_scale = 10.0
+    world = new_world("World")
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    own = _plane("Own", -4.0, _attribute_material("Own", "OBJECT", "tint"), scene.collection)
+    own["tint"] = (0.2, 0.7, 0.4)
+    path = _plane("Path", -2.0, _attribute_material("Path", "OBJECT", "location"), scene.collection)
+    path.location.y = 0.35
+    data = _plane("Data", 0.0, _attribute_material("Data", "OBJECT", "tint"), scene.collection)
+    data.data["tint"] = 0.6
+    hidden = bpy.data.collections.new("Instanced")
+    inner = _plane("Inner", 0.0, _attribute_material("Instanced", "INSTANCER", "tint"), hidden)
+    inner["tint"] = (1.0, 0.0, 0.0)  # the instancer's own value comes first
+    instancer = bpy.data.objects.new("Instancer", None)
+    instancer.instance_type = "COLLECTION"
+    instancer.instance_collection = hidden
+    instancer.location = (2.0, 0.0, 0.0)
+    instancer["tint"] = (0.3, 0.3, 0.9, 0.5)
+    scene.collection.objects.link(instancer)
+    scene["tint"] = (0.9, 0.5, 0.1)
+    _plane("Layer", 4.0, _attribute_material("Layer", "VIEW_LAYER", "tint"), scene.collection)
+    return scene

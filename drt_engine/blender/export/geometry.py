@@ -19,7 +19,7 @@ import numpy as np
 from ...core.scene import Instance, Mesh
 from ...core.shading.proctex.hash import hash_uint, to_unit
 from .materials import MaterialTable
-from .shader_graph import ISLANDS, POINTINESS
+from .shader_graph import ISLANDS, POINTINESS, find_rgba
 
 
 def _read(collection, attribute, count, width, dtype):
@@ -275,13 +275,14 @@ class GeometryExporter:
             return np.zeros(1, np.int32)
         return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
 
-    def add(self, obj, matrix: np.ndarray, key=None) -> None:
-        """Add one evaluated object placed by ``matrix``; non-geometry objects are ignored."""
+    def add(self, obj, matrix: np.ndarray, key=None, parent=None) -> None:
+        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it);
+        non-geometry objects are ignored."""
         if obj.type == "META":
             self._metaballs.append((obj, matrix, key))
         elif isinstance(obj.data, bpy.types.Mesh):
             self._meshed.add(obj.original.as_pointer())
-            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key)
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent)
 
     def finish(self) -> None:
         """Add metaballs that the depsgraph did not already hand over as mesh instances."""
@@ -292,14 +293,28 @@ class GeometryExporter:
         if self.cache is not None:
             self.cache.finish()
 
-    def _place(self, obj, matrix, source, key) -> None:
+    def _instance_attributes(self, obj, parent, slot_materials) -> dict:
+        """The Object and Instancer attributes the slots' materials read, looked up as Blender
+        does for Cycles: the instancing object first (Instancer only), the object, its data."""
+        out = {}
+        for index in set(slot_materials.tolist()):
+            program = self.materials.materials[index].program
+            for node in program.nodes if program is not None else ():
+                if node.op == "instance_attribute" and node.params["key"] not in out:
+                    kind, name = node.params["key"].split(":", 1)
+                    owners = ([parent] if kind == "INSTANCER" else []) + [obj, obj.data]
+                    out[node.params["key"]] = find_rgba(owners, name)
+        return out
+
+    def _place(self, obj, matrix, source, key, parent=None) -> None:
         slot_materials = self._slot_materials(obj)
         mesh_key = source + (slot_materials.tobytes(),)
         index = self._mesh_index.get(mesh_key)
         if index is None:
             index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
-            self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
+            self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
+                                           attributes=self._instance_attributes(obj, parent, slot_materials)))
             self.keys.append(key)
 
     def _tangent_maps(self, slot_materials) -> set:

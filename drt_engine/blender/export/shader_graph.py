@@ -27,6 +27,49 @@ COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE
                      "Generic Data")
 
 
+def _property_rgba(owner, name):
+    """Blender's find_property_rgba: a custom property ``name`` of ``owner``, else the RNA path
+    ``name`` from it, as RGBA (a number n as (n, n, n, 1), up to 4 numbers over (0, 0, 0, 1));
+    None when there is no such number."""
+    if owner is None:
+        return None
+    value = None
+    try:
+        if name in owner.keys():
+            value = owner[name]
+    except (TypeError, AttributeError):  # a struct without custom properties
+        pass
+    if value is None:
+        try:
+            value = owner.path_resolve(name)
+        except (KeyError, ValueError, TypeError, AttributeError):
+            return None
+    if isinstance(value, str):
+        return None
+    if isinstance(value, (bool, int, float)):
+        return np.array([value, value, value, 1.0], float)
+    try:
+        values = [float(v) for v in value]
+    except (TypeError, ValueError):
+        return None
+    if not 0 < len(values) <= 4:
+        return None
+    rgba = np.array([0.0, 0.0, 0.0, 1.0])
+    rgba[:len(values)] = values
+    return rgba
+
+
+def find_rgba(owners, name) -> np.ndarray:
+    """The first of ``owners`` (objects, datablocks, view layers) that has the attribute, as RGBA;
+    zero when none has (Blender's BKE_object_dupli_find_rgba_attribute and
+    BKE_view_layer_find_rgba_attribute, which Cycles reads)."""
+    for owner in owners:
+        rgba = _property_rgba(owner, name)
+        if rgba is not None:
+            return rgba
+    return np.zeros(4)
+
+
 def is_ref(value) -> bool:
     return isinstance(value, tuple)
 
@@ -91,7 +134,8 @@ def _fit(value, kind):
 class Compiler:
     """Compiles the sockets of one material or world into one program."""
 
-    def __init__(self, images: ImageTable, issues: Issues, world: bool = False):
+    def __init__(self, images: ImageTable, issues: Issues, world: bool = False, layer=None):
+        self.layer = layer  # (scene, view layer) for View Layer attributes
         self.program = Program()
         self.images = images
         self.issues = issues
@@ -250,8 +294,16 @@ class Compiler:
         return i, {"Color": 0, "Vector": 0, "Fac": 1, "Alpha": 2}.get(output.identifier, 0)
 
     def _node_ShaderNodeAttribute(self, node, output):
-        if node.attribute_type != "GEOMETRY":
-            return self._unsupported(node, f"{node.attribute_type.title()} Attribute")
+        kind = node.attribute_type
+        which = {"Color": 0, "Vector": 0, "Fac": 1, "Alpha": 2}.get(output.identifier, 0)
+        if kind in ("OBJECT", "INSTANCER"):  # per object: the geometry export looks them up
+            return self.program.add("instance_attribute", key=f"{kind}:{node.attribute_name}"), which
+        if kind == "VIEW_LAYER":
+            if self.layer is None:
+                return self._unsupported(node, "View Layer Attribute")
+            scene, view_layer = self.layer
+            rgba = find_rgba([view_layer, scene, scene.world], node.attribute_name)
+            return (rgba[:3], float(rgba[:3].mean()), float(rgba[3]))[which]
         return self._attribute(node.attribute_name, output)
 
     def _node_ShaderNodeVertexColor(self, node, output):

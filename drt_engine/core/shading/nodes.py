@@ -364,6 +364,9 @@ class Evaluator:
             # Fac as Cycles' svm attribute node: a 2-component attribute's first, else the mean
             pair = self.ctx.attribute_width(p["name"]) == 2
             return rgba[:, :3], np.where(pair, rgba[:, 0], rgba[:, :3].mean(axis=1)), rgba[:, 3]
+        if op == "instance_attribute":  # Object and Instancer attributes: one RGBA per object
+            rgba = self.ctx.instance_attribute(p["key"])
+            return rgba[:, :3], rgba[:, :3].mean(axis=1), rgba[:, 3]
         if op == "image":
             if p.get("projection") == "BOX":
                 return self._image_box(p, node.inputs[0], x[0])
@@ -652,6 +655,9 @@ class DirectionContext:
 
     def attribute_width(self, name):
         return np.zeros(self.n, np.int64)
+
+    def instance_attribute(self, key):
+        return np.zeros((self.n, 4))
 
     def footprint(self):
         return None, None

@@ -86,6 +86,10 @@ class SurfaceContext:
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
 
+    def instance_attribute(self, key):
+        """(N, 4) RGBA of an Object or Instancer attribute of each hit's object (0 where it has none)."""
+        return self.attrs.instance_attribute(self.prim, key)
+
     def attribute_width(self, name):
         """(N,) components of attribute ``name`` on each hit's mesh (0 where it has none)."""
         return self.attrs.width(self.prim, name)
@@ -180,6 +184,14 @@ class SurfaceAttributes:
             out[sel, :values.shape[1]] = values[:, :width]
             if kind == "color" and values.shape[1] < 4:
                 out[sel, 3] = 1.0
+        return out
+
+    def instance_attribute(self, prim, key):
+        out = np.zeros((len(prim), 4))
+        for sel, inst, _, _ in self._groups(prim):
+            value = inst.attributes.get(key)
+            if value is not None:
+                out[sel] = value
         return out
 
     def width(self, prim, name):
