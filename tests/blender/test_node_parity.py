@@ -124,3 +124,12 @@ def test_object_instancer_and_view_layer_attributes_match_cycles(drt, tmp_path):
     centre = drt_render.rgb[ps.TILE // 2, ps.TILE // 2::ps.TILE]
     assert np.allclose(centre, [[0.2, 0.7, 0.4], [2.0, 0.35, 0.0], [0.6] * 3, [0.3, 0.3, 0.9], [0.9, 0.5, 0.1]],
                        atol=1e-3)
+
+
+def test_mirror_ball_environment_matches_cycles(drt, tmp_path):
+    scene = ns.mirror_ball_scene()
+    assert not _cannot(render_export(scene))
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "mirror-ball")
+    rh.save_side_by_side("mirror-ball", drt_render.rgb, c0.rgb)
+    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
+    assert figures["ok"], ps.message("Environment Texture, Mirror Ball", figures)

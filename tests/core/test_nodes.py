@@ -281,3 +281,10 @@ def test_image_sphere_and_tube_projections():
                                                    [0.0, 1.0], [0.0, 0.0]])
     assert np.allclose(project("TUBE", points), [[0.25, 0.5], [0.0, 0.5], [0.5, 0.8], [0.0, 0.0], [0.0, 0.0]])
     assert np.allclose(project("FLAT", points), points[:, :2])
+
+
+def test_mirror_ball_is_the_ball_seen_from_minus_y():
+    from drt_engine.core.shading.nodes import mirror_ball_uv
+    d = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    # straight back to the viewer: the ball's centre; sideways: 45 degrees round it
+    assert np.allclose(mirror_ball_uv(d), [[0.5, 0.5], [0.5 + 0.5 * np.sqrt(0.5), 0.5], [0.5, 0.5 + 0.5 * np.sqrt(0.5)]])

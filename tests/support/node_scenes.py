@@ -545,3 +545,19 @@ def attribute_scene():
     scene["tint"] = (0.9, 0.5, 0.1)
     _plane("Layer", 4.0, _attribute_material("Layer", "VIEW_LAYER", "tint"), scene.collection)
     return scene
+
+
+def mirror_ball_scene(size=48):
+    """Only the world, an Environment Texture (the 8 x 8 texels, Closest) in Mirror Ball
+    projection, seen by a wide camera at the origin looking down -y, where the ball's centre is."""
+    scene = ps._scene(size, size)
+    cam = scene.camera
+    cam.location = (0.0, 0.0, 0.0)
+    cam.rotation_euler = mathutils.Vector((-0.3, -1.0, 0.2)).to_track_quat("-Z", "Y").to_euler()
+    cam.data.lens = 12.0
+    world = new_world("World")
+    tree = world.node_tree
+    env = _node(tree, "ShaderNodeTexEnvironment", image=_texels(), interpolation="Closest", projection="MIRROR_BALL")
+    tree.links.new(env.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    scene.world = world
+    return scene

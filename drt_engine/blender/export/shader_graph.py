@@ -333,12 +333,11 @@ class Compiler:
     def _node_ShaderNodeTexEnvironment(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection != "EQUIRECTANGULAR":
+        if node.projection not in ("EQUIRECTANGULAR", "MIRROR_BALL"):
             return self._unsupported(node, f"Environment Texture {node.projection.title()} projection")
         vector = self._vector_or(node, "generated")
-        interpolation = "Closest" if node.interpolation == "Closest" else "Linear"
         i = self.program.add("environment", [vector], image=self.images.index(node.image),
-                             interpolation=interpolation)
+                             interpolation=node.interpolation, projection=node.projection)
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeMapping(self, node, output):

@@ -373,7 +373,9 @@ class Evaluator:
             return self._image(p, node.inputs[0], x[0])
         if op == "environment":
             tex = self.textures[p["image"]]
-            rgba = tex.lookup(equirect_uv(x[0]), None, "REPEAT", p.get("interpolation", "Linear"))
+            d = _normalize(x[0])
+            uv = mirror_ball_uv(d) if p.get("projection") == "MIRROR_BALL" else equirect_uv(d)
+            rgba = tex.lookup(uv, None, "REPEAT", p.get("interpolation", "Linear"))
             return rgba[:, :3], rgba[:, 3]
         if op == "math":
             out = _math(p["operation"], x[0], x[1], x[2])
@@ -579,6 +581,15 @@ class Evaluator:
         grad = ((hx - h) / eps)[:, None] * t + ((hy - h) / eps)[:, None] * b
         out = _normalize(n - dist[:, None] * grad)
         return _normalize(strength * out + (1.0 - strength) * n)
+
+
+def mirror_ball_uv(d):
+    """Cycles' direction_to_mirrorball: the point of a mirror ball, seen from -y, that reflects
+    direction ``d`` (unit vectors (N, 3)) towards the viewer."""
+    h = d - [0.0, 1.0, 0.0]
+    div = 2.0 * np.sqrt(np.maximum(-0.5 * h[:, 1], 0.0))
+    h = np.where((div > 0)[:, None], h / np.where(div > 0, div, 1.0)[:, None], h)
+    return np.stack([0.5 * (h[:, 0] + 1.0), 0.5 * (h[:, 2] + 1.0)], axis=1)
 
 
 def project(projection, co):
