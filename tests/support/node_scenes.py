@@ -419,6 +419,15 @@ def _reflection(tree):
     return _affine(tree, coords.outputs["Reflection"], 0.4, 0.5)
 
 
+def _normal_map(space):
+    """Normal Map of a constant colour, shown as a colour ((N + 1) / 2)."""
+    def build(tree):
+        node = _link(tree, _node(tree, "ShaderNodeNormalMap", space=space), Color=(0.75, 0.35, 0.85, 1.0),
+                     Strength=0.8)
+        return _affine(tree, node.outputs["Normal"], 0.5, 0.5)
+    return build
+
+
 FACING = (
     ("Fresnel", lambda tree: _link(tree, _node(tree, "ShaderNodeFresnel"), IOR=1.45).outputs[0]),
     ("Fresnel, IOR and normal linked", lambda tree: _link(
@@ -430,10 +439,13 @@ FACING = (
     ("Geometry True Normal and Backfacing", _true_normal_and_backfacing),
     ("Texture Coordinate Reflection", _reflection),
     ("Texture Coordinate Window (perspective)", _window_coordinates),
+    ("Normal Map tangent space", _normal_map("TANGENT")),
+    ("Normal Map object space", _normal_map("OBJECT")),
+    ("Normal Map Blender world space", _normal_map("BLENDER_WORLD")),
 )
 """Nodes that see the direction a hit is seen from or its side (Fresnel, Layer Weight, Geometry's
-True Normal and Backfacing, Texture Coordinate's Reflection), and Window coordinates in
-perspective: a diffuse sphere each, coloured by the node, in front (top row) and, with the
+True Normal and Backfacing, Texture Coordinate's Reflection, Normal Map), and Window
+coordinates in perspective: a diffuse sphere each, coloured by the node, in front (top row) and, with the
 normals turned inwards, from the back."""
 
 

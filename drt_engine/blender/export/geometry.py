@@ -322,7 +322,8 @@ class GeometryExporter:
         for index in set(slot_materials.tolist()):
             program = self.materials.materials[index].program
             if program is not None:
-                maps |= {n.params.get("map", "") for n in program.nodes if n.op == "normal_map"}
+                maps |= {n.params.get("map", "") for n in program.nodes
+                         if n.op == "normal_map" and n.params.get("space", "TANGENT") == "TANGENT"}
         return maps
 
     def _needs(self, slot_materials, name) -> bool:

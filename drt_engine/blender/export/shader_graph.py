@@ -481,10 +481,8 @@ class Compiler:
                                 squash_frequency=int(node.squash_frequency))
 
     def _node_ShaderNodeNormalMap(self, node, output):
-        if node.space != "TANGENT":
-            return self._unsupported(node, f"Normal Map {node.space.title()} space")
         args = (self._in(node, "Strength", "float"), self._in(node, "Color", "color"))
-        return self.op("normal_map", args, map=node.uv_map), 0
+        return self.op("normal_map", args, map=node.uv_map, space=node.space), 0
 
     def _node_ShaderNodeBump(self, node, output):
         height = self.ref(self._in(node, "Height", "float"), "float")

@@ -559,14 +559,28 @@ class Evaluator:
         return out[:, :3], out[:, 3]
 
     def _normal_map(self, p, strength, color):
+        """Cycles' svm_node_normal_map: the colour as a normal in tangent, object or world space
+        (Blender's own object and world conventions with y and z negated), turned round on
+        backfacing hits, blended with the shading normal by strength."""
         ctx = self.ctx
         n = ctx.normal
-        t, sign = ctx.tangent(p.get("map", ""))
-        b = sign[:, None] * np.cross(n, t)
+        back = ctx.backfacing()[:, None]
         c = 2.0 * color - 1.0
-        out = _normalize(c[:, :1] * t + c[:, 1:2] * b + c[:, 2:] * n)
+        space = p.get("space", "TANGENT")
+        if space == "TANGENT":
+            t, sign = ctx.tangent(p.get("map", ""))
+            front = np.where(back, -n, n)  # the surface's own side, as Cycles builds the frame
+            b = sign[:, None] * np.cross(front, t)
+            out = _normalize(c[:, :1] * t + c[:, 1:2] * b + c[:, 2:] * front)
+        else:
+            if space in ("BLENDER_OBJECT", "BLENDER_WORLD"):
+                c = c * [1.0, -1.0, -1.0]
+            m = ctx.object_matrix() if space in ("OBJECT", "BLENDER_OBJECT") else None
+            out = _normalize(c if m is None else np.einsum("nji,nj->ni", np.linalg.inv(m[:, :3, :3]), c))
+        out = np.where(back, -out, out)
         s = np.maximum(strength, 0.0)[:, None]
-        return _normalize(n + (out - n) * s)
+        out = np.where(s != 1.0, _normalize(n + (out - n) * s), out)
+        return np.where((vec.norm(out) == 0)[:, None], n, out)
 
     def _bump(self, p, refs):
         strength_ref, distance_ref, height_ref, normal_ref = refs
