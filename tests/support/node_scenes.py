@@ -9,6 +9,7 @@ every angle, from the front and from the back.
 """
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass
 from typing import Callable
 
@@ -229,6 +230,27 @@ def _attribute_fac(name):
     return build
 
 
+def _udim_tiles():
+    """A UDIM image of tiles 1001, 1002 and 1011 (4 x 4 random texels each, EXR files in a
+    temporary folder), made once."""
+    image = bpy.data.images.get("Tiles")
+    if image is None:
+        from tests.support.textured_scenes import write_image
+        folder = tempfile.mkdtemp(prefix="drt-udim-")
+        rng = np.random.default_rng(8)
+        for tile in (1001, 1002, 1011):
+            write_image(f"{folder}/tiles.{tile}.exr", rng.uniform(0.05, 1.0, (4, 4, 3)).astype(np.float32))
+        image = bpy.data.images.load(f"{folder}/tiles.1001.exr")
+        image.name = "Tiles"
+        image.source = "TILED"  # Blender finds the other tiles and puts <UDIM> in the path
+    return image
+
+
+def _udim(tree, v):
+    node = _node(tree, "ShaderNodeTexImage", image=_udim_tiles(), interpolation="Closest")
+    return _link(tree, node, Vector=_affine(tree, v, 0.9, 1.0)).outputs["Color"]  # tiles 1001-1012, and beyond
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -328,6 +350,7 @@ CASES = (
     NodeCase("Texture Coordinate from another object", _other_object_coordinates),
     NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
     NodeCase("Image Texture Tube projection", _projected("TUBE")),
+    NodeCase("Image Texture UDIM tiles", _udim, strength=0.5),
     NodeCase("Image Texture Cubic, repeat", _interpolated("Cubic", "REPEAT")),
     NodeCase("Image Texture Cubic, clip", _interpolated("Cubic", "CLIP")),
     NodeCase("Image Texture Cubic, extend", _interpolated("Cubic", "EXTEND")),

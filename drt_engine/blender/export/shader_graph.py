@@ -90,11 +90,31 @@ class ImageTable:
             self.images.append(self._export(image))
         return found
 
-    def _export(self, image) -> TextureImage:
+    def tiles(self, image) -> dict | None:
+        """A UDIM image read from files: tile number -> image index (each tile a file, "<UDIM>" in
+        its path replaced by the number); None for any other image."""
+        if image.source != "TILED" or image.packed_file is not None or "<UDIM>" not in image.filepath:
+            return None
+        key = ("tiles", image.as_pointer())
+        found = self._index.get(key)
+        if found is None:
+            found = self._index[key] = {}
+            colorspace = self._colorspace(image)
+            path = bpy.path.native_pathsep(bpy.path.abspath(image.filepath, library=image.library))
+            for tile in image.tiles:
+                found[int(tile.number)] = len(self.images)
+                self.images.append(TextureImage(f"{image.name}.{tile.number}",
+                                                path=path.replace("<UDIM>", str(tile.number)), colorspace=colorspace))
+        return found
+
+    def _colorspace(self, image) -> str:
         space = image.colorspace_settings.name
         if space != "sRGB" and space not in COLORSPACES_AS_IS:
             self.warnings.append(f"image '{image.name}': colour space {space} used as linear")
-        colorspace = "sRGB" if space == "sRGB" else "Non-Color"
+        return "sRGB" if space == "sRGB" else "Non-Color"
+
+    def _export(self, image) -> TextureImage:
+        colorspace = self._colorspace(image)
         # Blender's own pixels where they are the only source, or where OpenImageIO is missing
         if image.packed_file is not None or image.source == "GENERATED" or not openimageio_available():
             w, h = image.size
@@ -104,8 +124,11 @@ class ImageTable:
                 # byte images hold encoded values; float images are linear already
                 return TextureImage(image.name, pixels=pixels.reshape(h, w, 4),
                                     colorspace=colorspace if not image.is_float else "Non-Color")
-        if image.source != "FILE":
+        if image.source not in ("FILE", "TILED"):
             self.warnings.append(f"image '{image.name}': {image.source.lower()} images are not supported")
+        elif image.source == "TILED" and (image.packed_file is not None or "<UDIM>" not in image.filepath):
+            self.warnings.append(f"image '{image.name}': packed or generated UDIM tiles are not supported "
+                                 "(its first tile used everywhere)")
         path = bpy.path.abspath(image.filepath, library=image.library)
         return TextureImage(image.name, path=bpy.path.native_pathsep(path), colorspace=colorspace)
 
@@ -325,9 +348,11 @@ class Compiler:
             return self._no_image(node, output)
         interpolation = node.interpolation
         vector = self._vector_or(node, "generated" if self.world else "uv")
-        i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
+        tiles = self.images.tiles(node.image) if node.projection != "BOX" else None
+        first = min(tiles.items())[1] if tiles else self.images.index(node.image)
+        i = self.program.add("image", [vector], image=first, interpolation=interpolation,
                              extension=node.extension, projection=node.projection,
-                             blend=float(node.projection_blend))
+                             blend=float(node.projection_blend), tiles=tiles)
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeTexEnvironment(self, node, output):

@@ -22,7 +22,7 @@ from ..base.vectors import orthonormal_basis
 from ..scene import Program
 from . import colornodes as cn
 from . import proctex
-from .textures import Texture, equirect_uv
+from .textures import MAGENTA, Texture, equirect_uv
 
 """Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
 
@@ -519,7 +519,6 @@ class Evaluator:
         return v
 
     def _image(self, p, vector_ref, uv3):
-        tex = self.textures[p["image"]]
         projection = p.get("projection", "FLAT")
         uv = project(projection, uv3)
         footprint = None
@@ -529,7 +528,21 @@ class Evaluator:
                 footprint = tuple(project(projection, e(vector_ref)) - uv for e in shifted)
                 if projection in ("SPHERE", "TUBE"):  # across the seam, the short way round
                     footprint = tuple(np.stack([d[:, 0] - np.round(d[:, 0]), d[:, 1]], axis=1) for d in footprint)
-        rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+        lookup = (p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+        if not p.get("tiles"):
+            rgba = self.textures[p["image"]].lookup(uv, footprint, *lookup)
+            return rgba[:, :3], rgba[:, 3]
+        # UDIM, as Cycles' svm_node_tex_image: the tile the coordinates fall in (their integer
+        # parts, truncated), read at the coordinates less those; outside every tile, magenta
+        tx, ty = np.trunc(uv[:, 0]), np.trunc(uv[:, 1])
+        number = np.where((tx >= 0) & (ty >= 0) & (tx < 10), 1001 + 10 * ty + tx, -1).astype(np.int64)
+        rgba = np.tile(MAGENTA, (self.ctx.n, 1)).astype(float)
+        for tile, index in p["tiles"].items():
+            sel = np.flatnonzero(number == tile)
+            if len(sel):
+                fp = None if footprint is None else tuple(d[sel] for d in footprint)
+                local = uv[sel] - np.stack([tx[sel], ty[sel]], axis=1)
+                rgba[sel] = self.textures[index].lookup(local, fp, *lookup)
         return rgba[:, :3], rgba[:, 3]
 
     def _image_box(self, p, vector_ref, co):
