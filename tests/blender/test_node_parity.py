@@ -27,6 +27,17 @@ def _cannot(data):
     return [w for w in data.warnings if "cannot evaluate" in w]
 
 
+def _matches_cycles(scene, out, name, label):
+    """Export ``scene`` without a warning, render it with DRT and Cycles (two seeds) and hold DRT
+    to the parity rule over the whole image; DRT's render."""
+    assert not _cannot(render_export(scene))
+    drt_render, c0, c1 = ps.parity_renders(scene, out, name)
+    rh.save_side_by_side(name, drt_render.rgb, c0.rgb)
+    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
+    assert figures["ok"], ps.message(label, figures)
+    return drt_render
+
+
 def test_every_case_exports_without_a_warning(drt):
     assert not _cannot(render_export(ns.grid_scene()))
     assert not _cannot(render_export(ns.facing_scene()))
@@ -106,30 +117,16 @@ def test_legacy_separate_and_combine_nodes_compile_as_their_colour_modes(drt):
 def test_pointiness_matches_cycles(drt, tmp_path):
     """Pointiness of a bumpy icosphere whose sharp edges are split: Cycles' per-vertex angle,
     blur and welding of the split vertices."""
-    scene = ns.pointiness_scene()
-    assert not _cannot(render_export(scene))
-    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "pointiness")
-    rh.save_side_by_side("pointiness", drt_render.rgb, c0.rgb)
-    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
-    assert figures["ok"], ps.message("Pointiness", figures)
+    _matches_cycles(ns.pointiness_scene(), tmp_path, "pointiness", "Pointiness")
 
 
 def test_object_instancer_and_view_layer_attributes_match_cycles(drt, tmp_path):
-    scene = ns.attribute_scene()
-    assert not _cannot(render_export(scene))
-    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "attributes")
-    rh.save_side_by_side("attributes", drt_render.rgb, c0.rgb)
-    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
-    assert figures["ok"], ps.message("Object, Instancer and View Layer attributes", figures)
+    drt_render = _matches_cycles(ns.attribute_scene(), tmp_path, "attributes",
+                                 "Object, Instancer and View Layer attributes")
     centre = drt_render.rgb[ps.TILE // 2, ps.TILE // 2::ps.TILE]
     assert np.allclose(centre, [[0.2, 0.7, 0.4], [2.0, 0.35, 0.0], [0.6] * 3, [0.3, 0.3, 0.9], [0.9, 0.5, 0.1]],
                        atol=1e-3)
 
 
 def test_mirror_ball_environment_matches_cycles(drt, tmp_path):
-    scene = ns.mirror_ball_scene()
-    assert not _cannot(render_export(scene))
-    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "mirror-ball")
-    rh.save_side_by_side("mirror-ball", drt_render.rgb, c0.rgb)
-    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
-    assert figures["ok"], ps.message("Environment Texture, Mirror Ball", figures)
+    _matches_cycles(ns.mirror_ball_scene(), tmp_path, "mirror-ball", "Environment Texture, Mirror Ball")

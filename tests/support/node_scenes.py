@@ -478,10 +478,8 @@ def facing_scene(size=32):
     shading normal at every angle. The bottom row's spheres have their normals flipped, so the
     camera sees their backs (Cycles' backfacing hits: the IOR inverted)."""
     scene = ps._scene(size * len(FACING), 2 * size)
-    cam = scene.camera
-    cam.location = (0.0, -7.0 * len(FACING) / 2.4, 0.0)  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 pixels
-    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
-    cam.data.lens = 50.0
+    ps.aim(scene.camera, (0.0, -7.0 * len(FACING) / 2.4, 0.0))  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 px
+    scene.camera.data.lens = 50.0
     scene.world = new_world("World")
     for row, flipped in enumerate((False, True)):
         for i, (name, build) in enumerate(FACING):
@@ -508,12 +506,8 @@ def pointiness_scene(size=48):
     duplicated vertices Pointiness welds again), emitting its Pointiness with the contrast raised
     (4 p - 1.5, through Absolute), seen in perspective."""
     scene = ps._scene(size, size)
-    cam = scene.camera
-    cam.location = (2.4, -3.0, 2.2)
-    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    ps.aim(scene.camera, (2.4, -3.0, 2.2))
+    ps.black_world(scene)
     bpy.ops.mesh.primitive_ico_sphere_add(radius=1.0, subdivisions=3)
     obj = bpy.context.active_object
     rng = np.random.default_rng(4)
@@ -559,9 +553,7 @@ def attribute_scene():
     cam = scene.camera
     cam.data.type = "ORTHO"
     cam.data.ortho_scale = 10.0
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    ps.black_world(scene)
     own = _plane("Own", -4.0, _attribute_material("Own", "OBJECT", "tint"), scene.collection)
     own["tint"] = (0.2, 0.7, 0.4)
     path = _plane("Path", -2.0, _attribute_material("Path", "OBJECT", "location"), scene.collection)

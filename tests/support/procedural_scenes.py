@@ -194,6 +194,19 @@ def _scene(width: int, height: int):
     return scene
 
 
+def black_world(scene) -> None:
+    """A world that gives no light (the Background's strength 0)."""
+    world = new_world("World")
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+
+
+def aim(camera, location) -> None:
+    """Place ``camera`` at ``location`` looking at the origin, y up."""
+    camera.location = location
+    camera.rotation_euler = (-mathutils.Vector(camera.location)).to_track_quat("-Z", "Y").to_euler()
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))
@@ -210,9 +223,7 @@ def grid_scene(cases=CASES, material=None):
     cam = scene.camera
     cam.data.type = "ORTHO"
     cam.data.ortho_scale = 2.0 * max(cols, rows)
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    black_world(scene)
     for i, case in enumerate(cases):
         row, col = divmod(i, cols)
         mesh = bpy.data.meshes.new(case.name)
@@ -319,9 +330,7 @@ def lit_scene(width=48):
     cam = scene.camera
     cam.location = (0.0, -6.0, 4.0)
     cam.rotation_euler = (0.98, 0.0, 0.0)
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    black_world(scene)
     bpy.ops.mesh.primitive_plane_add(size=8.0)
     bpy.context.active_object.data.materials.append(_diffuse("Ground", _ground_color))
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(0.0, 0.0, 1.0), segments=48, ring_count=24)
@@ -343,12 +352,8 @@ def box_scene(width=48, blend=0.3):
     colours (Closest) in Box projection of its Object coordinates: the three faces and the
     blended seams between them, which follow the object-space normal."""
     scene = _scene(width, width)
-    cam = scene.camera
-    cam.location = (2.6, -3.4, 2.4)
-    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    aim(scene.camera, (2.6, -3.4, 2.4))
+    black_world(scene)
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=64, ring_count=32, rotation=(0.3, 0.2, 0.5))
     bpy.ops.object.shade_smooth()
     image = bpy.data.images.new("Texels", 8, 8, float_buffer=True)
