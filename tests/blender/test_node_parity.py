@@ -130,3 +130,16 @@ def test_object_instancer_and_view_layer_attributes_match_cycles(drt, tmp_path):
 
 def test_mirror_ball_environment_matches_cycles(drt, tmp_path):
     _matches_cycles(ns.mirror_ball_scene(), tmp_path, "mirror-ball", "Environment Texture, Mirror Ball")
+
+
+def test_box_projection_of_a_udim_image_reads_tile_1001(drt):
+    """As Cycles: Box projection's coordinates always fall in tile 1001, the only tile it loads."""
+    scene = ns.grid_scene(ns.CASES[:1])
+    mat = scene.objects[ns.CASES[0].name].data.materials[0]
+    image = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    image.image, image.projection = ns._udim_tiles(), "BOX"
+    emission = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    mat.node_tree.links.new(image.outputs["Color"], emission.inputs["Color"])
+    data = render_export(scene)
+    (node,) = [n for m in data.materials if m.program is not None for n in m.program.nodes if n.op == "image"]
+    assert node.params["tiles"] is None and data.images[node.params["image"]].path.endswith("tiles.1001.exr")

@@ -348,8 +348,10 @@ class Compiler:
             return self._no_image(node, output)
         interpolation = node.interpolation
         vector = self._vector_or(node, "generated" if self.world else "uv")
-        tiles = self.images.tiles(node.image) if node.projection != "BOX" else None
-        first = min(tiles.items())[1] if tiles else self.images.index(node.image)
+        tiles = self.images.tiles(node.image)
+        first = (tiles[1001] if 1001 in tiles else min(tiles.items())[1]) if tiles else self.images.index(node.image)
+        if node.projection == "BOX":
+            tiles = None  # Cycles: Box projection's coordinates always fall in tile 1001
         i = self.program.add("image", [vector], image=first, interpolation=interpolation,
                              extension=node.extension, projection=node.projection,
                              blend=float(node.projection_blend), tiles=tiles)
