@@ -251,6 +251,21 @@ def _udim(tree, v):
     return _link(tree, node, Vector=_affine(tree, v, 0.9, 1.0)).outputs["Color"]  # tiles 1001-1012, and beyond
 
 
+def _mapped(kind, vector_type, axes=("X", "Y", "Z"), image=False, **props):
+    """A texture node fed by the tile's coordinates through its own Texture Mapping (an Image
+    Texture reads the 8 x 8 texels)."""
+    def build(tree, v):
+        node = _node(tree, kind, **props)
+        if image:
+            node.image = _texels()
+        mapping = node.texture_mapping
+        mapping.vector_type = vector_type
+        mapping.translation, mapping.rotation, mapping.scale = (0.3, -0.2, 0.5), (0.4, 0.2, -0.7), (1.5, 0.8, 1.2)
+        mapping.mapping_x, mapping.mapping_y, mapping.mapping_z = axes
+        return _link(tree, node, Vector=v).outputs[0]
+    return build
+
+
 def _normal_dot(tree, v):
     node = _node(tree, "ShaderNodeNormal")
     node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
@@ -351,6 +366,13 @@ CASES = (
     NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
     NodeCase("Image Texture Tube projection", _projected("TUBE")),
     NodeCase("Image Texture UDIM tiles", _udim, strength=0.5),
+    NodeCase("Texture Mapping, texture type (Noise)", _mapped("ShaderNodeTexNoise", "TEXTURE")),
+    NodeCase("Texture Mapping, point type, axes swapped (Checker)",
+             _mapped("ShaderNodeTexChecker", "POINT", ("Y", "NONE", "X"))),
+    NodeCase("Texture Mapping, vector type (Image)", _mapped("ShaderNodeTexImage", "VECTOR", image=True,
+                                                              interpolation="Closest")),
+    NodeCase("Texture Mapping, normal type (Gradient)", _mapped("ShaderNodeTexGradient", "NORMAL",
+                                                                 gradient_type="RADIAL")),
     NodeCase("Image Texture Cubic, repeat", _interpolated("Cubic", "REPEAT")),
     NodeCase("Image Texture Cubic, clip", _interpolated("Cubic", "CLIP")),
     NodeCase("Image Texture Cubic, extend", _interpolated("Cubic", "EXTEND")),

@@ -8,6 +8,7 @@ value and one line in the owner's warning naming the node type.
 from __future__ import annotations
 
 import bpy
+import mathutils
 import numpy as np
 
 from ...core.base.colour import LUMINANCE
@@ -68,6 +69,35 @@ def find_rgba(owners, name) -> np.ndarray:
         if rgba is not None:
             return rgba
     return np.zeros(4)
+
+
+def texture_mapping_matrix(mapping) -> np.ndarray | None:
+    """(4, 4) of a texture node's Texture Mapping as Cycles' TextureMapping::compute_transform
+    (None when it changes nothing): the axes picked first, then scale, rotation (Euler XYZ) and
+    translation (Point), their inverse (Texture), without translation (Vector), or the inverse
+    transpose (Normal, normalised after). Cycles reads no min/max from Blender."""
+    if mapping is None:
+        return None
+    axes = (mapping.mapping_x, mapping.mapping_y, mapping.mapping_z)
+    if not any(mapping.translation) and not any(mapping.rotation) and tuple(mapping.scale) == (1.0, 1.0, 1.0) \
+            and axes == ("X", "Y", "Z"):
+        return None
+    pick = np.zeros((4, 4))
+    pick[3, 3] = 1.0
+    for row, axis in enumerate(axes):
+        if axis != "NONE":
+            pick[row, "XYZ".index(axis)] = 1.0
+    kind = mapping.vector_type
+    scale = np.array(mapping.scale, float)
+    if kind in ("TEXTURE", "NORMAL"):  # kept invertible
+        scale = np.where(np.abs(scale) < 1e-5, np.where(scale < 0, -1e-5, 1e-5), scale)
+    linear = np.eye(4)
+    linear[:3, :3] = np.array(mathutils.Euler(mapping.rotation, "XYZ").to_matrix()) @ np.diag(scale)
+    full = linear.copy()
+    full[:3, 3] = mapping.translation
+    mat = {"POINT": full, "TEXTURE": np.linalg.inv(full), "VECTOR": linear,
+           "NORMAL": np.linalg.inv(linear).T}[kind]
+    return mat @ pick
 
 
 def is_ref(value) -> bool:
@@ -333,10 +363,20 @@ class Compiler:
         return self._attribute(node.layer_name, output)
 
     def _vector_or(self, node, default):
+        """The node's Vector input when linked, else the ``default`` coordinates, through the
+        node's Texture Mapping (its panel hidden in Blender's UI, older files set it)."""
         socket = node.inputs.get("Vector")
         if socket is not None and socket.is_linked:
-            return self.ref(self.value(socket, "vector"))
-        return self._coord(default)
+            vector = self.ref(self.value(socket, "vector"))
+        else:
+            vector = self._coord(default)
+        matrix = texture_mapping_matrix(getattr(node, "texture_mapping", None))
+        if matrix is None:
+            return vector
+        vector = self.op("affine", (vector,), matrix=matrix[:3]), 0
+        if node.texture_mapping.vector_type == "NORMAL":
+            vector = self.op("vector_math", (vector, np.zeros(3), np.zeros(3), 1.0), operation="NORMALIZE"), 0
+        return vector
 
     def _no_image(self, node, output):
         """Cycles renders a texture node without an image in magenta (measured), as a missing file."""
@@ -471,10 +511,6 @@ class Compiler:
     def _procedural(self, node, output, op, **params):
         """A procedural texture node: its vector (Generated coordinates when unlinked, as in
         Cycles), its other sockets in core.shading.proctex's order, and the output's index."""
-        mapping = getattr(node, "texture_mapping", None)
-        if mapping is not None and (any(mapping.translation) or any(mapping.rotation)
-                                    or any(v != 1.0 for v in mapping.scale)):
-            self.issues.add(f"'{node.name}' texture mapping (ignored)")
         kinds = {"Vector": "vector", "Color1": "color", "Color2": "color", "Mortar": "color"}
         args = [self._vector_or(node, "generated")]
         args += [self._in(node, name, kinds.get(name, "float")) for name in proctex.INPUTS[op][1:]]
