@@ -292,7 +292,7 @@ class SurfaceAttributes:
         return t, sign
 
 
-VIEW_OPS = ("fresnel", "layer_weight", "backfacing")
+VIEW_OPS = ("fresnel", "layer_weight", "backfacing", "normal_map")  # normal maps turn round on back faces
 VIEW_COORDS = ("incoming", "reflection", "true_normal")
 
 
