@@ -21,7 +21,6 @@ import bpy  # noqa: E402
 import drt_engine  # noqa: E402
 from bench.blocks import replace_between  # noqa: E402
 from tests.support import procedural_scenes as ps  # noqa: E402
-from tests.support import render_helpers as rh  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- texture parity: begin -->", "<!-- texture parity: end -->"
 JSON_PATH = ROOT / "docs" / "texture_parity.json"
@@ -29,20 +28,15 @@ PAGE = ROOT / "docs" / "shader-node-parity.md"
 BOX_BLENDS = (0.0, 0.3)
 
 
-def _three(scene, out, name):
-    return [rh.render(scene, engine, ps.SAMPLES, seed, out, name=name)
-            for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))]
-
-
 def measure() -> dict:
     with tempfile.TemporaryDirectory() as out:
-        grid = [ps.tiles(r.rgb, len(ps.CASES)) for r in _three(ps.grid_scene(), out, "grid")]
-        cases = {case.name: ps.parity(*(tiles[i] for tiles in grid)) for i, case in enumerate(ps.CASES)}
-        lit = _three(ps.lit_scene(), out, "lit")
+        grid = ps.grid_tiles(ps.grid_scene(), len(ps.CASES), out, "grid")
+        cases = {case.name: ps.tile_figures(grid, i) for i, case in enumerate(ps.CASES)}
+        lit = ps.parity_renders(ps.lit_scene(), out, "lit")
         cases["Lit scene (Voronoi x Noise ground, Brick and Wave sphere; sun and point light)"] = ps.parity(
             *(r.rgb for r in lit))
         for blend in BOX_BLENDS:
-            box = _three(ps.box_scene(blend=blend), out, f"box-{blend}")
+            box = ps.parity_renders(ps.box_scene(blend=blend), out, f"box-{blend}")
             cases[f"Image Texture, Box projection, blend {blend}"] = ps.parity(*(r.rgb for r in box))
     return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "tile_px": ps.TILE, "cases": cases}
 

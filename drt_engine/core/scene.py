@@ -184,6 +184,8 @@ class Instance:
     mesh: int
     matrices: np.ndarray
     name: str = ""
+    attributes: dict = field(default_factory=dict)
+    """Object and Instancer attributes its materials read (Attribute node): key -> RGBA (4,)."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)

@@ -19,11 +19,7 @@ from tests.support.export_helpers import render_export
 @pytest.fixture(scope="module")
 def grid(drt, tmp_path_factory):
     """Tiles of DRT seed 0, Cycles seeds 0 and 1, per case."""
-    scene = ps.grid_scene()
-    out = tmp_path_factory.mktemp("procedural")
-    renders = [rh.render(scene, engine, ps.SAMPLES, seed, out, name="grid")
-               for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))]
-    return [ps.tiles(r.rgb, len(ps.CASES)) for r in renders]
+    return ps.grid_tiles(ps.grid_scene(), len(ps.CASES), tmp_path_factory.mktemp("procedural"), "grid")
 
 
 def test_every_case_exports_without_a_warning(drt):
@@ -33,16 +29,13 @@ def test_every_case_exports_without_a_warning(drt):
 
 @pytest.mark.parametrize("index", range(len(ps.CASES)), ids=[c.name for c in ps.CASES])
 def test_texture_matches_cycles(grid, index):
-    drt, cycles0, cycles1 = (tiles[index] for tiles in grid)
-    figures = ps.parity(drt, cycles0, cycles1)
-    assert figures["ok"], (f"{ps.CASES[index].name}: worst block {figures['worst']:.4f} > "
-                           f"{figures['limit']:.4f} (Cycles' seeds: {figures['cycles_seeds']:.4f})")
+    figures = ps.tile_figures(grid, index)
+    assert figures["ok"], ps.message(ps.CASES[index].name, figures)
 
 
 def test_lit_scene_matches_cycles(drt, tmp_path):
     scene = ps.lit_scene()
-    drt_render, c0, c1 = (rh.render(scene, engine, ps.SAMPLES, seed, tmp_path, name="lit")
-                          for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "lit")
     figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
     rh.save_side_by_side("procedural-lit", drt_render.rgb, c0.rgb)
     assert figures["ok"], figures
@@ -52,8 +45,7 @@ def test_lit_scene_matches_cycles(drt, tmp_path):
 def test_image_box_projection_matches_cycles(drt, tmp_path, blend):
     scene = ps.box_scene(blend=blend)
     assert not [w for w in render_export(scene).warnings if "projection" in w]
-    drt_render, c0, c1 = (rh.render(scene, engine, ps.SAMPLES, seed, tmp_path, name="box")
-                          for engine, seed in (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1)))
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "box")
     figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
     rh.save_side_by_side(f"box-projection-{blend}", drt_render.rgb, c0.rgb)
     assert figures["ok"], figures

@@ -201,3 +201,24 @@ def test_textured_emission_lights_like_its_mean_and_is_seen_per_texel():
     image = TextureImage("noise", pixels=np.random.default_rng(1).random((TEXELS, TEXELS, 4)), colorspace="Non-Color")
     seen, _ = render(constant_world_scene(uv_plane(), glow, ortho_top(RES), radiance=0.0, images=[image]))
     assert np.abs(interior(seen) - image.pixels[..., :3]).max() < 1e-6
+
+
+def test_cubic_is_cycles_b_spline():
+    """Cubic (and Smart) read the image as Cycles' cubic B-spline: its weights, constants and
+    linear ramps reproduced, a texel spread over its neighbours, and Clip fading out past the edge."""
+    from drt_engine.core.shading.textures import bspline_weights
+    w = bspline_weights(np.array([0.0, 0.3, 1.0]))
+    assert np.allclose(w.sum(axis=1), 1) and np.allclose(w[0], [1 / 6, 2 / 3, 1 / 6, 0]) and np.allclose(w[2, 1:], w[0, :3])
+    ramp = np.repeat(np.arange(8, dtype=np.float32)[None, :, None], 8, axis=0).repeat(4, axis=2)
+    tex = Texture(TextureImage("ramp", pixels=ramp, colorspace="Non-Color"))
+    uv = np.array([[0.4, 0.5], [0.55, 0.2]])
+    assert np.allclose(tex.lookup(uv, None, "EXTEND", "Cubic")[:, 0], uv[:, 0] * 8 - 0.5)  # linear in, linear out
+    spike = np.zeros((8, 8, 4), np.float32)
+    spike[4, 4] = 1.0
+    tex = Texture(TextureImage("spike", pixels=spike, colorspace="Non-Color"))
+    centre = np.array([[4.5 / 8, 4.5 / 8]])
+    assert np.isclose(tex.lookup(centre, None, "REPEAT", "Smart")[0, 0], (2 / 3) ** 2)
+    assert np.isclose(tex.lookup(centre + [1 / 8, 0], None, "REPEAT", "Cubic")[0, 0], 2 / 3 / 6)
+    edge = Texture(TextureImage("white", pixels=np.ones((8, 8, 4), np.float32), colorspace="Non-Color"))
+    past = edge.lookup(np.array([[1.0 + 0.5 / 8, 0.5], [1.5, 0.5]]), None, "CLIP", "Cubic")[:, 0]
+    assert np.allclose(past, [1 / 6, 0.0])  # half a texel past the edge: only the last column's 1/6 left

@@ -17,6 +17,7 @@ import bpy
 import mathutils
 import numpy as np
 
+from tests.support import render_helpers as rh
 from tests.support.datablocks import new_material, new_world
 from tests.support.export_helpers import empty_scene
 
@@ -193,26 +194,44 @@ def _scene(width: int, height: int):
     return scene
 
 
+def black_world(scene) -> None:
+    """A world that gives no light (the Background's strength 0)."""
+    world = new_world("World")
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+
+
+def aim(camera, location) -> None:
+    """Place ``camera`` at ``location`` looking at the origin, y up."""
+    camera.location = location
+    camera.rotation_euler = (-mathutils.Vector(camera.location)).to_track_quat("-Z", "Y").to_euler()
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))
 
 
-def grid_scene(cases=CASES):
-    """The cases as a grid of emissive tiles (row-major from the top left) under a black world."""
+def grid_scene(cases=CASES, material=None):
+    """The cases as a grid of emissive tiles (row-major from the top left) under a black world;
+    ``material(case)`` makes each tile's material (this module's texture cases by default), and
+    a case with a ``mesh`` ((vertices, faces) within the tile's 2 x 2 m) has it instead of one quad,
+    and a case's ``setup(mesh)`` adds to its tile's mesh what it needs (attributes)."""
+    material = material or _material
     cols, rows = grid_shape(len(cases))
     scene = _scene(cols * TILE, rows * TILE)
     cam = scene.camera
     cam.data.type = "ORTHO"
     cam.data.ortho_scale = 2.0 * max(cols, rows)
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    black_world(scene)
     for i, case in enumerate(cases):
         row, col = divmod(i, cols)
         mesh = bpy.data.meshes.new(case.name)
-        mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
-        mesh.materials.append(_material(case))
+        shape = getattr(case, "mesh", None) or ([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [(0, 1, 2, 3)])
+        mesh.from_pydata(shape[0], [], shape[1])
+        if getattr(case, "setup", None) is not None:
+            case.setup(mesh)
+        mesh.materials.append(material(case))
         obj = bpy.data.objects.new(case.name, mesh)
         obj.location = (2.0 * col - cols + 1.0, rows - 1.0 - 2.0 * row, 0.0)
         scene.collection.objects.link(obj)
@@ -240,6 +259,31 @@ def parity(drt: np.ndarray, cycles0: np.ndarray, cycles1: np.ndarray) -> dict:
     worst = worst_block(drt, cycles0)
     own = worst_block(cycles0, cycles1)
     return {"worst": worst, "cycles_seeds": own, "limit": 1.5 * own + 0.002, "ok": worst <= 1.5 * own + 0.002}
+
+
+RUNS = (("DRT", 0), ("CYCLES", 0), ("CYCLES", 1))
+"""The renders a parity figure compares: DRT seed 0 against Cycles seed 0, Cycles seeds 0 and 1."""
+
+
+def parity_renders(scene, out, name):
+    """DRT seed 0, Cycles seeds 0 and 1 of ``scene`` (render_helpers.Render each)."""
+    return [rh.render(scene, engine, SAMPLES, seed, out, name=name) for engine, seed in RUNS]
+
+
+def grid_tiles(scene, n: int, out, name) -> list:
+    """The ``n`` case tiles of a grid scene's three ``parity_renders``: [DRT, Cycles 0, Cycles 1]."""
+    return [tiles(r.rgb, n) for r in parity_renders(scene, out, name)]
+
+
+def tile_figures(grid, index) -> dict:
+    """``parity`` of case ``index`` from the tiles of the three ``parity_renders``."""
+    return parity(*(tiles[index] for tiles in grid))
+
+
+def message(name: str, figures: dict) -> str:
+    """A failed case's figures, for an assertion."""
+    return (f"{name}: worst block {figures['worst']:.4f} > {figures['limit']:.4f} "
+            f"(Cycles' seeds: {figures['cycles_seeds']:.4f})")
 
 
 def _diffuse(name, color_from):
@@ -286,9 +330,7 @@ def lit_scene(width=48):
     cam = scene.camera
     cam.location = (0.0, -6.0, 4.0)
     cam.rotation_euler = (0.98, 0.0, 0.0)
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    black_world(scene)
     bpy.ops.mesh.primitive_plane_add(size=8.0)
     bpy.context.active_object.data.materials.append(_diffuse("Ground", _ground_color))
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(0.0, 0.0, 1.0), segments=48, ring_count=24)
@@ -310,12 +352,8 @@ def box_scene(width=48, blend=0.3):
     colours (Closest) in Box projection of its Object coordinates: the three faces and the
     blended seams between them, which follow the object-space normal."""
     scene = _scene(width, width)
-    cam = scene.camera
-    cam.location = (2.6, -3.4, 2.4)
-    cam.rotation_euler = (-mathutils.Vector(cam.location)).to_track_quat("-Z", "Y").to_euler()
-    world = new_world("World")
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    aim(scene.camera, (2.6, -3.4, 2.4))
+    black_world(scene)
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=64, ring_count=32, rotation=(0.3, 0.2, 0.5))
     bpy.ops.object.shade_smooth()
     image = bpy.data.images.new("Texels", 8, 8, float_buffer=True)

@@ -45,7 +45,7 @@ def export_scene(
     camera = export_camera(scene, camera_object)
     warnings: list[str] = []
     images = ImageTable(warnings)
-    materials = MaterialTable(warnings, images)
+    materials = MaterialTable(warnings, images, (scene, depsgraph.view_layer))
     geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes)
     lights = []
     light_keys = []
@@ -62,7 +62,7 @@ def export_scene(
                 lights.append(light)
                 light_keys.append(instance_key(instance))
         else:
-            geometry.add(obj, matrix, instance_key(instance))
+            geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None)
     geometry.finish()
     scene_data = SceneData(
         camera=camera,

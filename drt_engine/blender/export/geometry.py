@@ -17,7 +17,9 @@ import bpy
 import numpy as np
 
 from ...core.scene import Instance, Mesh
+from ...core.shading.proctex.hash import hash_uint, to_unit
 from .materials import MaterialTable
+from .shader_graph import ISLANDS, POINTINESS, find_rgba
 
 
 def _read(collection, attribute, count, width, dtype):
@@ -77,7 +79,99 @@ def _tangents(mesh, uv_maps, tri_loops, attributes, warnings):
         mesh.free_tangents()
 
 
-def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None) -> Mesh | None:
+def island_roots(edges: np.ndarray, vertex_count: int) -> np.ndarray:
+    """Per vertex, the root of its island (the vertices its edges connect) as Cycles' DisjointSet
+    finds it after joining the edges in order: union by rank, the first set's root kept on ties,
+    path compression. The root, not just the island, decides Random Per Island's value."""
+    parents = list(range(vertex_count))
+    ranks = [0] * vertex_count
+
+    def find(x):
+        root = x
+        while parents[root] != root:
+            root = parents[root]
+        while parents[x] != root:
+            parents[x], x = root, parents[x]
+        return root
+
+    for a, b in edges.tolist():
+        ra, rb = find(a), find(b)
+        if ra == rb:
+            continue
+        if ranks[ra] < ranks[rb]:
+            ra, rb = rb, ra
+        parents[rb] = ra
+        if ranks[ra] == ranks[rb]:
+            ranks[ra] += 1
+    return np.array([find(v) for v in range(vertex_count)], np.int64)
+
+
+def random_per_island(mesh, tri_vertices) -> np.ndarray:
+    """(T,) Cycles' Random Per Island of each loop triangle: the hash of its first vertex's island root."""
+    edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+    roots = island_roots(edges, len(mesh.vertices))[tri_vertices[:, 0]]
+    values = {r: to_unit(hash_uint(r)) for r in np.unique(roots).tolist()}
+    return np.array([values[r] for r in roots.tolist()], np.float32)
+
+
+FLT_EPSILON = float(np.finfo(np.float32).eps)
+
+
+def welded(positions: np.ndarray) -> np.ndarray:
+    """Per vertex, the vertex it is welded to for Pointiness (itself if none), as Cycles'
+    attr_create_pointiness: in order of coordinate sums, each vertex points to the first later
+    one whose sum is within 3 FLT_EPSILON and whose squared distance is below FLT_EPSILON, and
+    chains are followed to their end."""
+    n = len(positions)
+    order = np.argsort(positions.sum(axis=1), kind="stable")
+    sums = positions.sum(axis=1)[order]
+    found = np.full(n, -1, np.int64)
+    for j in range(1, n):
+        k = np.flatnonzero((found[:n - j] < 0) & (sums[j:] - sums[:n - j] <= 3 * FLT_EPSILON))
+        if len(k) == 0:
+            break
+        close = ((positions[order[k + j]] - positions[order[k]]) ** 2).sum(axis=1) < FLT_EPSILON
+        found[k[close]] = order[k[close] + j]
+    orig = np.arange(n)
+    orig[order] = np.where(found >= 0, found, order)
+    while True:
+        nxt = orig[orig]
+        if np.array_equal(nxt, orig):
+            return orig
+        orig = nxt
+
+
+def pointiness(positions: np.ndarray, normals: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(V,) Cycles' Pointiness (blender/mesh.cpp attr_create_pointiness): duplicate vertices
+    welded, per vertex the angle between its (welded) normal and the mean direction of its edges
+    over pi, then blurred with its edge neighbours."""
+    n = len(positions)
+    orig = welded(positions)
+    normal = np.zeros((n, 3))
+    np.add.at(normal, orig, normals)
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = (normal / np.where(length > 0, length, 1.0))[orig]
+    pairs = np.unique(np.sort(orig[edges], axis=1), axis=0)  # each welded edge once
+    v0, v1 = pairs[:, 0], pairs[:, 1]
+    d = positions[v1] - positions[v0]
+    dl = np.linalg.norm(d, axis=1, keepdims=True)
+    d = np.where(dl > 0, d / np.where(dl > 0, dl, 1.0), 0.0)
+    accum = np.zeros((n, 3))
+    np.add.at(accum, v0, d)
+    np.add.at(accum, v1, -d)
+    count = np.bincount(v0, minlength=n) + np.bincount(v1, minlength=n)
+    mean = accum / np.maximum(count, 1)[:, None]
+    raw = np.where((count > 0) & (orig == np.arange(n)),
+                   np.arccos(np.clip((normal * mean).sum(axis=1), -1.0, 1.0)) / np.pi, 0.0)
+    data = raw.copy()
+    np.add.at(data, v0, raw[v1])
+    np.add.at(data, v1, raw[v0])
+    data /= count + 1
+    return data[orig].astype(np.float32)
+
+
+def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None,
+                      islands=False, pointy=False) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
@@ -96,6 +190,13 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
     attributes, uvs, colors = _corner_attributes(mesh, tri_vertices, tri_loops)
     if tangent_maps and len(mesh.loops):
         _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
+    if islands:  # the same value at the three corners: read back exactly
+        attributes[ISLANDS] = np.repeat(random_per_island(mesh, tri_vertices)[:, None, None], 3, axis=1).repeat(4, axis=2)
+    if pointy:
+        edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+        normals = _read(mesh.vertex_normals, "vector", len(mesh.vertices), 3, np.float32)
+        per_vertex = pointiness(vertices.astype(np.float64), normals.astype(np.float64), edges)
+        attributes[POINTINESS] = np.repeat(per_vertex[tri_vertices][:, :, None], 4, axis=2)
     return Mesh(
         name=name,
         vertices=vertices,
@@ -174,13 +275,14 @@ class GeometryExporter:
             return np.zeros(1, np.int32)
         return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
 
-    def add(self, obj, matrix: np.ndarray, key=None) -> None:
-        """Add one evaluated object placed by ``matrix``; non-geometry objects are ignored."""
+    def add(self, obj, matrix: np.ndarray, key=None, parent=None) -> None:
+        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it);
+        non-geometry objects are ignored."""
         if obj.type == "META":
             self._metaballs.append((obj, matrix, key))
         elif isinstance(obj.data, bpy.types.Mesh):
             self._meshed.add(obj.original.as_pointer())
-            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key)
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent)
 
     def finish(self) -> None:
         """Add metaballs that the depsgraph did not already hand over as mesh instances."""
@@ -191,14 +293,28 @@ class GeometryExporter:
         if self.cache is not None:
             self.cache.finish()
 
-    def _place(self, obj, matrix, source, key) -> None:
+    def _instance_attributes(self, obj, parent, slot_materials) -> dict:
+        """The Object and Instancer attributes the slots' materials read, looked up as Blender
+        does for Cycles: the instancing object first (Instancer only), the object, its data."""
+        out = {}
+        for index in set(slot_materials.tolist()):
+            program = self.materials.materials[index].program
+            for node in program.nodes if program is not None else ():
+                if node.op == "instance_attribute" and node.params["key"] not in out:
+                    kind, name = node.params["key"].split(":", 1)
+                    owners = ([parent] if kind == "INSTANCER" else []) + [obj, obj.data]
+                    out[node.params["key"]] = find_rgba(owners, name)
+        return out
+
+    def _place(self, obj, matrix, source, key, parent=None) -> None:
         slot_materials = self._slot_materials(obj)
         mesh_key = source + (slot_materials.tobytes(),)
         index = self._mesh_index.get(mesh_key)
         if index is None:
             index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
-            self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name))
+            self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
+                                           attributes=self._instance_attributes(obj, parent, slot_materials)))
             self.keys.append(key)
 
     def _tangent_maps(self, slot_materials) -> set:
@@ -206,26 +322,34 @@ class GeometryExporter:
         for index in set(slot_materials.tolist()):
             program = self.materials.materials[index].program
             if program is not None:
-                maps |= {n.params.get("map", "") for n in program.nodes if n.op == "normal_map"}
+                maps |= {n.params.get("map", "") for n in program.nodes
+                         if n.op == "normal_map" and n.params.get("space", "TANGENT") == "TANGENT"}
         return maps
+
+    def _needs(self, slot_materials, name) -> bool:
+        """Whether the materials of these slots read the attribute ``name``."""
+        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+        return any(n.op == "attribute" and n.params.get("name") == name
+                   for p in programs if p is not None for n in p.nodes)
 
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
+        islands, pointy = self._needs(slot_materials, ISLANDS), self._needs(slot_materials, POINTINESS)
         warnings = self.materials.warnings
         cache_key = None
         if self.cache is not None and obj.type != "META":
-            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)))
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy)
             mesh = self.cache.get(cache_key)
             if mesh is not None:
                 self.meshes.append(mesh)
                 return len(self.meshes) - 1
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy)
         if mesh is None:
             return -1
         if cache_key is not None:

@@ -175,13 +175,13 @@ CLOSURE_NODES = {
 }
 
 
-def export_material(material, images: ImageTable) -> tuple[Material, str | None]:
+def export_material(material, images: ImageTable, layer=None) -> tuple[Material, str | None]:
     """The material as closures, and a warning (or None) about what was approximated."""
     if not uses_nodes(material):
         color = np.array(material.diffuse_color[:3], dtype=np.float64)
         return Material(material.name, [Closure("DIFFUSE", color=color, roughness=0.0)]), None
     issues = Issues()
-    compiler = Compiler(images, issues)
+    compiler = Compiler(images, issues, layer=layer)
 
     def leaf(node, weight):
         make = CLOSURE_NODES.get(node.bl_idname)
@@ -204,10 +204,11 @@ class MaterialTable:
     materials, as Cycles uses its default surface.
     """
 
-    def __init__(self, warnings: list[str], images: ImageTable):
+    def __init__(self, warnings: list[str], images: ImageTable, layer=None):
         self.materials = [DEFAULT_MATERIAL]
         self.warnings = warnings
         self.images = images
+        self.layer = layer  # (scene, view layer) whose View Layer attributes the materials read
         self._index: dict[int, int] = {}
 
     def index(self, material) -> int:
@@ -216,7 +217,7 @@ class MaterialTable:
         key = material.original.as_pointer()
         found = self._index.get(key)
         if found is None:
-            exported, warning = export_material(material, self.images)
+            exported, warning = export_material(material, self.images, self.layer)
             if warning:
                 self.warnings.append(warning)
             found = self._index[key] = len(self.materials)

@@ -8,6 +8,7 @@ value and one line in the owner's warning naming the node type.
 from __future__ import annotations
 
 import bpy
+import mathutils
 import numpy as np
 
 from ...core.base.colour import LUMINANCE
@@ -17,8 +18,86 @@ from ...core.shading import proctex
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
+ISLANDS = "geometry:random_per_island"
+POINTINESS = "geometry:pointiness"
+"""The corner attributes the geometry export adds for Geometry's Random Per Island and Pointiness
+(RGBA all the value)."""
+RAMP_TABLE_SIZE = 256
+"""Cycles' RAMP_TABLE_SIZE: colour ramps and curves reach its kernel as this many + 1 samples."""
 COLORSPACES_AS_IS = ("Non-Color", "Linear Rec.709", "Linear", "Raw", "Linear CIE-XYZ E", "Linear CIE-XYZ D65",
                      "Generic Data")
+
+
+def _property_rgba(owner, name):
+    """Blender's find_property_rgba: a custom property ``name`` of ``owner``, else the RNA path
+    ``name`` from it, as RGBA (a number n as (n, n, n, 1), up to 4 numbers over (0, 0, 0, 1));
+    None when there is no such number."""
+    if owner is None:
+        return None
+    value = None
+    try:
+        if name in owner.keys():
+            value = owner[name]
+    except (TypeError, AttributeError):  # a struct without custom properties
+        pass
+    if value is None:
+        try:
+            value = owner.path_resolve(name)
+        except (KeyError, ValueError, TypeError, AttributeError):
+            return None
+    if isinstance(value, str):
+        return None
+    if isinstance(value, (bool, int, float)):
+        return np.array([value, value, value, 1.0], float)
+    try:
+        values = [float(v) for v in value]
+    except (TypeError, ValueError):
+        return None
+    if not 0 < len(values) <= 4:
+        return None
+    rgba = np.array([0.0, 0.0, 0.0, 1.0])
+    rgba[:len(values)] = values
+    return rgba
+
+
+def find_rgba(owners, name) -> np.ndarray:
+    """The first of ``owners`` (objects, datablocks, view layers) that has the attribute, as RGBA;
+    zero when none has (Blender's BKE_object_dupli_find_rgba_attribute and
+    BKE_view_layer_find_rgba_attribute, which Cycles reads)."""
+    for owner in owners:
+        rgba = _property_rgba(owner, name)
+        if rgba is not None:
+            return rgba
+    return np.zeros(4)
+
+
+def texture_mapping_matrix(mapping) -> np.ndarray | None:
+    """(4, 4) of a texture node's Texture Mapping as Cycles' TextureMapping::compute_transform
+    (None when it changes nothing): the axes picked first, then scale, rotation (Euler XYZ) and
+    translation (Point), their inverse (Texture), without translation (Vector), or the inverse
+    transpose (Normal, normalised after). Cycles reads no min/max from Blender."""
+    if mapping is None:
+        return None
+    axes = (mapping.mapping_x, mapping.mapping_y, mapping.mapping_z)
+    if not any(mapping.translation) and not any(mapping.rotation) and tuple(mapping.scale) == (1.0, 1.0, 1.0) \
+            and axes == ("X", "Y", "Z"):
+        return None
+    pick = np.zeros((4, 4))
+    pick[3, 3] = 1.0
+    for row, axis in enumerate(axes):
+        if axis != "NONE":
+            pick[row, "XYZ".index(axis)] = 1.0
+    kind = mapping.vector_type
+    scale = np.array(mapping.scale, float)
+    if kind in ("TEXTURE", "NORMAL"):  # kept invertible
+        scale = np.where(np.abs(scale) < 1e-5, np.where(scale < 0, -1e-5, 1e-5), scale)
+    linear = np.eye(4)
+    linear[:3, :3] = np.array(mathutils.Euler(mapping.rotation, "XYZ").to_matrix()) @ np.diag(scale)
+    full = linear.copy()
+    full[:3, 3] = mapping.translation
+    mat = {"POINT": full, "TEXTURE": np.linalg.inv(full), "VECTOR": linear,
+           "NORMAL": np.linalg.inv(linear).T}[kind]
+    return mat @ pick
 
 
 def is_ref(value) -> bool:
@@ -41,11 +120,31 @@ class ImageTable:
             self.images.append(self._export(image))
         return found
 
-    def _export(self, image) -> TextureImage:
+    def tiles(self, image) -> dict | None:
+        """A UDIM image read from files: tile number -> image index (each tile a file, "<UDIM>" in
+        its path replaced by the number); None for any other image."""
+        if image.source != "TILED" or image.packed_file is not None or "<UDIM>" not in image.filepath:
+            return None
+        key = ("tiles", image.as_pointer())
+        found = self._index.get(key)
+        if found is None:
+            found = self._index[key] = {}
+            colorspace = self._colorspace(image)
+            path = bpy.path.native_pathsep(bpy.path.abspath(image.filepath, library=image.library))
+            for tile in image.tiles:
+                found[int(tile.number)] = len(self.images)
+                self.images.append(TextureImage(f"{image.name}.{tile.number}",
+                                                path=path.replace("<UDIM>", str(tile.number)), colorspace=colorspace))
+        return found
+
+    def _colorspace(self, image) -> str:
         space = image.colorspace_settings.name
         if space != "sRGB" and space not in COLORSPACES_AS_IS:
             self.warnings.append(f"image '{image.name}': colour space {space} used as linear")
-        colorspace = "sRGB" if space == "sRGB" else "Non-Color"
+        return "sRGB" if space == "sRGB" else "Non-Color"
+
+    def _export(self, image) -> TextureImage:
+        colorspace = self._colorspace(image)
         # Blender's own pixels where they are the only source, or where OpenImageIO is missing
         if image.packed_file is not None or image.source == "GENERATED" or not openimageio_available():
             w, h = image.size
@@ -55,8 +154,11 @@ class ImageTable:
                 # byte images hold encoded values; float images are linear already
                 return TextureImage(image.name, pixels=pixels.reshape(h, w, 4),
                                     colorspace=colorspace if not image.is_float else "Non-Color")
-        if image.source != "FILE":
+        if image.source not in ("FILE", "TILED"):
             self.warnings.append(f"image '{image.name}': {image.source.lower()} images are not supported")
+        elif image.source == "TILED" and (image.packed_file is not None or "<UDIM>" not in image.filepath):
+            self.warnings.append(f"image '{image.name}': packed or generated UDIM tiles are not supported "
+                                 "(its first tile used everywhere)")
         path = bpy.path.abspath(image.filepath, library=image.library)
         return TextureImage(image.name, path=bpy.path.native_pathsep(path), colorspace=colorspace)
 
@@ -85,7 +187,8 @@ def _fit(value, kind):
 class Compiler:
     """Compiles the sockets of one material or world into one program."""
 
-    def __init__(self, images: ImageTable, issues: Issues, world: bool = False):
+    def __init__(self, images: ImageTable, issues: Issues, world: bool = False, layer=None):
+        self.layer = layer  # (scene, view layer) for View Layer attributes
         self.program = Program()
         self.images = images
         self.issues = issues
@@ -214,8 +317,11 @@ class Compiler:
         if self.world:
             return self._coord("generated")
         if getattr(node, "object", None) is not None and name == "Object":
-            return self._unsupported(node, "Texture Coordinate from another object")
-        table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal"}
+            # Cycles: the world position in the other object's space (its inverse world matrix)
+            matrix = np.linalg.inv(np.array(node.object.matrix_world, float))[:3]
+            return self.op("affine", (self._coord("position"),), matrix=matrix), 0
+        table = {"Generated": "generated", "UV": "uv", "Object": "object", "Normal": "normal", "Camera": "camera",
+                 "Reflection": "reflection", "Window": "window"}
         if name not in table:
             return self._unsupported(node, f"Texture Coordinate {name}")
         return self._coord(table[name])
@@ -224,7 +330,13 @@ class Compiler:
         return self._coord("uv", node.uv_map)
 
     def _node_ShaderNodeNewGeometry(self, node, output):
-        table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming"}
+        if output.identifier == "Backfacing":
+            return self.op("backfacing"), 0
+        if output.identifier in ("Random Per Island", "Pointiness"):
+            name = ISLANDS if output.identifier == "Random Per Island" else POINTINESS
+            return self.program.add("attribute", name=name), 2  # its alpha: the value itself
+        table = {"Position": "position", "Normal": "normal_world", "Incoming": "incoming",
+                 "True Normal": "true_normal", "Parametric": "parametric", "Tangent": "tangent"}
         name = table.get(output.identifier)
         if name is None:
             return self._unsupported(node, f"Geometry {output.identifier}")
@@ -235,18 +347,36 @@ class Compiler:
         return i, {"Color": 0, "Vector": 0, "Fac": 1, "Alpha": 2}.get(output.identifier, 0)
 
     def _node_ShaderNodeAttribute(self, node, output):
-        if node.attribute_type != "GEOMETRY":
-            return self._unsupported(node, f"{node.attribute_type.title()} Attribute")
+        kind = node.attribute_type
+        which = {"Color": 0, "Vector": 0, "Fac": 1, "Alpha": 2}.get(output.identifier, 0)
+        if kind in ("OBJECT", "INSTANCER"):  # per object: the geometry export looks them up
+            return self.program.add("instance_attribute", key=f"{kind}:{node.attribute_name}"), which
+        if kind == "VIEW_LAYER":
+            if self.layer is None:
+                return self._unsupported(node, "View Layer Attribute")
+            scene, view_layer = self.layer
+            rgba = find_rgba([view_layer, scene, scene.world], node.attribute_name)
+            return (rgba[:3], float(rgba[:3].mean()), float(rgba[3]))[which]
         return self._attribute(node.attribute_name, output)
 
     def _node_ShaderNodeVertexColor(self, node, output):
         return self._attribute(node.layer_name, output)
 
     def _vector_or(self, node, default):
+        """The node's Vector input when linked, else the ``default`` coordinates, through the
+        node's Texture Mapping (its panel hidden in Blender's UI, older files set it)."""
         socket = node.inputs.get("Vector")
         if socket is not None and socket.is_linked:
-            return self.ref(self.value(socket, "vector"))
-        return self._coord(default)
+            vector = self.ref(self.value(socket, "vector"))
+        else:
+            vector = self._coord(default)
+        matrix = texture_mapping_matrix(getattr(node, "texture_mapping", None))
+        if matrix is None:
+            return vector
+        vector = self.op("affine", (vector,), matrix=matrix[:3]), 0
+        if node.texture_mapping.vector_type == "NORMAL":
+            vector = self.op("vector_math", (vector, np.zeros(3), np.zeros(3), 1.0), operation="NORMALIZE"), 0
+        return vector
 
     def _no_image(self, node, output):
         """Cycles renders a texture node without an image in magenta (measured), as a missing file."""
@@ -256,26 +386,25 @@ class Compiler:
     def _node_ShaderNodeTexImage(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection not in ("FLAT", "BOX"):
-            self.issues.add(f"'{node.name}' {node.projection.title()} projection (rendered as Flat)")
-        interpolation = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
-        if node.interpolation not in ("Linear", "Closest"):
-            self.issues.add(f"'{node.name}' {node.interpolation} interpolation (rendered as Linear)")
+        interpolation = node.interpolation
         vector = self._vector_or(node, "generated" if self.world else "uv")
-        i = self.program.add("image", [vector], image=self.images.index(node.image), interpolation=interpolation,
+        tiles = self.images.tiles(node.image)
+        first = (tiles[1001] if 1001 in tiles else min(tiles.items())[1]) if tiles else self.images.index(node.image)
+        if node.projection == "BOX":
+            tiles = None  # Cycles: Box projection's coordinates always fall in tile 1001
+        i = self.program.add("image", [vector], image=first, interpolation=interpolation,
                              extension=node.extension, projection=node.projection,
-                             blend=float(node.projection_blend))
+                             blend=float(node.projection_blend), tiles=tiles)
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeTexEnvironment(self, node, output):
         if node.image is None:
             return self._no_image(node, output)
-        if node.projection != "EQUIRECTANGULAR":
+        if node.projection not in ("EQUIRECTANGULAR", "MIRROR_BALL"):
             return self._unsupported(node, f"Environment Texture {node.projection.title()} projection")
         vector = self._vector_or(node, "generated")
-        interpolation = "Closest" if node.interpolation == "Closest" else "Linear"
         i = self.program.add("environment", [vector], image=self.images.index(node.image),
-                             interpolation=interpolation)
+                             interpolation=node.interpolation, projection=node.projection)
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeMapping(self, node, output):
@@ -342,8 +471,6 @@ class Compiler:
         return i, names.index(output.identifier) if output.identifier in names else 0
 
     def _node_ShaderNodeSeparateColor(self, node, output):
-        if node.mode not in ("RGB", "HSV"):
-            return self._unsupported(node, f"Separate Color {node.mode}")
         return self._separate(node, output, node.mode, ("Red", "Green", "Blue"))
 
     def _node_ShaderNodeSeparateXYZ(self, node, output):
@@ -354,8 +481,6 @@ class Compiler:
         return self.op("combine", args, mode=mode), 0
 
     def _node_ShaderNodeCombineColor(self, node, output):
-        if node.mode not in ("RGB", "HSV"):
-            return self._unsupported(node, f"Combine Color {node.mode}")
         return self._combine(node, node.mode)
 
     def _node_ShaderNodeCombineXYZ(self, node, output):
@@ -363,13 +488,19 @@ class Compiler:
 
     def _node_ShaderNodeValToRGB(self, node, output):
         ramp = node.color_ramp
+        fac = self._in(node, "Fac", "float")
+        out = 0 if output.identifier == "Color" else 1
         if ramp.interpolation not in ("LINEAR", "CONSTANT", "EASE") or ramp.color_mode != "RGB":
-            self.issues.add(f"'{node.name}' Color Ramp {ramp.interpolation.title()} (rendered as Linear)")
+            # B-Spline, Cardinal, HSV and HSL blending: Blender's own values baked as Cycles bakes
+            # every ramp (blender/util.h colorramp_to_array), read back linearly
+            table = [ramp.evaluate(i / RAMP_TABLE_SIZE)[:] for i in range(RAMP_TABLE_SIZE + 1)]
+            return self.op("ramp", (fac,), interpolation="TABLE", table=np.array(table, float),
+                           interpolate=ramp.interpolation != "CONSTANT"), out
         elements = sorted(ramp.elements, key=lambda e: e.position)
         interpolation = ramp.interpolation if ramp.interpolation in ("CONSTANT", "EASE") else "LINEAR"
-        i = self.op("ramp", (self._in(node, "Fac", "float"),), positions=[e.position for e in elements],
+        i = self.op("ramp", (fac,), positions=[e.position for e in elements],
                     colors=[list(e.color) for e in elements], interpolation=interpolation)
-        return i, 0 if output.identifier == "Color" else 1
+        return i, out
 
     def _node_ShaderNodeTexChecker(self, node, output):
         args = (self._vector_or(node, "generated"), self._in(node, "Color1", "color"),
@@ -380,10 +511,6 @@ class Compiler:
     def _procedural(self, node, output, op, **params):
         """A procedural texture node: its vector (Generated coordinates when unlinked, as in
         Cycles), its other sockets in core.shading.proctex's order, and the output's index."""
-        mapping = getattr(node, "texture_mapping", None)
-        if mapping is not None and (any(mapping.translation) or any(mapping.rotation)
-                                    or any(v != 1.0 for v in mapping.scale)):
-            self.issues.add(f"'{node.name}' texture mapping (ignored)")
         kinds = {"Vector": "vector", "Color1": "color", "Color2": "color", "Mortar": "color"}
         args = [self._vector_or(node, "generated")]
         args += [self._in(node, name, kinds.get(name, "float")) for name in proctex.INPUTS[op][1:]]
@@ -417,10 +544,8 @@ class Compiler:
                                 squash_frequency=int(node.squash_frequency))
 
     def _node_ShaderNodeNormalMap(self, node, output):
-        if node.space != "TANGENT":
-            return self._unsupported(node, f"Normal Map {node.space.title()} space")
         args = (self._in(node, "Strength", "float"), self._in(node, "Color", "color"))
-        return self.op("normal_map", args, map=node.uv_map), 0
+        return self.op("normal_map", args, map=node.uv_map, space=node.space), 0
 
     def _node_ShaderNodeBump(self, node, output):
         height = self.ref(self._in(node, "Height", "float"), "float")
@@ -435,8 +560,99 @@ class Compiler:
         return self.op("clamp", args, type=node.clamp_type), 0
 
     def _node_ShaderNodeMapRange(self, node, output):
-        if node.data_type != "FLOAT":
-            return self._unsupported(node, "Map Range Vector")
+        if node.data_type == "FLOAT_VECTOR":
+            names = ("Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3")
+            args = [self.value(next(s for s in node.inputs if s.identifier == n), "vector") for n in names]
+            return self.op("map_range_vector", args, type=node.interpolation_type, clamp=node.clamp), 0
         names = ("Value", "From Min", "From Max", "To Min", "To Max", "Steps")
         args = [self._in(node, n, "float") for n in names]
         return self.op("map_range", args, type=node.interpolation_type, clamp=node.clamp), 0
+
+    # -- converters, colour and vector nodes that need tables or the shading point ----------------
+    def _normal_in(self, node):
+        """The node's Normal input when linked; unlinked, the hit's shading normal (no input)."""
+        socket = node.inputs.get("Normal")
+        return [self.ref(self.value(socket, "vector"))] if socket is not None and socket.is_linked else []
+
+    def _node_ShaderNodeFresnel(self, node, output):
+        return self.op("fresnel", [self._in(node, "IOR", "float")] + self._normal_in(node)), 0
+
+    def _node_ShaderNodeLayerWeight(self, node, output):
+        i = self.op("layer_weight", [self._in(node, "Blend", "float")] + self._normal_in(node))
+        return i, 0 if output.identifier == "Fresnel" else 1
+
+    def _node_ShaderNodeBrightContrast(self, node, output):
+        args = (self._in(node, "Color", "color"), self._in(node, "Bright", "float"),
+                self._in(node, "Contrast", "float"))
+        return self.op("brightness", args), 0
+
+    def _curve_table(self, node, curves):
+        """Blender's own curves sampled as Cycles samples them (blender/util.h's
+        curvemapping_*_to_array): RAMP_TABLE_SIZE + 1 points over the x range of the curves'
+        end points, the RGB Curves' combined curve applied before each channel's."""
+        mapping = node.mapping
+        mapping.initialize()
+        mapping.update()
+        maps = list(mapping.curves)[:curves]
+        lo = min(m.points[0].location[0] for m in maps)
+        hi = max(m.points[-1].location[0] for m in maps)
+        xs = lo + np.arange(RAMP_TABLE_SIZE + 1) / RAMP_TABLE_SIZE * (hi - lo)
+        if curves == 1:
+            table = [[mapping.evaluate(maps[0], float(x))] for x in xs]
+        elif curves == 4:
+            table = [[mapping.evaluate(m, mapping.evaluate(maps[3], float(x))) for m in maps[:3]] for x in xs]
+        else:
+            table = [[mapping.evaluate(m, float(x)) for m in maps] for x in xs]
+        return dict(table=np.array(table, float), min=float(lo), max=float(hi),
+                    extrapolate=mapping.extend == "EXTRAPOLATED")
+
+    def _node_ShaderNodeRGBCurve(self, node, output):
+        args = (self._in(node, "Fac", "float"), self._in(node, "Color", "color"))
+        return self.op("curves", args, **self._curve_table(node, 4)), 0
+
+    def _node_ShaderNodeVectorCurve(self, node, output):
+        args = (self._in(node, "Fac", "float"), self._in(node, "Vector", "vector"))
+        return self.op("curves", args, **self._curve_table(node, 3)), 0
+
+    def _node_ShaderNodeFloatCurve(self, node, output):
+        args = (self._in(node, "Factor", "float"), self._in(node, "Value", "float"))
+        params = self._curve_table(node, 1)
+        params["table"] = params["table"][:, 0]
+        return self.op("float_curve", args, **params), 0
+
+    def _node_ShaderNodeVectorRotate(self, node, output):
+        args = [self._in(node, n, "vector") for n in ("Vector", "Center", "Axis")]
+        rotation = self._in(node, "Rotation", "vector") if node.rotation_type == "EULER_XYZ" else None
+        args += [self._in(node, "Angle", "float"), np.zeros(3) if rotation is None else rotation]
+        return self.op("vector_rotate", args, type=node.rotation_type, invert=bool(node.invert)), 0
+
+    def _node_ShaderNodeVectorTransform(self, node, output):
+        if self.world and "CAMERA" in (node.convert_from, node.convert_to):
+            return self._unsupported(node, "Vector Transform to or from camera space in the world")
+        return self.op("vector_transform", (self._in(node, "Vector", "vector"),), type=node.vector_type,
+                       **{"from": node.convert_from, "to": node.convert_to}), 0
+
+    def _node_ShaderNodeNormal(self, node, output):
+        direction = _const(node.outputs["Normal"].default_value)
+        if output.identifier == "Normal":
+            return direction / max(float(np.linalg.norm(direction)), 1e-30)
+        return self.op("normal", (self._in(node, "Normal", "vector"),), direction=direction), 1
+
+    def _node_ShaderNodeBlackbody(self, node, output):
+        return self.op("blackbody", (self._in(node, "Temperature", "float"),)), 0
+
+    def _node_ShaderNodeWavelength(self, node, output):
+        return self.op("wavelength", (self._in(node, "Wavelength", "float"),)), 0
+
+    # Blender 4.x's legacy colour nodes (5.0 opens them as Separate/Combine Color)
+    def _node_ShaderNodeSeparateRGB(self, node, output):
+        return self._separate(node, output, "RGB", ("R", "G", "B"))
+
+    def _node_ShaderNodeSeparateHSV(self, node, output):
+        return self._separate(node, output, "HSV", ("H", "S", "V"))
+
+    def _node_ShaderNodeCombineRGB(self, node, output):
+        return self._combine(node, "RGB")
+
+    def _node_ShaderNodeCombineHSV(self, node, output):
+        return self._combine(node, "HSV")

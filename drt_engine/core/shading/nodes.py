@@ -20,8 +20,9 @@ from ..base.colour import LUMINANCE
 from ..base.constants import TINY
 from ..base.vectors import orthonormal_basis
 from ..scene import Program
+from . import colornodes as cn
 from . import proctex
-from .textures import Texture, equirect_uv
+from .textures import MAGENTA, Texture, equirect_uv
 
 """Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
 
@@ -159,11 +160,36 @@ def _blend(mode, t, c1, c2):
             return tm * c1 + t * ((1.0 - c1) * c2 * c1 + c1 * scr)
         if mode == "LINEAR_LIGHT":
             return c1 + t * (2.0 * c2 - 1.0)
+        if mode in HSV_BLENDS:
+            return _blend_hsv(mode, t, c1, c2)
     raise KeyError(mode)
 
 
+HSV_BLENDS = ("HUE", "SATURATION", "VALUE", "COLOR")
+
+
+def _blend_hsv(mode, t, c1, c2):
+    """Cycles' svm_mix_hue, _sat, _val and _color: c1's HSV with c2's hue, saturation or value
+    (hue and saturation for Color) blended in; Hue and Color keep c1 where c2 is grey,
+    Saturation where c1 is."""
+    hsv1, hsv2 = rgb_to_hsv(c1), rgb_to_hsv(c2)
+    t1 = t[:, 0]
+    if mode == "VALUE":
+        hsv1[:, 2] = (1.0 - t1) * hsv1[:, 2] + t1 * hsv2[:, 2]
+        return hsv_to_rgb(hsv1)
+    if mode == "SATURATION":
+        keep = hsv1[:, 1] == 0
+        hsv1[:, 1] = (1.0 - t1) * hsv1[:, 1] + t1 * hsv2[:, 1]
+        return np.where(keep[:, None], c1, hsv_to_rgb(hsv1))
+    hsv1[:, 0] = hsv2[:, 0]
+    if mode == "COLOR":
+        hsv1[:, 1] = hsv2[:, 1]
+    out = c1 + t * (hsv_to_rgb(hsv1) - c1)
+    return np.where((hsv2[:, 1] == 0)[:, None], c1, out)
+
+
 BLEND_MODES = ("MIX", "ADD", "MULTIPLY", "SUBTRACT", "SCREEN", "DIVIDE", "DIFFERENCE", "EXCLUSION", "DARKEN",
-               "LIGHTEN", "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT")
+               "LIGHTEN", "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT") + HSV_BLENDS
 
 
 def rgb_to_hsv(c):
@@ -234,6 +260,31 @@ def _ramp(fac, positions, colors, interpolation):
     return out[:, :3], out[:, 3]
 
 
+def rotate_about_axis(v, axis, angle):
+    """Cycles' rotate_around_axis (Rodrigues' formula, right-handed) for unit axes (N, 3)."""
+    cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return v * cos + np.cross(axis, v) * sin + axis * (vec.dot(axis, v)[:, None] * (1.0 - cos))
+
+
+AXES = {"X_AXIS": (1.0, 0.0, 0.0), "Y_AXIS": (0.0, 1.0, 0.0), "Z_AXIS": (0.0, 0.0, 1.0)}
+
+
+def _vector_rotate(kind, invert, v, center, axis, angle, rotation):
+    """Cycles' svm_node_vector_rotate: about ``center``, by Euler angles (inverted: the
+    transposed rotation) or an angle (negated when inverted) about an axis; a zero axis
+    leaves the vector as it is."""
+    d = v - center
+    if kind == "EULER_XYZ":
+        m = euler_matrix(rotation)
+        return np.einsum("nji,nj->ni" if invert else "nij,nj->ni", m, d) + center
+    if kind in AXES:
+        axis = np.broadcast_to(AXES[kind], v.shape)
+    length = vec.norm(axis)
+    unit = axis / np.where(length > 0, length, 1.0)[:, None]
+    out = rotate_about_axis(d, unit, -angle if invert else angle) + center
+    return np.where((length != 0)[:, None], out, v)
+
+
 def _checker(p, c1, c2, scale):
     p = (p * scale[:, None] + 0.000001) * 0.999999
     i = np.abs(np.floor(p)).astype(np.int64) % 2
@@ -242,6 +293,16 @@ def _checker(p, c1, c2, scale):
 
 
 def _map_range(kind, v, a, b, c, d, steps, clamp):
+    """Cycles' svm_node_map_range (0 where From Min equals From Max), then the Clamp node its
+    compiler adds for Linear and Stepped."""
+    out = np.where(a != b, _map_range_vector(kind, v, a, b, c, d, steps, False), 0.0)
+    if clamp and kind in ("LINEAR", "STEPPED"):
+        out = np.clip(out, np.minimum(c, d), np.maximum(c, d))
+    return out
+
+
+def _map_range_vector(kind, v, a, b, c, d, steps, clamp):
+    """Cycles' svm_node_vector_map_range, per component (also the float node's factor)."""
     t = _safe_div(v - a, b - a)
     if kind == "STEPPED":
         t = np.where(steps > 0, np.floor(t * (steps + 1)) / np.where(steps > 0, steps, 1.0), 0.0)
@@ -300,14 +361,21 @@ class Evaluator:
             return (self.ctx.coord(p["name"], p.get("map", "")),)
         if op == "attribute":
             rgba = self.ctx.attribute(p["name"])
-            return rgba[:, :3], rgba[:, :3] @ LUMINANCE, rgba[:, 3]
+            # Fac as Cycles' svm attribute node: a 2-component attribute's first, else the mean
+            pair = self.ctx.attribute_width(p["name"]) == 2
+            return rgba[:, :3], np.where(pair, rgba[:, 0], rgba[:, :3].mean(axis=1)), rgba[:, 3]
+        if op == "instance_attribute":  # Object and Instancer attributes: one RGBA per object
+            rgba = self.ctx.instance_attribute(p["key"])
+            return rgba[:, :3], rgba[:, :3].mean(axis=1), rgba[:, 3]
         if op == "image":
             if p.get("projection") == "BOX":
                 return self._image_box(p, node.inputs[0], x[0])
             return self._image(p, node.inputs[0], x[0])
         if op == "environment":
             tex = self.textures[p["image"]]
-            rgba = tex.lookup(equirect_uv(x[0]), None, "REPEAT", p.get("interpolation", "Linear"))
+            d = _normalize(x[0])
+            uv = mirror_ball_uv(d) if p.get("projection") == "MIRROR_BALL" else equirect_uv(d)
+            rgba = tex.lookup(uv, None, "REPEAT", p.get("interpolation", "Linear"))
             return rgba[:, :3], rgba[:, 3]
         if op == "math":
             out = _math(p["operation"], x[0], x[1], x[2])
@@ -333,13 +401,46 @@ class Evaluator:
         if op == "rgb_to_bw":
             return (x[0] @ LUMINANCE,)
         if op == "separate":
-            c = rgb_to_hsv(x[0]) if p.get("mode") == "HSV" else x[0]
+            mode = p.get("mode")
+            c = rgb_to_hsv(x[0]) if mode == "HSV" else cn.rgb_to_hsl(x[0]) if mode == "HSL" else x[0]
             return c[:, 0], c[:, 1], c[:, 2]
         if op == "combine":
             c = np.stack(x[:3], axis=1)
-            return (hsv_to_rgb(c) if p.get("mode") == "HSV" else c,)
+            mode = p.get("mode")
+            return (hsv_to_rgb(c) if mode == "HSV" else cn.hsl_to_rgb(c) if mode == "HSL" else c,)
         if op == "ramp":
+            if p["interpolation"] == "TABLE":  # baked by the export, as Cycles bakes every ramp
+                rgba = cn.table_lookup(p["table"], x[0], p.get("interpolate", True))
+                return rgba[:, :3], rgba[:, 3]
             return _ramp(x[0], p["positions"], p["colors"], p["interpolation"])
+        if op in ("fresnel", "layer_weight"):
+            normal = x[1] if len(x) > 1 else self.ctx.normal
+            cosi = vec.dot(self.ctx.coord("incoming"), normal)
+            back = self.ctx.backfacing()
+            return (cn.fresnel(x[0], cosi, back),) if op == "fresnel" else cn.layer_weight(x[0], cosi, back)
+        if op == "affine":  # a fixed transform (3, 4) of points
+            m = np.asarray(p["matrix"], float)
+            return (x[0] @ m[:3, :3].T + m[:3, 3],)
+        if op == "backfacing":
+            return (self.ctx.backfacing().astype(float),)
+        if op == "brightness":
+            return (cn.brightness_contrast(*x),)
+        if op == "curves":
+            return (cn.curves(x[0], x[1], np.asarray(p["table"], float), p["min"], p["max"], p["extrapolate"]),)
+        if op == "float_curve":
+            return (cn.float_curve(x[0], x[1], p["table"], p["min"], p["max"], p["extrapolate"]),)
+        if op == "blackbody":
+            return (cn.blackbody(x[0]),)
+        if op == "wavelength":
+            return (cn.wavelength(x[0]),)
+        if op == "normal":
+            d = np.asarray(p["direction"], float)
+            d = d / max(np.linalg.norm(d), TINY)
+            return np.broadcast_to(d, (n, 3)).copy(), _normalize(x[0]) @ d
+        if op == "vector_rotate":
+            return (_vector_rotate(p["type"], p.get("invert", False), *x),)
+        if op == "vector_transform":
+            return (self._vector_transform(p, x[0]),)
         if op == "checker":
             return _checker(x[0], x[1], x[2], x[3])
         if op in proctex.OPS:
@@ -357,6 +458,8 @@ class Evaluator:
             return (np.minimum(np.maximum(v, lo), hi),)
         if op == "map_range":
             return (_map_range(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
+        if op == "map_range_vector":
+            return (_map_range_vector(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
         if op == "convert":
             return (_convert(p["kind"], x[0]),)
         raise KeyError(f"unknown program op {op!r}")
@@ -375,15 +478,71 @@ class Evaluator:
         out = _blend(p.get("blend", "MIX"), t, a, b)
         return np.clip(out, 0, 1) if p.get("clamp_result") else out
 
+    def _vector_transform(self, p, v):
+        """Cycles' svm_node_vector_transform between world, object and camera space (camera
+        space as Cycles': Blender's camera axes with z looking forward); a point, a direction, or
+        a normal (carried by the inverse transpose and normalised)."""
+        kind, src, dst = p["type"], p["from"], p["to"]
+        obj = self.ctx.object_matrix()
+        cam = self.ctx.camera_matrix()
+        if cam is not None:
+            cam = np.broadcast_to(cam, (self.ctx.n, 4, 4))
+
+        def carry(m, v, inverse):
+            if m is None:
+                return v
+            a, t = m[:, :3, :3], m[:, :3, 3]
+            if kind == "NORMAL":
+                a = a if inverse else np.linalg.inv(a)
+                return _normalize(np.einsum("nji,nj->ni", a, v))
+            if inverse:
+                a = np.linalg.inv(a)
+                v = v - t if kind == "POINT" else v
+                return np.einsum("nij,nj->ni", a, v)
+            return np.einsum("nij,nj->ni", a, v) + (t if kind == "POINT" else 0.0)
+
+        if src == "WORLD":
+            if dst == "CAMERA":
+                v = carry(cam, v, True)
+            elif dst == "OBJECT":
+                v = carry(obj, v, True)
+        elif src == "CAMERA":
+            if dst in ("WORLD", "OBJECT"):
+                v = carry(cam, v, False)
+            if dst == "OBJECT":
+                v = carry(obj, v, True)
+        elif src == "OBJECT":
+            if dst in ("WORLD", "CAMERA"):
+                v = carry(obj, v, False)
+            if dst == "CAMERA":
+                v = carry(cam, v, True)
+        return v
+
     def _image(self, p, vector_ref, uv3):
-        tex = self.textures[p["image"]]
-        uv = uv3[:, :2]
+        projection = p.get("projection", "FLAT")
+        uv = project(projection, uv3)
         footprint = None
-        if p.get("interpolation", "Linear") != "Closest":
+        if p.get("interpolation", "Linear") == "Linear":
             shifted = self._footprint_evaluators()
             if shifted is not None:
-                footprint = tuple(e(vector_ref)[:, :2] - uv for e in shifted)
-        rgba = tex.lookup(uv, footprint, p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+                footprint = tuple(project(projection, e(vector_ref)) - uv for e in shifted)
+                if projection in ("SPHERE", "TUBE"):  # across the seam, the short way round
+                    footprint = tuple(np.stack([d[:, 0] - np.round(d[:, 0]), d[:, 1]], axis=1) for d in footprint)
+        lookup = (p.get("extension", "REPEAT"), p.get("interpolation", "Linear"))
+        if not p.get("tiles"):
+            rgba = self.textures[p["image"]].lookup(uv, footprint, *lookup)
+            return rgba[:, :3], rgba[:, 3]
+        # UDIM, as Cycles' svm_node_tex_image: the tile the coordinates fall in (their integer
+        # parts, truncated), read at the coordinates less those; outside every tile, magenta
+        tx, ty = np.trunc(uv[:, 0]), np.trunc(uv[:, 1])
+        number = np.where((tx >= 0) & (ty >= 0) & (tx < 10), 1001 + 10 * ty + tx, -1).astype(np.int64)
+        rgba = np.tile(MAGENTA, (self.ctx.n, 1)).astype(float)
+        for tile, index in p["tiles"].items():
+            sel = np.flatnonzero(number == tile)
+            if len(sel):
+                fp = None if footprint is None else tuple(d[sel] for d in footprint)
+                local = uv[sel] - np.stack([tx[sel], ty[sel]], axis=1)
+                rgba[sel] = self.textures[index].lookup(local, fp, *lookup)
         return rgba[:, :3], rgba[:, 3]
 
     def _image_box(self, p, vector_ref, co):
@@ -393,7 +552,7 @@ class Evaluator:
         normal = self.ctx.coord("normal")
         weights = box_weights(normal, p.get("blend", 0.0))
         footprint = None
-        if p.get("interpolation", "Linear") != "Closest":
+        if p.get("interpolation", "Linear") == "Linear":
             shifted = self._footprint_evaluators()
             if shifted is not None:
                 footprint = tuple(e(vector_ref) - co for e in shifted)
@@ -413,14 +572,28 @@ class Evaluator:
         return out[:, :3], out[:, 3]
 
     def _normal_map(self, p, strength, color):
+        """Cycles' svm_node_normal_map: the colour as a normal in tangent, object or world space
+        (Blender's own object and world conventions with y and z negated), turned round on
+        backfacing hits, blended with the shading normal by strength."""
         ctx = self.ctx
         n = ctx.normal
-        t, sign = ctx.tangent(p.get("map", ""))
-        b = sign[:, None] * np.cross(n, t)
+        back = ctx.backfacing()[:, None]
         c = 2.0 * color - 1.0
-        out = _normalize(c[:, :1] * t + c[:, 1:2] * b + c[:, 2:] * n)
+        space = p.get("space", "TANGENT")
+        if space == "TANGENT":
+            t, sign = ctx.tangent(p.get("map", ""))
+            front = np.where(back, -n, n)  # the surface's own side, as Cycles builds the frame
+            b = sign[:, None] * np.cross(front, t)
+            out = _normalize(c[:, :1] * t + c[:, 1:2] * b + c[:, 2:] * front)
+        else:
+            if space in ("BLENDER_OBJECT", "BLENDER_WORLD"):
+                c = c * [1.0, -1.0, -1.0]
+            m = ctx.object_matrix() if space in ("OBJECT", "BLENDER_OBJECT") else None
+            out = _normalize(c if m is None else np.einsum("nji,nj->ni", np.linalg.inv(m[:, :3, :3]), c))
+        out = np.where(back, -out, out)
         s = np.maximum(strength, 0.0)[:, None]
-        return _normalize(n + (out - n) * s)
+        out = np.where(s != 1.0, _normalize(n + (out - n) * s), out)
+        return np.where((vec.norm(out) == 0)[:, None], n, out)
 
     def _bump(self, p, refs):
         strength_ref, distance_ref, height_ref, normal_ref = refs
@@ -435,6 +608,32 @@ class Evaluator:
         grad = ((hx - h) / eps)[:, None] * t + ((hy - h) / eps)[:, None] * b
         out = _normalize(n - dist[:, None] * grad)
         return _normalize(strength * out + (1.0 - strength) * n)
+
+
+def mirror_ball_uv(d):
+    """Cycles' direction_to_mirrorball: the point of a mirror ball, seen from -y, that reflects
+    direction ``d`` (unit vectors (N, 3)) towards the viewer."""
+    h = d - [0.0, 1.0, 0.0]
+    div = 2.0 * np.sqrt(np.maximum(-0.5 * h[:, 1], 0.0))
+    h = np.where((div > 0)[:, None], h / np.where(div > 0, div, 1.0)[:, None], h)
+    return np.stack([0.5 * (h[:, 0] + 1.0), 0.5 * (h[:, 2] + 1.0)], axis=1)
+
+
+def project(projection, co):
+    """(N, 2) image coordinates of Image Texture's Flat, Sphere and Tube projections (Cycles'
+    svm_node_tex_image: the vector from the [0, 1] box to [-1, 1], then map_to_sphere or
+    map_to_tube; u turns once around z, starting at -y)."""
+    if projection not in ("SPHERE", "TUBE"):
+        return co[:, :2]
+    c = (co - 0.5) * 2.0
+    x, y, z = c[:, 0], c[:, 1], c[:, 2]
+    axis = np.hypot(x, y)
+    u = np.where(axis > 0, (1.0 - np.arctan2(x, y) / np.pi) * 0.5, 0.0)
+    if projection == "TUBE":
+        return np.stack([u, np.where(axis > 0, (z + 1.0) * 0.5, 0.0)], axis=1)
+    length = vec.norm(c)
+    v = 1.0 - np.arccos(np.clip(z / np.where(length > 0, length, 1.0), -1.0, 1.0)) / np.pi
+    return np.stack([np.where(length > 0, u, 0.0), np.where(length > 0, v, 0.0)], axis=1)
 
 
 def box_weights(normal, blend):
@@ -492,11 +691,26 @@ class DirectionContext:
     def attribute(self, name):
         return np.zeros((self.n, 4))
 
+    def attribute_width(self, name):
+        return np.zeros(self.n, np.int64)
+
+    def instance_attribute(self, key):
+        return np.zeros((self.n, 4))
+
     def footprint(self):
         return None, None
 
     def shifted(self, dp):
         return DirectionContext(self.dirs + dp)
+
+    def backfacing(self):
+        return np.zeros(self.n, bool)
+
+    def object_matrix(self):
+        return None  # the world has no object (Cycles' is_object is false there)
+
+    def camera_matrix(self):
+        return None
 
     def tangent(self, uv_map):
         t, _ = orthonormal_basis(self.dirs)

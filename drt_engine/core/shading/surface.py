@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..base import vectors as vec
+from ..base.constants import TINY
 from ..bsdf.shader import MaterialShader, Tables
 from ..scene import Closure, Material, SceneData
 from .nodes import Evaluator
@@ -61,6 +62,21 @@ class SurfaceContext:
             return -self.direction if self.direction is not None else self.normal
         if name == "normal":
             return a.object_normal(self.prim, self.normal)
+        if name == "true_normal":  # the triangle's normal, turned to face the ray as Cycles' Ng
+            ng = a.geometry.world_ng[self.prim]
+            return np.where(self.backfacing()[:, None], -ng, ng)
+        if name == "reflection":  # the incoming direction mirrored about the shading normal
+            wi = self.coord("incoming")
+            return 2.0 * np.einsum("ij,ij->i", self.normal, wi)[:, None] * self.normal - wi
+        if name == "camera":  # Cycles' camera space: z looks forward
+            m = np.linalg.inv(self.camera_matrix())
+            return self.pos @ m[:3, :3].T + m[:3, 3]
+        if name == "window":
+            return self._window()
+        if name == "parametric":  # Cycles' (1 - u - v, u, 0): the weights of the triangle's first two corners
+            return np.concatenate([self.bary[:, :2], np.zeros((self.n, 1))], axis=1)
+        if name == "tangent":
+            return self._radial_tangent()
         p = a.object_position(self.prim, self.bary)
         if name == "generated":
             lo, size = a.texspace(self.prim)
@@ -69,6 +85,50 @@ class SurfaceContext:
 
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
+
+    def instance_attribute(self, key):
+        """(N, 4) RGBA of an Object or Instancer attribute of each hit's object (0 where it has none)."""
+        return self.attrs.instance_attribute(self.prim, key)
+
+    def attribute_width(self, name):
+        """(N,) components of attribute ``name`` on each hit's mesh (0 where it has none)."""
+        return self.attrs.width(self.prim, name)
+
+    def _radial_tangent(self):
+        """Cycles' primitive_tangent: the direction around the object's z axis through its Generated
+        coordinates' centre, carried to the world as a normal and made perpendicular to the shading normal."""
+        g = self.coord("generated")
+        around = np.stack([-(g[:, 1] - 0.5), g[:, 0] - 0.5, np.zeros(self.n)], axis=1)
+        world = np.einsum("nji,nj->ni", np.linalg.inv(self.object_matrix()[:, :3, :3]), around)
+        side = vec.normalize(np.cross(world, self.normal), 1e-300)
+        return np.cross(self.normal, side)
+
+    def _window(self):
+        """Cycles' camera_world_to_ndc: the point projected into the camera's full frame, (0, 0)
+        at its bottom left and (1, 1) at its top right, z 0."""
+        cam = self.attrs.scene.camera
+        m = np.linalg.inv(cam.matrix)
+        p = self.pos @ m[:3, :3].T + m[:3, 3]
+        s = p[:, :2] / np.where(p[:, 2:] < 0, -p[:, 2:], TINY) if cam.type == "PERSP" else p[:, :2]
+        left, right, bottom, top = cam.frame
+        return np.stack([(s[:, 0] - left) / (right - left), (s[:, 1] - bottom) / (top - bottom),
+                         np.zeros(self.n)], axis=1)
+
+    def backfacing(self):
+        """Whether each hit sees the back of its triangle (Cycles' SD_BACKFACING): the ray
+        against the triangle's world normal at mid-shutter."""
+        if self.direction is None:
+            return np.zeros(self.n, bool)
+        return np.einsum("ij,ij->i", self.direction, self.attrs.geometry.world_ng[self.prim]) > 0
+
+    def object_matrix(self):
+        """(N, 4, 4) object-to-world transforms of the hits' objects."""
+        return self.attrs.object_matrix(self.prim)
+
+    def camera_matrix(self):
+        """(4, 4) camera-to-world transform in Cycles' camera space (Blender's camera axes with z
+        negated: z looks forward), at mid-shutter."""
+        return self.attrs.scene.camera.matrix @ np.diag([1.0, 1.0, -1.0, 1.0])
 
     def footprint(self):
         """World-space vectors spanning a pixel's footprint on the surface (major, minor axis)."""
@@ -126,10 +186,31 @@ class SurfaceAttributes:
                 out[sel, 3] = 1.0
         return out
 
+    def instance_attribute(self, prim, key):
+        out = np.zeros((len(prim), 4))
+        for sel, inst, _, _ in self._groups(prim):
+            value = inst.attributes.get(key)
+            if value is not None:
+                out[sel] = value
+        return out
+
+    def width(self, prim, name):
+        out = np.zeros(len(prim), np.int64)
+        for sel, _, mesh, _ in self._groups(prim):
+            data = mesh.attributes.get(name) if name else mesh.colors
+            out[sel] = 0 if data is None else data.shape[2]
+        return out
+
     def object_position(self, prim, bary):
         out = np.zeros((len(prim), 3))
         for sel, _, mesh, tri in self._groups(prim):
             out[sel] = np.einsum("ni,nij->nj", bary[sel], mesh.vertices[mesh.triangles[tri]])
+        return out
+
+    def object_matrix(self, prim):
+        out = np.empty((len(prim), 4, 4))
+        for sel, inst, _, _ in self._groups(prim):
+            out[sel] = inst.matrix
         return out
 
     def object_normal(self, prim, normal):
@@ -211,6 +292,25 @@ class SurfaceAttributes:
         return t, sign
 
 
+VIEW_OPS = ("fresnel", "layer_weight", "backfacing", "normal_map")  # normal maps turn round on back faces
+VIEW_COORDS = ("incoming", "reflection", "true_normal")
+
+
+def views(program, refs) -> bool:
+    """Whether the program outputs ``refs`` depend on the direction the hit is seen from."""
+    stack, seen = [r[0] for r in refs], set()
+    while stack:
+        i = stack.pop()
+        if i in seen:
+            continue
+        seen.add(i)
+        node = program.nodes[i]
+        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") in VIEW_COORDS):
+            return True
+        stack.extend(r[0] for r in node.inputs if r is not None)
+    return False
+
+
 class MaterialShading:
     """One material: its constant shader, or its program and the shaders bound per hit."""
 
@@ -226,6 +326,11 @@ class MaterialShading:
         self._cache: dict[bytes, MaterialShader] = {}
         self.coarsened = False
         self.warnings = warnings if warnings is not None else []  # the renderer's, added to while rendering
+        if self.varying_emission and views(material.program, [r for c in self.emitters for k, r in c.inputs.items()
+                                                               if k in ("emission", "weight")]):
+            self.warnings.append(f"material '{material.name}': its emission uses Fresnel, Layer Weight, the "
+                                 "incoming or reflected direction or which side is seen, which DRT's emission "
+                                 "does not see yet: evaluated as if seen along the surface normal")
 
     @property
     def emission(self):

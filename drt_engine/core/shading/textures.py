@@ -104,14 +104,17 @@ class Texture:
         no filtering). Linear: an anisotropic filter of FILTER_SCALE times the footprint, up to
         MAX_TAPS trilinear lookups along its major axis at the mip level of its minor axis (or
         of the major axis over MAX_TAPS); Closest: the nearest texel of the full-resolution
-        image, as Blender's Closest.
+        image, as Blender's Closest; Cubic and Smart: Cycles' cubic B-spline through the 4 x 4
+        texels around the point, unfiltered (as Cycles' CPU kernel point-samples it).
         """
         uv = np.asarray(uv, np.float64)
         outside = None
-        if extension == "CLIP":
+        if extension == "CLIP" and interpolation not in CUBIC:  # the cubic taps clip themselves
             outside = ((uv < 0.0) | (uv > 1.0)).any(axis=1)
         if interpolation == "Closest":
             out = self._closest(0, uv, extension)
+        elif interpolation in CUBIC:
+            out = self._bicubic(uv, extension)
         elif footprint is None:
             out = self._bilinear(0, uv, extension)
         else:
@@ -160,6 +163,26 @@ class Texture:
         y = self._index(np.floor(uv[:, 1] * h).astype(np.int64), h, extension)
         return img[y, x].astype(np.float64)
 
+    def _bicubic(self, uv, extension):
+        """Cycles' interp_cubic: uniform cubic B-spline weights over the 4 x 4 texels around the
+        point; with Clip, texels outside the image count as transparent black."""
+        img = self.levels[0]
+        h, w = img.shape[:2]
+        out = np.zeros((len(uv), 4))
+        corner, weights, index = [], [], []
+        for k, n in ((0, w), (1, h)):
+            x = uv[:, k] * n - 0.5
+            i0 = np.floor(x).astype(np.int64)
+            weights.append(bspline_weights(x - i0))
+            taps = i0[:, None] + np.arange(-1, 3)
+            index.append(self._index(taps, n, extension))
+            corner.append((taps >= 0) & (taps < n) if extension == "CLIP" else np.ones_like(taps, bool))
+        for j in range(4):
+            for i in range(4):
+                wij = (weights[0][:, i] * weights[1][:, j] * corner[0][:, i] * corner[1][:, j])[:, None]
+                out += wij * img[index[1][:, j], index[0][:, i]]
+        return out
+
     def _bilinear(self, level, uv, extension):
         img = self.levels[level]
         h, w = img.shape[:2]
@@ -173,6 +196,18 @@ class Texture:
         top = img[ya, xa] * (1 - fx) + img[ya, xb] * fx
         bottom = img[yb, xa] * (1 - fx) + img[yb, xb] * fx
         return (top * (1 - fy) + bottom * fy).astype(np.float64)
+
+
+CUBIC = ("Cubic", "Smart")
+"""Interpolations Cycles' CPU kernel evaluates as its cubic B-spline."""
+
+
+def bspline_weights(t: np.ndarray) -> np.ndarray:
+    """(N, 4) uniform cubic B-spline weights of the texels at offsets -1, 0, 1, 2 for the fraction
+    ``t`` past texel 0 (they sum to 1; at t = 0: 1/6, 2/3, 1/6, 0)."""
+    t = np.asarray(t, np.float64)
+    return np.stack([(1.0 - t) ** 3 / 6.0, (3.0 * t ** 3 - 6.0 * t ** 2 + 4.0) / 6.0,
+                     (-3.0 * t ** 3 + 3.0 * t ** 2 + 3.0 * t + 1.0) / 6.0, t ** 3 / 6.0], axis=1)
 
 
 def equirect_uv(direction: np.ndarray) -> np.ndarray:

@@ -1,0 +1,145 @@
+"""Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
+and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
+Weight as the colour of diffuse spheres seen at every angle, from the front and the back. The rule is the procedural textures' (procedural_scenes.parity):
+DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
+1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
+leaves out keeps its one warning.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.support import node_scenes as ns
+from tests.support import procedural_scenes as ps
+from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material
+from tests.support.export_helpers import render_export
+
+
+@pytest.fixture(scope="module")
+def grid(drt, tmp_path_factory):
+    """Tiles of DRT seed 0, Cycles seeds 0 and 1, per case."""
+    return ps.grid_tiles(ns.grid_scene(), len(ns.CASES), tmp_path_factory.mktemp("nodes"), "nodes")
+
+
+def _cannot(data):
+    return [w for w in data.warnings if "cannot evaluate" in w]
+
+
+def _matches_cycles(scene, out, name, label):
+    """Export ``scene`` without a warning, render it with DRT and Cycles (two seeds) and hold DRT
+    to the parity rule over the whole image; DRT's render."""
+    assert not _cannot(render_export(scene))
+    drt_render, c0, c1 = ps.parity_renders(scene, out, name)
+    rh.save_side_by_side(name, drt_render.rgb, c0.rgb)
+    figures = ps.parity(drt_render.rgb, c0.rgb, c1.rgb)
+    assert figures["ok"], ps.message(label, figures)
+    return drt_render
+
+
+def test_every_case_exports_without_a_warning(drt):
+    assert not _cannot(render_export(ns.grid_scene()))
+    assert not _cannot(render_export(ns.facing_scene()))
+
+
+def test_a_node_left_out_keeps_its_one_warning(drt):
+    """Light Path still has no handler: the socket it feeds keeps its value, with one warning naming it."""
+    scene = ns.grid_scene(ns.CASES[:1])
+    mat = new_material("Light Path")  # Light Path -> Fresnel's IOR -> Principled roughness
+    tree = mat.node_tree
+    path = tree.nodes.new("ShaderNodeLightPath")
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    tree.links.new(path.outputs["Ray Length"], fresnel.inputs["IOR"])
+    tree.links.new(fresnel.outputs[0], tree.nodes["Principled BSDF"].inputs["Roughness"])
+    scene.objects[ns.CASES[0].name].data.materials[0] = mat
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Light Path" in warnings[0] and "Fresnel" not in warnings[0], warnings
+
+
+@pytest.mark.parametrize("index", range(len(ns.CASES)), ids=[c.name for c in ns.CASES])
+def test_node_matches_cycles(grid, index):
+    figures = ps.tile_figures(grid, index)
+    assert figures["ok"], ps.message(ns.CASES[index].name, figures)
+
+
+def test_fresnel_and_layer_weight_on_spheres_match_cycles(drt, tmp_path):
+    scene = ns.facing_scene()
+    drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "facing")
+    rh.save_side_by_side("fresnel-layer-weight", drt_render.rgb, c0.rgb)
+    size = c0.rgb.shape[0] // 2
+    for row, side in enumerate(("front", "back")):
+        for i, (name, _) in enumerate(ns.FACING):
+            part = (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size))
+            figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
+            assert figures["ok"], ps.message(f"{name} ({side})", figures)
+
+
+class _Socket:
+    def __init__(self, identifier, value=0.0):
+        self.identifier = self.name = identifier
+        self.default_value = value
+        self.is_linked = False
+        self.enabled = True
+        self.type = "RGBA" if isinstance(value, tuple) else "VALUE"
+
+
+class _LegacyNode:
+    """Stands in for Blender 4.x's Separate/Combine RGB and HSV nodes (5.0 opens them as
+    Separate/Combine Color): their sockets, unlinked."""
+
+    def __init__(self, inputs, outputs):
+        self.inputs = [_Socket(k, v) for k, v in inputs.items()]
+        self.outputs = [_Socket(k) for k in outputs]
+        self.name = "legacy"
+
+
+def test_legacy_separate_and_combine_nodes_compile_as_their_colour_modes(drt):
+    from drt_engine.blender.export.nodes import Issues
+    from drt_engine.blender.export.shader_graph import Compiler, ImageTable
+    from drt_engine.core.shading.nodes import DirectionContext, Evaluator, rgb_to_hsv
+
+    def evaluate(kind, inputs, outputs, output):
+        compiler = Compiler(ImageTable([]), Issues())
+        node = _LegacyNode(inputs, outputs)
+        ref = getattr(compiler, "_node_" + kind)(node, node.outputs[outputs.index(output)])
+        return Evaluator(compiler.program, DirectionContext(np.zeros((1, 3))), [])(ref)[0]
+    colour = (0.2, 0.5, 0.9, 1.0)
+    assert np.isclose(evaluate("ShaderNodeSeparateRGB", {"Image": colour}, ("R", "G", "B"), "G"), 0.5)
+    hsv = [evaluate("ShaderNodeSeparateHSV", {"Color": colour}, ("H", "S", "V"), k) for k in "HSV"]
+    assert np.allclose(hsv, rgb_to_hsv(np.array([colour[:3]]))[0])
+    rgb = evaluate("ShaderNodeCombineRGB", {"R": 0.1, "G": 0.2, "B": 0.3}, ("Image",), "Image")
+    assert np.allclose(rgb, [0.1, 0.2, 0.3])
+    back = evaluate("ShaderNodeCombineHSV", dict(zip("HSV", hsv)), ("Color",), "Color")
+    assert np.allclose(back, colour[:3])
+
+
+def test_pointiness_matches_cycles(drt, tmp_path):
+    """Pointiness of a bumpy icosphere whose sharp edges are split: Cycles' per-vertex angle,
+    blur and welding of the split vertices."""
+    _matches_cycles(ns.pointiness_scene(), tmp_path, "pointiness", "Pointiness")
+
+
+def test_object_instancer_and_view_layer_attributes_match_cycles(drt, tmp_path):
+    drt_render = _matches_cycles(ns.attribute_scene(), tmp_path, "attributes",
+                                 "Object, Instancer and View Layer attributes")
+    centre = drt_render.rgb[ps.TILE // 2, ps.TILE // 2::ps.TILE]
+    assert np.allclose(centre, [[0.2, 0.7, 0.4], [2.0, 0.35, 0.0], [0.6] * 3, [0.3, 0.3, 0.9], [0.9, 0.5, 0.1]],
+                       atol=1e-3)
+
+
+def test_mirror_ball_environment_matches_cycles(drt, tmp_path):
+    _matches_cycles(ns.mirror_ball_scene(), tmp_path, "mirror-ball", "Environment Texture, Mirror Ball")
+
+
+def test_box_projection_of_a_udim_image_reads_tile_1001(drt):
+    """As Cycles: Box projection's coordinates always fall in tile 1001, the only tile it loads."""
+    scene = ns.grid_scene(ns.CASES[:1])
+    mat = scene.objects[ns.CASES[0].name].data.materials[0]
+    image = mat.node_tree.nodes.new("ShaderNodeTexImage")
+    image.image, image.projection = ns._udim_tiles(), "BOX"
+    emission = next(n for n in mat.node_tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    mat.node_tree.links.new(image.outputs["Color"], emission.inputs["Color"])
+    data = render_export(scene)
+    (node,) = [n for m in data.materials if m.program is not None for n in m.program.nodes if n.op == "image"]
+    assert node.params["tiles"] is None and data.images[node.params["image"]].path.endswith("tiles.1001.exr")

@@ -1,0 +1,612 @@
+"""Shader-node cases (converters, colour and vector nodes, Fresnel and Layer Weight) and the
+scenes that show them, for the Cycles parity test: the procedural texture grid's machinery
+(procedural_scenes: emissive 2 x 2 m tiles seen straight down, each case's output as the
+emission colour through Vector Math Absolute) with a material per case that links every input
+it can to the tile's mapped Object coordinates, so each node is evaluated over a range of
+inputs. Fresnel and Layer Weight depend on the direction a hit is seen from, which DRT's
+emission does not see: ``facing_scene`` shows them as the colour of diffuse spheres seen at
+every angle, from the front and from the back.
+"""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from typing import Callable
+
+import bpy
+import mathutils
+import numpy as np
+
+from tests.support import procedural_scenes as ps
+from tests.support.datablocks import new_material, new_world
+
+
+@dataclass(frozen=True)
+class NodeCase:
+    name: str
+    build: Callable  # (tree, vector socket) -> the output socket shown
+    strength: float = 1.0
+    mesh: tuple | None = None  # (vertices, faces) instead of the tile's one quad
+    setup: Callable | None = None  # adds what the case reads to the tile's mesh
+
+
+def _node(tree, kind, **props):
+    node = tree.nodes.new(kind)
+    for key, value in props.items():
+        setattr(node, key, value)
+    return node
+
+
+def _link(tree, node, **inputs):
+    """Link or set the node's inputs by identifier; returns the node."""
+    sockets = {s.identifier: s for s in node.inputs}
+    for key, value in inputs.items():
+        if isinstance(value, bpy.types.NodeSocket):
+            tree.links.new(value, sockets[key])
+        else:
+            sockets[key].default_value = value
+    return node
+
+
+def _affine(tree, v, scale, offset):
+    """v * scale + offset, per component (Vector Math Multiply Add)."""
+    node = _node(tree, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    tree.links.new(v, node.inputs[0])
+    node.inputs[1].default_value = (scale,) * 3
+    node.inputs[2].default_value = (offset,) * 3
+    return node.outputs["Vector"]
+
+
+def _unit(tree, v):
+    """The tile's coordinates squeezed to about [0, 1]."""
+    return _affine(tree, v, 0.3, 0.5)
+
+
+def _component(tree, v, axis):
+    split = _node(tree, "ShaderNodeSeparateXYZ")
+    tree.links.new(v, split.inputs[0])
+    return split.outputs[axis]
+
+
+def _scaled(tree, value, scale, offset):
+    node = _node(tree, "ShaderNodeMath", operation="MULTIPLY_ADD")
+    tree.links.new(value, node.inputs[0])
+    node.inputs[1].default_value = scale
+    node.inputs[2].default_value = offset
+    return node.outputs[0]
+
+
+def _normalized(tree, v):
+    node = _node(tree, "ShaderNodeVectorMath", operation="NORMALIZE")
+    tree.links.new(v, node.inputs[0])
+    return node.outputs["Vector"]
+
+
+def _brightness(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeBrightContrast"), Color=_unit(tree, v),
+                 Bright=_scaled(tree, _component(tree, v, "X"), 0.2, 0.0),
+                 Contrast=_scaled(tree, _component(tree, v, "Y"), 0.5, 0.1))
+    return node.outputs[0]
+
+
+def _shape(mapping, curve, points):
+    """Give curve ``curve`` of a curve mapping these (x, y) points, the first and last moved."""
+    cmap = mapping.curves[curve]
+    cmap.points[0].location = points[0]
+    cmap.points[-1].location = points[-1]
+    for x, y in points[1:-1]:
+        cmap.points.new(x, y)
+
+
+def _rgb_curves(tree, v):
+    node = _node(tree, "ShaderNodeRGBCurve")
+    _shape(node.mapping, 3, [(0.0, 0.1), (0.5, 0.7), (1.0, 0.9)])
+    _shape(node.mapping, 0, [(0.0, 0.0), (0.3, 0.1), (1.0, 1.0)])
+    _shape(node.mapping, 2, [(0.0, 0.3), (0.6, 0.5), (1.0, 0.8)])
+    node.mapping.update()
+    return _link(tree, node, Color=_affine(tree, v, 0.45, 0.5),
+                 Fac=_scaled(tree, _component(tree, v, "Z"), 0.2, 0.8)).outputs[0]
+
+
+def _vector_curves(tree, v):
+    node = _node(tree, "ShaderNodeVectorCurve")
+    _shape(node.mapping, 0, [(-1.0, -0.5), (0.0, 0.4), (1.0, 1.0)])
+    _shape(node.mapping, 1, [(-1.0, 1.0), (0.2, -0.3), (1.0, 0.2)])
+    node.mapping.extend = "EXTRAPOLATED"
+    node.mapping.update()
+    return _link(tree, node, Vector=v, Fac=0.9).outputs[0]
+
+
+def _float_curve(tree, v):
+    node = _node(tree, "ShaderNodeFloatCurve")
+    _shape(node.mapping, 0, [(0.0, 0.2), (0.4, 0.9), (0.7, 0.3), (1.0, 0.6)])
+    node.mapping.update()
+    unit = _unit(tree, v)
+    return _link(tree, node, Value=_component(tree, unit, "X"), Factor=_component(tree, unit, "Y")).outputs[0]
+
+
+def _rotate(kind, invert):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeVectorRotate", rotation_type=kind, invert=invert)
+        inputs = {"Vector": v, "Center": (0.2, -0.3, 0.1), "Angle": _scaled(tree, _component(tree, v, "Y"), 1.2, 0.4)}
+        if kind == "AXIS_ANGLE":
+            inputs["Axis"] = _unit(tree, v)
+        if kind == "EULER_XYZ":
+            inputs["Rotation"] = _affine(tree, v, 0.8, 0.3)
+        return _link(tree, node, **inputs).outputs[0]
+    return build
+
+
+def _transform(kind, src, dst, scale=1.0):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeVectorTransform", vector_type=kind, convert_from=src, convert_to=dst)
+        # offset, so that the Absolute before the emission does not hide a sign
+        return _affine(tree, _link(tree, node, Vector=v).outputs[0], scale, 0.5)
+    return build
+
+
+def _camera_coordinates(tree, v):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _affine(tree, coords.outputs["Camera"], 0.1, 0.5)
+
+
+def _window_coordinates(tree, v=None):
+    return _node(tree, "ShaderNodeTexCoord").outputs["Window"]
+
+
+def _other_object_coordinates(tree, v):
+    """Object coordinates of an empty turned, scaled and moved in the scene."""
+    empty = bpy.data.objects.new("Frame", None)
+    empty.location = (1.5, -0.7, 0.4)
+    empty.rotation_euler = (0.3, -0.5, 0.9)
+    empty.scale = (1.5, 0.7, 1.2)
+    bpy.context.scene.collection.objects.link(empty)
+    coords = _node(tree, "ShaderNodeTexCoord")
+    coords.object = empty
+    return _affine(tree, coords.outputs["Object"], 0.15, 0.5)
+
+
+def _texels():
+    """An 8 x 8 packed image of random colours (one per texel, read Closest), made once."""
+    image = bpy.data.images.get("Texels")
+    if image is None:
+        image = bpy.data.images.new("Texels", 8, 8, float_buffer=True)
+        texels = np.random.default_rng(5).uniform(0.05, 1.0, (8, 8, 4)).astype(np.float32)
+        texels[..., 3] = 1.0
+        image.pixels.foreach_set(texels.ravel())
+        image.pack()  # a generated image would be generated again (blank) for the render
+    return image
+
+
+def _projected(projection):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeTexImage", image=_texels(), interpolation="Closest", projection=projection)
+        return _link(tree, node, Vector=_unit(tree, v)).outputs["Color"]
+    return build
+
+
+def _geometry(output, scale=1.0, offset=0.0):
+    def build(tree, v):
+        return _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs[output], scale, offset)
+    return build
+
+
+def _interpolated(interpolation, extension):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeTexImage", image=_texels(), interpolation=interpolation, extension=extension)
+        return _link(tree, node, Vector=_affine(tree, v, 0.6, 0.5)).outputs["Color"]  # past the edges
+    return build
+
+
+def _islands():
+    """Four quads filling the tile, the two on the left sharing an edge, the vertices listed in a
+    shuffled order: three islands whose roots are not simply their first vertices."""
+    corners = [(x, y, 0.0) for y in (-1.0, 0.0, 1.0) for x in (-1.0, 0.0, 1.0)]
+    quads = [[(0, 1, 4, 3), (3, 4, 7, 6)], [(1, 2, 5, 4)], [(4, 5, 8, 7)]]
+    vertices, faces = [], []
+    for island in quads:  # each island its own copies of the corners it uses
+        used = sorted({c for quad in island for c in quad})
+        base = len(vertices)
+        vertices += [corners[c] for c in used]
+        faces += [tuple(base + used.index(c) for c in quad) for quad in island]
+    order = np.random.default_rng(0).permutation(len(vertices))  # no island rooted at its smallest index
+    where = np.argsort(order)
+    return [vertices[i] for i in order], [tuple(int(where[c]) for c in face) for face in faces]
+
+
+def _paint(mesh):
+    """A corner colour attribute "Paint" and a second UV map "Extra", a value per corner."""
+    colours = mesh.color_attributes.new("Paint", "FLOAT_COLOR", "CORNER")
+    for i, value in enumerate(colours.data):
+        value.color = ((0.9, 0.1, 0.3, 1.0), (0.2, 0.8, 0.1, 0.5), (0.1, 0.3, 0.9, 1.0), (1.0, 0.9, 0.2, 0.7))[i]
+    uv = mesh.uv_layers.new(name="Extra")
+    for i, value in enumerate(uv.data):
+        value.uv = ((0.1, 0.9), (0.8, 0.3), (0.5, 0.5), (0.2, 0.1))[i]
+
+
+def _attribute_fac(name):
+    def build(tree, v):
+        return _node(tree, "ShaderNodeAttribute", attribute_name=name).outputs["Fac"]
+    return build
+
+
+def _udim_tiles():
+    """A UDIM image of tiles 1001, 1002 and 1011 (4 x 4 random texels each, EXR files in a
+    temporary folder), made once."""
+    image = bpy.data.images.get("Tiles")
+    if image is None:
+        from tests.support.textured_scenes import write_image
+        folder = tempfile.mkdtemp(prefix="drt-udim-")
+        rng = np.random.default_rng(8)
+        for tile in (1001, 1002, 1011):
+            write_image(f"{folder}/tiles.{tile}.exr", rng.uniform(0.05, 1.0, (4, 4, 3)).astype(np.float32))
+        image = bpy.data.images.load(f"{folder}/tiles.1001.exr")
+        image.name = "Tiles"
+        image.source = "TILED"  # Blender finds the other tiles and puts <UDIM> in the path
+    return image
+
+
+def _udim(tree, v):
+    node = _node(tree, "ShaderNodeTexImage", image=_udim_tiles(), interpolation="Closest")
+    return _link(tree, node, Vector=_affine(tree, v, 0.9, 1.0)).outputs["Color"]  # tiles 1001-1012, and beyond
+
+
+def _mapped(kind, vector_type, axes=("X", "Y", "Z"), image=False, **props):
+    """A texture node fed by the tile's coordinates through its own Texture Mapping (an Image
+    Texture reads the 8 x 8 texels)."""
+    def build(tree, v):
+        node = _node(tree, kind, **props)
+        if image:
+            node.image = _texels()
+        mapping = node.texture_mapping
+        mapping.vector_type = vector_type
+        mapping.translation, mapping.rotation, mapping.scale = (0.3, -0.2, 0.5), (0.4, 0.2, -0.7), (1.5, 0.8, 1.2)
+        mapping.mapping_x, mapping.mapping_y, mapping.mapping_z = axes
+        return _link(tree, node, Vector=v).outputs[0]
+    return build
+
+
+def _normal_dot(tree, v):
+    node = _node(tree, "ShaderNodeNormal")
+    node.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
+    return _link(tree, node, Normal=v).outputs["Dot"]
+
+
+def _blackbody(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeBlackbody"),
+                 Temperature=_scaled(tree, _component(tree, v, "X"), 2500.0, 5000.0))
+    return node.outputs[0]
+
+
+def _wavelength(tree, v):
+    node = _link(tree, _node(tree, "ShaderNodeWavelength"),
+                 Wavelength=_scaled(tree, _component(tree, v, "X"), 120.0, 560.0))
+    return node.outputs[0]
+
+
+def _separate_hsl(tree, v):
+    # green the largest channel: hue away from its wrap from 1 to 0, whose edge pixels the two
+    # renderers' pixel samples split differently; saturation away from white, where it is singular
+    unit = _affine(tree, v, 0.2, 0.4)
+    colour = _node(tree, "ShaderNodeCombineXYZ")
+    tree.links.new(_component(tree, unit, "X"), colour.inputs[0])
+    colour.inputs[1].default_value = 0.9
+    tree.links.new(_component(tree, unit, "Z"), colour.inputs[2])
+    split = _link(tree, _node(tree, "ShaderNodeSeparateColor", mode="HSL"), Color=colour.outputs[0])
+    join = _node(tree, "ShaderNodeCombineXYZ")
+    for i, name in enumerate(("Red", "Green", "Blue")):
+        tree.links.new(split.outputs[name], join.inputs[i])
+    return join.outputs[0]
+
+
+def _combine_hsl(tree, v):
+    unit = _unit(tree, v)
+    node = _node(tree, "ShaderNodeCombineColor", mode="HSL")
+    for axis, name in zip("XYZ", ("Red", "Green", "Blue")):
+        tree.links.new(_component(tree, unit, axis), node.inputs[name])
+    return node.outputs[0]
+
+
+def _mix(blend):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMix", data_type="RGBA", blend_type=blend)
+        return _link(tree, node, A_Color=_unit(tree, v), B_Color=_affine(tree, v, -0.35, 0.5),
+                     Factor_Float=_component(tree, _unit(tree, v), "X")).outputs[2]
+    return build
+
+
+def _map_range_vector(kind, clamp=True):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMapRange", data_type="FLOAT_VECTOR", interpolation_type=kind, clamp=clamp)
+        return _link(tree, node, Vector=v, Steps_FLOAT3=(3.0, 4.0, 5.0), From_Min_FLOAT3=(-1.0, -1.2, -0.8),
+                     From_Max_FLOAT3=(1.0, 0.9, 1.1),
+                     To_Min_FLOAT3=(0.1, 0.9, 0.0), To_Max_FLOAT3=_unit(tree, v)).outputs["Vector"]
+    return build
+
+
+def _map_range_float(kind):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeMapRange", data_type="FLOAT", interpolation_type=kind)
+        return _link(tree, node, Value=_component(tree, v, "X"), Steps=4.0, **{"From Min": -1.2, "From Max": 1.0,
+                     "To Min": 0.1, "To Max": _component(tree, _unit(tree, v), "Y")}).outputs["Result"]
+    return build
+
+
+def _ramp(interpolation, color_mode="RGB"):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeValToRGB")
+        ramp = node.color_ramp
+        ramp.interpolation = interpolation
+        ramp.color_mode = color_mode
+        ramp.elements[0].color = (0.9, 0.1, 0.1, 1.0)
+        ramp.elements[1].color = (0.1, 0.2, 0.9, 1.0)
+        for position, color in ((0.3, (0.1, 0.9, 0.2, 1.0)), (0.55, (1.0, 0.9, 0.1, 1.0))):
+            ramp.elements.new(position).color = color
+        return _link(tree, node, Fac=_component(tree, _affine(tree, v, 0.4, 0.5), "X")).outputs["Color"]
+    return build
+
+
+CASES = (
+    NodeCase("Brightness/Contrast", _brightness),
+    NodeCase("RGB Curves, extrapolated", _rgb_curves),
+    NodeCase("Vector Curves", _vector_curves),
+    NodeCase("Float Curve", _float_curve),
+    NodeCase("Vector Rotate X axis", _rotate("X_AXIS", False)),
+    NodeCase("Vector Rotate Y axis inverted", _rotate("Y_AXIS", True)),
+    NodeCase("Vector Rotate Z axis", _rotate("Z_AXIS", False)),
+    NodeCase("Vector Rotate axis angle", _rotate("AXIS_ANGLE", False)),
+    NodeCase("Vector Rotate Euler inverted", _rotate("EULER_XYZ", True)),
+    NodeCase("Vector Transform point object to world", _transform("POINT", "OBJECT", "WORLD", 0.25)),
+    NodeCase("Vector Transform normal world to camera", _transform("NORMAL", "WORLD", "CAMERA")),
+    NodeCase("Vector Transform vector camera to object", _transform("VECTOR", "CAMERA", "OBJECT")),
+    NodeCase("Vector Transform point world to camera", _transform("POINT", "WORLD", "CAMERA", 0.1)),
+    NodeCase("Texture Coordinate Camera", _camera_coordinates),
+    NodeCase("Texture Coordinate Window", _window_coordinates),
+    NodeCase("Texture Coordinate from another object", _other_object_coordinates),
+    NodeCase("Image Texture Sphere projection", _projected("SPHERE")),
+    NodeCase("Image Texture Tube projection", _projected("TUBE")),
+    NodeCase("Image Texture UDIM tiles", _udim, strength=0.5),
+    NodeCase("Texture Mapping, texture type (Noise)", _mapped("ShaderNodeTexNoise", "TEXTURE")),
+    NodeCase("Texture Mapping, point type, axes swapped (Checker)",
+             _mapped("ShaderNodeTexChecker", "POINT", ("Y", "NONE", "X"))),
+    NodeCase("Texture Mapping, vector type (Image)", _mapped("ShaderNodeTexImage", "VECTOR", image=True,
+                                                              interpolation="Closest")),
+    NodeCase("Texture Mapping, normal type (Gradient)", _mapped("ShaderNodeTexGradient", "NORMAL",
+                                                                 gradient_type="RADIAL")),
+    NodeCase("Image Texture Cubic, repeat", _interpolated("Cubic", "REPEAT")),
+    NodeCase("Image Texture Cubic, clip", _interpolated("Cubic", "CLIP")),
+    NodeCase("Image Texture Cubic, extend", _interpolated("Cubic", "EXTEND")),
+    NodeCase("Image Texture Smart, mirror", _interpolated("Smart", "MIRROR")),
+    # scaled down: Parametric jumps across the quad's diagonal, whose edge pixels the renderers'
+    # pixel samples split differently (by up to 0.08 of the jump), as they would any edge
+    NodeCase("Geometry Parametric", _geometry("Parametric", 0.3)),
+    NodeCase("Geometry Tangent", _geometry("Tangent", 0.5, 0.5)),
+    NodeCase("Attribute Fac of a colour attribute", _attribute_fac("Paint"), setup=_paint),
+    NodeCase("Attribute Fac of a UV map", _attribute_fac("Extra"), setup=_paint),
+    NodeCase("Geometry Random Per Island", _geometry("Random Per Island"), mesh=_islands()),
+    NodeCase("Normal Dot", _normal_dot),
+    NodeCase("Blackbody", _blackbody, strength=0.3),
+    NodeCase("Wavelength", _wavelength),
+    NodeCase("Separate Color HSL", _separate_hsl),
+    NodeCase("Combine Color HSL", _combine_hsl),
+    NodeCase("Mix Hue", _mix("HUE")),
+    NodeCase("Mix Saturation", _mix("SATURATION")),
+    NodeCase("Mix Value", _mix("VALUE")),
+    NodeCase("Mix Color", _mix("COLOR")),
+    NodeCase("Map Range vector linear", _map_range_vector("LINEAR")),
+    NodeCase("Map Range vector stepped", _map_range_vector("STEPPED")),
+    NodeCase("Map Range vector smoothstep", _map_range_vector("SMOOTHSTEP")),
+    NodeCase("Map Range vector smootherstep, unclamped", _map_range_vector("SMOOTHERSTEP", False)),
+    NodeCase("Map Range stepped", _map_range_float("STEPPED")),
+    NodeCase("Map Range smootherstep", _map_range_float("SMOOTHERSTEP")),
+    NodeCase("Color Ramp B-Spline", _ramp("B_SPLINE")),
+    NodeCase("Color Ramp Cardinal", _ramp("CARDINAL")),
+    NodeCase("Color Ramp linear in HSV", _ramp("LINEAR", "HSV")),
+)
+
+
+def _emissive(tree, color, strength):
+    absolute = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+    tree.links.new(color, absolute.inputs[0])
+    emission = _node(tree, "ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = strength
+    tree.links.new(absolute.outputs["Vector"], emission.inputs["Color"])
+    out = _node(tree, "ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+
+
+def material(case: NodeCase):
+    """The case's node fed by the tile's Object coordinates turned by a Mapping, as emission."""
+    mat = new_material(case.name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    coords = _node(tree, "ShaderNodeTexCoord")
+    mapping = _node(tree, "ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.31, -0.17, 0.43)
+    mapping.inputs["Rotation"].default_value = (0.5, 0.35, 0.2)
+    tree.links.new(coords.outputs["Object"], mapping.inputs["Vector"])
+    _emissive(tree, case.build(tree, mapping.outputs["Vector"]), case.strength)
+    return mat
+
+
+def grid_scene(cases=CASES):
+    return ps.grid_scene(cases, material)
+
+
+def _sphere_normal(tree):
+    """The sphere's normal tilted (normalised object-space normal plus a constant): a linked Normal."""
+    coords = _node(tree, "ShaderNodeTexCoord")
+    add = _node(tree, "ShaderNodeVectorMath", operation="ADD")
+    tree.links.new(coords.outputs["Normal"], add.inputs[0])
+    add.inputs[1].default_value = (0.4, -0.3, 0.2)
+    return _normalized(tree, add.outputs["Vector"])
+
+
+def _generated_z(tree, scale, offset):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _scaled(tree, _component(tree, coords.outputs["Generated"], "Z"), scale, offset)
+
+
+def _true_normal_and_backfacing(tree):
+    """|True Normal| / 2 plus Backfacing / 2."""
+    geometry = _node(tree, "ShaderNodeNewGeometry")
+    absolute = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+    tree.links.new(geometry.outputs["True Normal"], absolute.inputs[0])
+    node = _node(tree, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    tree.links.new(absolute.outputs["Vector"], node.inputs[0])
+    node.inputs[1].default_value = (0.5, 0.5, 0.5)
+    tree.links.new(_scaled(tree, geometry.outputs["Backfacing"], 0.5, 0.0), node.inputs[2])
+    return node.outputs["Vector"]
+
+
+def _reflection(tree):
+    coords = _node(tree, "ShaderNodeTexCoord")
+    return _affine(tree, coords.outputs["Reflection"], 0.4, 0.5)
+
+
+def _normal_map(space):
+    """Normal Map of a constant colour, shown as a colour ((N + 1) / 2)."""
+    def build(tree):
+        node = _link(tree, _node(tree, "ShaderNodeNormalMap", space=space), Color=(0.75, 0.35, 0.85, 1.0),
+                     Strength=0.8)
+        return _affine(tree, node.outputs["Normal"], 0.5, 0.5)
+    return build
+
+
+FACING = (
+    ("Fresnel", lambda tree: _link(tree, _node(tree, "ShaderNodeFresnel"), IOR=1.45).outputs[0]),
+    ("Fresnel, IOR and normal linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeFresnel"), IOR=_generated_z(tree, 1.0, 1.2), Normal=_sphere_normal(tree)).outputs[0]),
+    ("Layer Weight Fresnel, blend linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeLayerWeight"), Blend=_generated_z(tree, 0.6, 0.2)).outputs[0]),
+    ("Layer Weight Facing, normal linked", lambda tree: _link(
+        tree, _node(tree, "ShaderNodeLayerWeight"), Blend=0.3, Normal=_sphere_normal(tree)).outputs[1]),
+    ("Geometry True Normal and Backfacing", _true_normal_and_backfacing),
+    ("Texture Coordinate Reflection", _reflection),
+    ("Texture Coordinate Window (perspective)", _window_coordinates),
+    ("Normal Map tangent space", _normal_map("TANGENT")),
+    ("Normal Map object space", _normal_map("OBJECT")),
+    ("Normal Map Blender world space", _normal_map("BLENDER_WORLD")),
+)
+"""Nodes that see the direction a hit is seen from or its side (Fresnel, Layer Weight, Geometry's
+True Normal and Backfacing, Texture Coordinate's Reflection, Normal Map), and Window
+coordinates in perspective: a diffuse sphere each, coloured by the node, in front (top row) and, with the
+normals turned inwards, from the back."""
+
+
+def facing_scene(size=32):
+    """The FACING cases on smooth diffuse spheres under a uniform white world (each point of a
+    sphere then reflects its colour), seen in perspective: the incoming direction meets the
+    shading normal at every angle. The bottom row's spheres have their normals flipped, so the
+    camera sees their backs (Cycles' backfacing hits: the IOR inverted)."""
+    scene = ps._scene(size * len(FACING), 2 * size)
+    ps.aim(scene.camera, (0.0, -7.0 * len(FACING) / 2.4, 0.0))  # 36 mm sensor at 50 mm: 2.1 m, the spacing, is 32 px
+    scene.camera.data.lens = 50.0
+    scene.world = new_world("World")
+    for row, flipped in enumerate((False, True)):
+        for i, (name, build) in enumerate(FACING):
+            x = 2.1 * (i - (len(FACING) - 1) / 2)
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(x, 0.0, 1.05 - 2.1 * row), segments=48,
+                                                 ring_count=24)
+            bpy.ops.object.shade_smooth()
+            obj = bpy.context.active_object
+            if flipped:
+                obj.data.flip_normals()
+            mat = new_material(name)
+            tree = mat.node_tree
+            tree.nodes.clear()
+            bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
+            tree.links.new(build(tree), bsdf.inputs["Color"])
+            out = _node(tree, "ShaderNodeOutputMaterial")
+            tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+            obj.data.materials.append(mat)
+    return scene
+
+
+def pointiness_scene(size=48):
+    """An icosphere with its vertices pushed in and out at random and its sharp edges split (the
+    duplicated vertices Pointiness welds again), emitting its Pointiness with the contrast raised
+    (4 p - 1.5, through Absolute), seen in perspective."""
+    scene = ps._scene(size, size)
+    ps.aim(scene.camera, (2.4, -3.0, 2.2))
+    ps.black_world(scene)
+    bpy.ops.mesh.primitive_ico_sphere_add(radius=1.0, subdivisions=3)
+    obj = bpy.context.active_object
+    rng = np.random.default_rng(4)
+    for vertex in obj.data.vertices:
+        vertex.co *= rng.uniform(0.85, 1.15)
+    bpy.ops.object.shade_smooth()
+    split = obj.modifiers.new("Split", "EDGE_SPLIT")
+    split.split_angle = 0.5
+    mat = new_material("Pointiness")
+    tree = mat.node_tree
+    tree.nodes.clear()
+    geometry = _node(tree, "ShaderNodeNewGeometry")
+    _emissive(tree, _affine(tree, geometry.outputs["Pointiness"], 4.0, -1.5), 1.0)
+    obj.data.materials.append(mat)
+    return scene
+
+
+def _plane(name, x, material, collection):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([(-0.9, -0.9, 0), (0.9, -0.9, 0), (0.9, 0.9, 0), (-0.9, 0.9, 0)], [], [(0, 1, 2, 3)])
+    mesh.materials.append(material)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.location = (x, 0.0, 0.0)
+    collection.objects.link(obj)
+    return obj
+
+
+def _attribute_material(name, kind, attribute, output="Color"):
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    node = _node(tree, "ShaderNodeAttribute", attribute_type=kind, attribute_name=attribute)
+    _emissive(tree, node.outputs[output], 1.0)
+    return mat
+
+
+def attribute_scene():
+    """Five emissive squares in a row, seen from above, coloured by Attribute nodes of the
+    Object, Instancer and View Layer types: an object's custom property, an RNA path (its
+    location), its mesh's custom property, an instanced object's instancer's property, the
+    scene's custom property (through the view layer)."""
+    scene = ps._scene(5 * ps.TILE, ps.TILE)
+    cam = scene.camera
+    cam.data.type = "ORTHO"
+    cam.data.ortho_scale = 10.0
+    ps.black_world(scene)
+    own = _plane("Own", -4.0, _attribute_material("Own", "OBJECT", "tint"), scene.collection)
+    own["tint"] = (0.2, 0.7, 0.4)
+    path = _plane("Path", -2.0, _attribute_material("Path", "OBJECT", "location"), scene.collection)
+    path.location.y = 0.35
+    data = _plane("Data", 0.0, _attribute_material("Data", "OBJECT", "tint"), scene.collection)
+    data.data["tint"] = 0.6
+    hidden = bpy.data.collections.new("Instanced")
+    inner = _plane("Inner", 0.0, _attribute_material("Instanced", "INSTANCER", "tint"), hidden)
+    inner["tint"] = (1.0, 0.0, 0.0)  # the instancer's own value comes first
+    instancer = bpy.data.objects.new("Instancer", None)
+    instancer.instance_type = "COLLECTION"
+    instancer.instance_collection = hidden
+    instancer.location = (2.0, 0.0, 0.0)
+    instancer["tint"] = (0.3, 0.3, 0.9, 0.5)
+    scene.collection.objects.link(instancer)
+    scene["tint"] = (0.9, 0.5, 0.1)
+    _plane("Layer", 4.0, _attribute_material("Layer", "VIEW_LAYER", "tint"), scene.collection)
+    return scene
+
+
+def mirror_ball_scene(size=48):
+    """Only the world, an Environment Texture (the 8 x 8 texels, Closest) in Mirror Ball
+    projection, seen by a wide camera at the origin looking down -y, where the ball's centre is."""
+    scene = ps._scene(size, size)
+    cam = scene.camera
+    cam.location = (0.0, 0.0, 0.0)
+    cam.rotation_euler = mathutils.Vector((-0.3, -1.0, 0.2)).to_track_quat("-Z", "Y").to_euler()
+    cam.data.lens = 12.0
+    world = new_world("World")
+    tree = world.node_tree
+    env = _node(tree, "ShaderNodeTexEnvironment", image=_texels(), interpolation="Closest", projection="MIRROR_BALL")
+    tree.links.new(env.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    scene.world = world
+    return scene
