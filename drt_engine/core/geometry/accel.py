@@ -381,26 +381,35 @@ def _corner_normals(ms: _MeshScene) -> np.ndarray:
 
 
 # -- kernels: one hit, one ray -----------------------------------------------------------
-@kernel
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
 def instance_of(geo, prim):
     """The instance (its row in the instance tables) whose triangles include global id ``prim``."""
     return np.searchsorted(geo[6], prim, side="right") - 1
 
 
-@kernel
-def instance_frame(geo, i, time, scratch):
-    """Object-to-world transform (3, 4) of instance i at shutter fraction ``time``, and its inverse."""
-    steps = geo[9]
-    a, count = steps[i, 0], steps[i, 1]
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
+def instance_frame(geo, i, time, frame):
+    """Object-to-world transform of instance i at shutter fraction ``time`` into frame[0] (3, 4), its
+    inverse into frame[1]. Copied element by element: array views cost more than the copy."""
+    count = geo[9][i, 1]
     if count == 0:
-        return geo[7][i], geo[8][i]
-    m, inv = scratch[0], scratch[1]
-    frame_at(geo[10][a:a + count], geo[11][a:a + count], geo[12][a:a + count], time, m)
-    invert_frame(m, inv)
-    return m, inv
+        still, inverse = geo[7], geo[8]
+        for r in range(3):
+            for c in range(4):
+                frame[0, r, c] = still[i, r, c]
+                frame[1, r, c] = inverse[i, r, c]
+    else:
+        _moving_frame(geo[10], geo[11], geo[12], geo[9][i, 0], count, time, frame)
 
 
 @kernel
+def _moving_frame(translation, quat, upper, first, count, time, frame):
+    """instance_frame of a moving instance (apart: its slices cost every caller ~40 ns a hit when inlined)."""
+    frame_at(translation[first:first + count], quat[first:first + count], upper[first:first + count], time, frame[0])
+    invert_frame(frame[0], frame[1])
+
+
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
 def _corners(geo, i, prim, time):
     """Object-space corners (9 coordinates) of global triangle ``prim`` of instance i at ``time``
     (a deforming mesh's vertices interpolated linearly between its steps, as Embree does), its
@@ -427,19 +436,22 @@ def _corners(geo, i, prim, time):
 
 
 @kernel
-def _to_world_normal(inv, x, y, z):
-    """A normal carried to the world by the inverse transpose (outward under mirroring too), unit."""
-    return unit(inv[0, 0] * x + inv[1, 0] * y + inv[2, 0] * z, inv[0, 1] * x + inv[1, 1] * y + inv[2, 1] * z,
-                inv[0, 2] * x + inv[1, 2] * y + inv[2, 2] * z, 1e-300)
+def _to_world_normal(f, x, y, z):
+    """A normal carried to the world by the inverse transpose of frame f (outward under mirroring
+    too), unit."""
+    return unit(f[1, 0, 0] * x + f[1, 1, 0] * y + f[1, 2, 0] * z, f[1, 0, 1] * x + f[1, 1, 1] * y + f[1, 2, 1] * z,
+                f[1, 0, 2] * x + f[1, 1, 2] * y + f[1, 2, 2] * z, 1e-300)
 
 
 @kernel
-def _to_world_point(m, x, y, z):
-    return (m[0, 0] * x + m[0, 1] * y + m[0, 2] * z + m[0, 3], m[1, 0] * x + m[1, 1] * y + m[1, 2] * z + m[1, 3],
-            m[2, 0] * x + m[2, 1] * y + m[2, 2] * z + m[2, 3])
+def _to_world_point(f, x, y, z):
+    """A point carried to the world by frame f."""
+    return (f[0, 0, 0] * x + f[0, 0, 1] * y + f[0, 0, 2] * z + f[0, 0, 3],
+            f[0, 1, 0] * x + f[0, 1, 1] * y + f[0, 1, 2] * z + f[0, 1, 3],
+            f[0, 2, 0] * x + f[0, 2, 1] * y + f[0, 2, 2] * z + f[0, 2, 3])
 
 
-@kernel
+@kernel(inline="always")  # see instance_of
 def hit_surface(geo, prim, u, v, time, scratch):
     """World position, geometric and shading normal of the hit (prim, u, v) at ``time``.
 
@@ -450,22 +462,22 @@ def hit_surface(geo, prim, u, v, time, scratch):
     """
     ng_all, ns_all = geo[2], geo[3]
     i = instance_of(geo, prim)
-    m, inv = instance_frame(geo, i, time, scratch)
+    instance_frame(geo, i, time, scratch)
     c, row, deforming = _corners(geo, i, prim, time)
     w = 1.0 - u - v
-    px, py, pz = _to_world_point(m, w * c[0] + u * c[3] + v * c[6], w * c[1] + u * c[4] + v * c[7],
+    px, py, pz = _to_world_point(scratch, w * c[0] + u * c[3] + v * c[6], w * c[1] + u * c[4] + v * c[7],
                                  w * c[2] + u * c[5] + v * c[8])
     if deforming:
         ex, ey, ez = c[3] - c[0], c[4] - c[1], c[5] - c[2]
         fx, fy, fz = c[6] - c[0], c[7] - c[1], c[8] - c[2]
-        gx, gy, gz = _to_world_normal(inv, ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx)
+        gx, gy, gz = _to_world_normal(scratch, ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx)
     else:
-        gx, gy, gz = _to_world_normal(inv, ng_all[row, 0], ng_all[row, 1], ng_all[row, 2])
+        gx, gy, gz = _to_world_normal(scratch, ng_all[row, 0], ng_all[row, 1], ng_all[row, 2])
     if len(ns_all):
         sx = sy = sz = 0.0
         bary = (w, u, v)
         for j in range(3):
-            nx, ny, nz = _to_world_normal(inv, ns_all[row, j, 0], ns_all[row, j, 1], ns_all[row, j, 2])
+            nx, ny, nz = _to_world_normal(scratch, ns_all[row, j, 0], ns_all[row, j, 1], ns_all[row, j, 2])
             sx += bary[j] * nx
             sy += bary[j] * ny
             sz += bary[j] * nz
@@ -475,7 +487,7 @@ def hit_surface(geo, prim, u, v, time, scratch):
     return px, py, pz, gx, gy, gz, sx, sy, sz
 
 
-@kernel
+@kernel(inline="always")  # see instance_of
 def lift(geo, prim, u, v, time, scratch):
     """World vector from the hit to the smooth surface its corner normals describe.
 
@@ -488,19 +500,19 @@ def lift(geo, prim, u, v, time, scratch):
     if len(ns) == 0:
         return 0.0, 0.0, 0.0
     i = instance_of(geo, prim)
-    m, inv = instance_frame(geo, i, time, scratch)
+    instance_frame(geo, i, time, scratch)
     c, row, _ = _corners(geo, i, prim, time)
     bary = (1.0 - u - v, u, v)
-    ax, ay, az = _to_world_point(m, c[0], c[1], c[2])
-    bx, by, bz = _to_world_point(m, c[3], c[4], c[5])
-    cx, cy, cz = _to_world_point(m, c[6], c[7], c[8])
+    ax, ay, az = _to_world_point(scratch, c[0], c[1], c[2])
+    bx, by, bz = _to_world_point(scratch, c[3], c[4], c[5])
+    cx, cy, cz = _to_world_point(scratch, c[6], c[7], c[8])
     world = (ax, ay, az, bx, by, bz, cx, cy, cz)
     px = bary[0] * ax + bary[1] * bx + bary[2] * cx
     py = bary[0] * ay + bary[1] * by + bary[2] * cy
     pz = bary[0] * az + bary[1] * bz + bary[2] * cz
     ox = oy = oz = 0.0
     for j in range(3):
-        nx, ny, nz = _to_world_normal(inv, ns[row, j, 0], ns[row, j, 1], ns[row, j, 2])
+        nx, ny, nz = _to_world_normal(scratch, ns[row, j, 0], ns[row, j, 1], ns[row, j, 2])
         below = min((px - world[3 * j]) * nx + (py - world[3 * j + 1]) * ny + (pz - world[3 * j + 2]) * nz, 0.0)
         ox -= bary[j] * below * nx
         oy -= bary[j] * below * ny
@@ -549,18 +561,18 @@ def _intersects(scene, geo, origins, directions, tmax, times, t, prim, u, v):
                                       directions[r, 1], directions[r, 2], time, th, uh, vh, scratch)
 
 
-@kernel
+@kernel(inline="always")  # see instance_of
 def refine(geo, prim, ox, oy, oz, dx, dy, dz, time, t, u, v, scratch):
     """(t, u, v) of the ray's hit on triangle ``prim`` in float64 (Moller-Trumbore on the world
     triangle at ``time``), clamped into the triangle; Embree's float32 (t, u, v) if the triangle
     is too thin to say. Embree's barycentrics can be off by 1e-3 on grazing hits, and differently
     for an instance than for the same triangles in one mesh; these are not."""
     i = instance_of(geo, prim)
-    m, _ = instance_frame(geo, i, time, scratch)
+    instance_frame(geo, i, time, scratch)
     c, _, _ = _corners(geo, i, prim, time)
-    ax, ay, az = _to_world_point(m, c[0], c[1], c[2])
-    bx, by, bz = _to_world_point(m, c[3], c[4], c[5])
-    cx, cy, cz = _to_world_point(m, c[6], c[7], c[8])
+    ax, ay, az = _to_world_point(scratch, c[0], c[1], c[2])
+    bx, by, bz = _to_world_point(scratch, c[3], c[4], c[5])
+    cx, cy, cz = _to_world_point(scratch, c[6], c[7], c[8])
     ex, ey, ez = bx - ax, by - ay, bz - az
     fx, fy, fz = cx - ax, cy - ay, cz - az
     px, py, pz = dy * fz - dz * fy, dz * fx - dx * fz, dx * fy - dy * fx
