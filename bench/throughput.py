@@ -1,9 +1,10 @@
 """make bench (throughput part): DRT's ray throughput against raw Embree, and its peak memory.
 
 For each sample scene, in one run:
-(a) raw embreex: the scene's own camera rays (pixel jitter, lens, shutter as the scene
-    has them, each moving part queried in its own frame at mid-shutter) traced by
-    ``EmbreeScene.run`` alone, on 1 thread and on every core (one chunk per thread);
+(a) raw Embree: the scene's own camera rays (pixel jitter, lens, shutter as the scene
+    has them, at mid-shutter) traced through the scene's top-level Embree scene by the
+    binding's batch kernel alone (core.geometry.embree), on 1 thread and on every core (one
+    chunk per thread);
 (b) DRT end to end: every ray the renderer traced (camera, shadow, reflection,
     refraction, transparent) over its render time (export and BVH build excluded), on
     1 thread and on every core;
@@ -37,7 +38,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import drt_engine  # noqa: E402
-from drt_engine.core.geometry import camera as camera_rays  # noqa: E402
+from drt_engine.core.geometry import camera as camera_rays, embree  # noqa: E402
 from drt_engine.core.render.prepared import PreparedScene  # noqa: E402
 from drt_engine.core.render.render import WAVE, Renderer  # noqa: E402
 from blocks import RESULTS_THROUGHPUT, write_block  # noqa: E402
@@ -60,26 +61,24 @@ def camera_batch(data, n, seed=0):
 
 
 def raw_embree(geometry, cam, threads, seconds=1.0):
-    """(rays per wall second, rays per CPU second) of EmbreeScene.run alone over every part,
-    for closest hits as DRT asks."""
-    batches = []
-    for k, part in enumerate(geometry.parts):
-        if not part.scenes:
-            continue
-        times = geometry.ray_times(np.full(len(cam.origins), 0.5))
-        o, d = geometry._rays_in(k, cam.origins, cam.directions, times, np.arange(len(cam.origins)))
-        far = np.minimum(cam.tmax, 3e38).astype(np.float32)
-        batches.append((part.scenes[len(part.scenes) // 2], np.ascontiguousarray(o, np.float32),
-                        np.ascontiguousarray(d, np.float32), far))
+    """(rays per wall second, rays per CPU second) of Embree alone: the binding's batch kernel over
+    the scene's top-level Embree scene at mid-shutter, for closest hits as DRT asks."""
+    top = geometry.instance_scene
+    if top is None:
+        return float("nan"), float("nan")
     n = len(cam.origins)
+    rays = (np.ascontiguousarray(cam.origins - geometry.center, np.float32),
+            np.ascontiguousarray(cam.directions, np.float32), np.zeros(n, np.float32),
+            np.minimum(cam.tmax, 3e38).astype(np.float32), np.full(n, 0.5, np.float32))
+    out = (np.empty(n, np.float32), np.empty((n, 2), np.float32), np.empty((n, 3), np.float32),
+           np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int32))
     bounds = np.linspace(0, n, threads + 1).astype(int)
     with ThreadPoolExecutor(threads) as pool:
         def once():
-            for scene, o, d, far in batches:
-                jobs = [pool.submit(scene.run, o[a:b], d[a:b], far[a:b], "INTERSECT", 1)
-                        for a, b in zip(bounds[:-1], bounds[1:])]
-                for job in jobs:
-                    job.result()
+            jobs = [pool.submit(embree.intersect_batch, top.handle, *(x[a:b] for x in rays + out))
+                    for a, b in zip(bounds[:-1], bounds[1:])]
+            for job in jobs:
+                job.result()
         once()
         reps, start, cpu = 0, time.perf_counter(), time.process_time()
         while reps < 3 or time.perf_counter() - start < seconds:
@@ -158,8 +157,8 @@ def table(rows, memory, startup, width, samples, cores, memory_scene, memory_sam
         f"Made by `make bench` (bench/throughput.py) on {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
         f"{cores} cores, Python {sys.version.split()[0]}, NumPy {np.__version__}; machine load average "
         f"{os.getloadavg()[0]:.1f} when it ended. Scenes at width {width} px, DRT {samples} spp. Raw: the scene's "
-        "own camera rays through `EmbreeScene.run` only. DRT: every ray it traced (all kinds) over its render "
-        "time. Mrays/s per wall second, and per CPU second of the process on 1 thread (which other "
+        "own camera rays through the binding's batch kernel on its top-level Embree scene only. DRT: every "
+        "ray it traced (all kinds) over its render time. Mrays/s per wall second, and per CPU second of the process on 1 thread (which other "
         "processes on the machine disturb less).",
         "",
         "| scene | raw 1 thread | raw all | DRT 1 thread | DRT all | DRT / raw, all (target "

@@ -218,6 +218,45 @@ def test_moving_instances_start_and_end_at_their_given_matrices():
             np.testing.assert_allclose(got["t"][hit], expected["t"][hit], rtol=1e-4)
 
 
+@pytest.mark.parametrize("moving", [False, True])
+def test_a_pivot_places_vertices_given_relative_to_it(moving):
+    """A mesh handed to Embree relative to a point of its own (the pivot) and instanced with that
+    pivot hits where the mesh given as it is does, under the same transform(s): a still one, or a
+    turn, stretch and shift over the shutter (the pivot turns about the object's origin)."""
+    vertices, triangles = _sphere()
+    pivot = np.array([0.5, -0.3, 0.2])
+    steps = np.array([_transform(0.0, 1.0, (0, 0, 0)), _transform(0.8, 1.3, (0.2, 0.1, -0.1))])
+    steps[1, 2, 2] = 0.7
+    transforms = steps if moving else steps[1]
+    rng = np.random.default_rng(6)
+    origins, directions = _random_rays(rng, 5000)
+    time = rng.random(5000)
+    with embree.TriangleScene(vertices + pivot.astype(np.float32), triangles) as whole, \
+            embree.TriangleScene(vertices, triangles) as centred, embree.InstanceScene() as plain, \
+            embree.InstanceScene() as pivoted:
+        plain.add(whole, transforms)
+        pivoted.add(centred, transforms, pivot)
+        plain.commit()
+        pivoted.commit()
+        expected = embree.intersect(plain, origins, directions, time=time)
+        got = embree.intersect(pivoted, origins, directions, time=time)
+    hit = expected["geomID"] >= 0
+    assert 0.2 < hit.mean() < 0.9
+    assert (got["primID"] != expected["primID"]).mean() < 1e-3  # rounding near edges only
+    both = hit & (got["primID"] == expected["primID"])
+    np.testing.assert_allclose(got["t"][both], expected["t"][both], rtol=1e-4)
+
+
+def test_mesh_scene_builds_are_counted():
+    vertices, triangles = _sphere()
+    before = embree.TriangleScene.builds
+    with embree.TriangleScene(vertices, triangles) as mesh, embree.InstanceScene() as top:
+        top.add(mesh, np.eye(4))
+        top.add(mesh, _transform(0.3, 1.0, (2, 0, 0)))
+        top.commit()
+    assert embree.TriangleScene.builds - before == 1
+
+
 def test_error_callback_reports_and_the_device_keeps_working():
     """Instancing a closed scene passes Embree a NULL scene: the callback records Embree's message,
     the call raises it, and the device goes on tracing."""

@@ -4,6 +4,7 @@ import dataclasses
 
 import numpy as np
 
+from drt_engine.core.geometry.embree import TriangleScene
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import PASSES, RenderSettings
@@ -28,13 +29,22 @@ def before(base, prepared):
     return Renderer(base, SETTINGS, prepared).render().passes["Combined"]
 
 
+def mesh_builds(update):
+    """The Embree mesh scenes (BVHs) ``update()`` built, and what it returned."""
+    before = TriangleScene.builds
+    result = update()
+    return TriangleScene.builds - before, result
+
+
 def test_an_instance_transform_rebuilds_the_geometry_and_keeps_the_materials():
+    """... and no mesh's Embree scene: only the top level is new."""
     base = scene()
     prepared = PreparedScene(base)
     instances = list(base.instances)
     instances[1] = dataclasses.replace(instances[1], matrices=translation(0.3, 0.2, 0.1)[None])
     edited = dataclasses.replace(base, instances=instances)
-    updated = prepared.update(edited)
+    builds, updated = mesh_builds(lambda: prepared.update(edited))
+    assert builds == 0
     assert updated.geometry is not prepared.geometry and updated.shading is prepared.shading
     assert updated.textures is prepared.textures
     image = same_image_as_fresh(updated, edited)
@@ -42,12 +52,14 @@ def test_an_instance_transform_rebuilds_the_geometry_and_keeps_the_materials():
 
 
 def test_a_mesh_edit_rebuilds_the_geometry():
+    """... building that mesh's Embree scene alone."""
     base = scene()
     prepared = PreparedScene(base)
     meshes = list(base.meshes)
     meshes[2] = dataclasses.replace(meshes[2], vertices=meshes[2].vertices * np.float32(0.8))
     edited = dataclasses.replace(base, meshes=meshes)
-    updated = prepared.update(edited)
+    builds, updated = mesh_builds(lambda: prepared.update(edited))
+    assert builds == 1
     assert updated.geometry is not prepared.geometry and updated.shading is prepared.shading
     same_image_as_fresh(updated, edited)
 

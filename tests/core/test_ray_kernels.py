@@ -11,7 +11,7 @@ import pytest
 from drt_engine.core.geometry import camera as camera_rays
 from drt_engine.core.geometry.accel import Geometry
 from drt_engine.core.geometry.motion import Motion, invert_frame
-from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
+from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData
 from tests.support.scenes import plane, translation, uv_sphere
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -73,6 +73,48 @@ def test_rigid_hits_lie_on_the_triangle_where_it_was_at_the_rays_time():
     from drt_engine.core.geometry.accel import spawn
     up = spawn(pos, ng, -dirs, scale)
     assert np.allclose(up - pos, ng * scale[:, None])
+
+
+def test_deforming_hits_lie_on_the_mesh_where_it_was_at_the_rays_time():
+    """A plane whose vertices rise to z = 1 and come back over the shutter (three vertex steps,
+    interpolated linearly between them at each ray's own time, not in buckets)."""
+    flat = plane(2.0)
+    steps = np.stack([flat.vertices + [0, 0, z] for z in (0.0, 1.0, 0.0)])
+    deforming = Mesh("rising", flat.vertices, flat.triangles, flat.material_indices, motion_vertices=steps)
+    geo = Geometry(SceneData(camera=None, meshes=[deforming], instances=[Instance(0, translation(0.3, 0, 0))],
+                             materials=[Material("m", [Closure("DIFFUSE")])]), np.zeros(3))
+    rng = np.random.default_rng(6)
+    n = 2000
+    time = rng.random(n)
+    origins = np.concatenate([rng.uniform(-0.6, 0.6, (n, 2)) + [0.3, 0], np.full((n, 1), 3.0)], axis=1)
+    dirs = np.tile([0.0, 0.0, -1.0], (n, 1))
+    hits = geo.intersect(origins, dirs, np.full(n, np.inf), time)
+    assert geo.moving and hits.hit.all()
+    pos, ng, _ = geo.surface(hits, np.arange(n), geo.ray_times(time))
+    height = np.where(time < 0.5, 2 * time, 2 - 2 * time)
+    np.testing.assert_allclose(pos[:, 2], height, atol=1e-9)
+    np.testing.assert_allclose(pos[:, :2], origins[:, :2], atol=1e-9)
+    np.testing.assert_allclose(hits.t, 3 - height, atol=1e-9)
+    assert np.allclose(ng, [0, 0, 1], atol=1e-12)
+
+
+def test_an_instanced_mesh_is_one_embree_scene_and_each_instance_numbers_its_own_triangles():
+    from drt_engine.core.geometry.embree import TriangleScene
+
+    ball, floor = uv_sphere(0.4, segments=8, rings=6), plane(8.0, z=-1.0)
+    places = [translation(x, 0, 0) for x in (-1.0, 0.0, 1.0)]
+    scene = SceneData(camera=None, meshes=[ball, floor], instances=[Instance(0, m) for m in places] + [
+        Instance(1, np.eye(4))], materials=[Material("m", [Closure("DIFFUSE")])])
+    before = TriangleScene.builds
+    geo = Geometry(scene, np.array([0.0, 0.0, 5.0]))
+    assert TriangleScene.builds - before == 2
+    t = len(ball.triangles)
+    assert geo.triangle_count == 3 * t + len(floor.triangles)
+    origins = np.array([[-1.0, 0, 5], [0.0, 0, 5], [1.0, 0, 5], [3.0, 0, 5]])
+    hits = geo.intersect(origins, np.tile([0.0, 0, -1], (4, 1)), np.full(4, np.inf))
+    np.testing.assert_array_equal(geo.source[hits.prim, 0], [0, 1, 2, 3])  # which object each ray hit
+    np.testing.assert_array_equal(hits.prim[:3] // t, [0, 1, 2])
+    np.testing.assert_allclose(hits.t, [4.6, 4.6, 4.6, 6.0], atol=2e-2)
 
 
 def test_lift_moves_hits_toward_the_smooth_sphere():

@@ -1,42 +1,43 @@
-"""Triangles in Embree scenes, and batched ray queries at each ray's own time.
+"""Triangles in Embree scenes, and ray queries at each ray's own time.
 
-Embree works in float32 with tnear fixed at 0 and has no motion in this binding, so
-precision and motion are ours to manage:
+Each distinct mesh is one Embree scene (one BVH however many objects show it) and every object
+an instance of it in one top-level scene (geometry/embree.py), so Embree does what DRT did by
+hand before: it carries rays into an object's space, interpolates a moving object's transform
+steps (rotation by slerp, the rest linearly, as geometry/motion.py) and a deforming mesh's
+vertex steps at each ray's own time. Float32 precision stays ours to manage:
 
-- static geometry is flattened to world space in one Embree scene, relative to a
-  centre (the camera), and hit points are rebuilt in float64 from barycentrics;
-- a rigidly moving instance keeps its own object-space scene; rays are carried into
-  object space at their own time (the direction is not renormalised, so distances
-  along the ray stay world distances);
-- a deforming mesh is baked into one scene per time bucket; a ray uses the bucket of
-  its time, and the time dimension is stratified, so buckets are too;
-- new rays leave a surface offset along the geometric normal by a bound on the
-  float32 error of the hit.
+- instance transforms go to Embree relative to a centre (the camera), and a mesh's vertices
+  relative to a pivot of its own (its box's point nearest the camera when the camera is close
+  to it, else its middle; see ``_pivot``), so Embree's float32 numbers are small where the
+  image needs them, however far from the origin the scene lies;
+- each hit is refined in float64 (the float64 ray on the mesh's float64 triangle, carried by
+  the instance's float64 transform at the ray's time, in the decomposition Embree
+  interpolates), and hit points are rebuilt from those barycentrics;
+- new rays leave a surface offset along the geometric normal by a bound on the float32 error
+  of the hit.
 
-Triangles of all parts share one global numbering, so materials, normals and lights
-index the same arrays whatever part a hit came from. The per-ray arithmetic (hit
-reconstruction, the terminator lift, offsets, carrying rays into a part's frame) is in
-scalar kernels over ``Geometry.tables``, flat arrays a fused stage kernel can read too;
-Embree is called in batches between them.
+Triangles keep one global numbering (an instance's first id plus Embree's primID), so
+materials, lights and attributes index the same arrays whatever object a hit came from. The
+per-ray work (queries, hit reconstruction, the terminator lift, offsets) is in scalar kernels
+over ``Geometry.tables``, flat arrays a fused stage kernel can read too.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..base.jit import kernel
 from ..base.vectors import unit
 from ..errors import SceneError
-from ..scene import SceneData
-from .motion import Motion, frame_at, invert_frame
+from ..scene import Mesh, SceneData
+from . import embree
+from .motion import frame_at, invert_frame
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
 _EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates hit points are rebuilt in
-_CHUNK = 1 << 16  # rays per Embree call: bounds its output buffers
 _FAR = np.float32(3.0e38)
-DEFORM_BUCKETS = 8
-_KINDS = {"static": 0, "rigid": 1, "deform": 2}
 
 
 @dataclass
@@ -57,10 +58,8 @@ class Hits:
 class RayTimes:
     """Shutter times of a batch of rays (None when nothing moves).
 
-    A path keeps its camera sample's time down its whole tree. Kernels work out a moving
-    part's transform at a ray's time where they need it: a slerp and a 3x3 inverse cost
-    less than gathering precomputed transforms as paths go on.
-    """
+    A path keeps its camera sample's time down its whole tree; Embree and the hit kernels
+    place moving objects at it."""
 
     values: np.ndarray | None
 
@@ -68,28 +67,20 @@ class RayTimes:
         return RayTimes(None if self.values is None else self.values[index])
 
 
-@dataclass
-class _Part:
-    kind: str  # "static" | "rigid" | "deform"
-    base: int  # first global triangle id
-    count: int
-    center: np.ndarray
-    scenes: list
-    motion: Motion | None = None
-    buckets: list | None = None  # deform, until Geometry.tables stacks them: (world vertices, mirrored) per bucket
-    first_vertex: int = 0
+@dataclass(frozen=True)
+class _MeshScene:
+    """One mesh as Embree holds it, shared by all its instances, and by the geometry of an
+    edited scene while the mesh object and its pivot stay the same."""
 
-
-def _embree(vertices: np.ndarray, triangles: np.ndarray):
-    from embreex import rtcore_scene
-    from embreex.mesh_construction import TriangleMesh
-
-    v = vertices.astype(np.float32)
-    if not np.isfinite(v).all():
-        raise SceneError("geometry too far from the camera to be represented in single precision")
-    scene = rtcore_scene.EmbreeScene()
-    TriangleMesh(scene, np.ascontiguousarray(v), np.ascontiguousarray(triangles, dtype=np.int32))
-    return scene
+    mesh: Mesh
+    kept: np.ndarray  # indices of the mesh's triangles Embree holds (finite, not degenerate)
+    bad: int  # triangles left out for non-finite vertices
+    steps: np.ndarray  # (S, V, 3) float64 object-space vertices, S > 1 for a deforming mesh
+    mid: np.ndarray  # (V, 3) the vertices at mid-shutter, non-finite ones zeroed
+    ng: np.ndarray  # (T, 3) object-space unit normals of the kept triangles (mid-shutter)
+    bounds: np.ndarray  # (2, 3) object-space box of the kept triangles over the shutter
+    pivot: np.ndarray | None = None  # the object-space point Embree's vertices are relative to
+    scene: embree.TriangleScene | None = None
 
 
 def _cross_normals(p: np.ndarray):
@@ -98,191 +89,212 @@ def _cross_normals(p: np.ndarray):
     return n, length
 
 
+def _deforming(mesh: Mesh) -> bool:
+    return mesh.motion_vertices is not None and not np.allclose(mesh.motion_vertices, mesh.motion_vertices[:1])
+
+
+def _moving(matrices: np.ndarray) -> bool:
+    return len(matrices) > 1 and not np.allclose(matrices, matrices[:1], rtol=0, atol=1e-12)
+
+
+def _analyse(mesh: Mesh) -> _MeshScene:
+    """The triangles of a mesh Embree can hold (finite, with an area) and their object-space data."""
+    steps = mesh.motion_vertices if _deforming(mesh) else mesh.vertices[None]
+    mid = _vertices_at(mesh, 0.5) if len(steps) > 1 else mesh.vertices
+    finite = np.isfinite(steps).all(axis=(0, 2))
+    tri = mesh.triangles
+    bad = ~finite[tri].all(axis=1)
+    mid = np.where(finite[:, None], mid, 0.0)
+    n, length = _cross_normals(mid[tri])
+    kept = np.flatnonzero(~bad & (length > 0))
+    used = np.zeros(len(mid), bool)
+    used[tri[kept].ravel()] = True
+    steps = np.where(finite[None, :, None], steps, 0.0)
+    bounds = np.array([steps[:, used].min(axis=(0, 1)), steps[:, used].max(axis=(0, 1))]) if len(kept) \
+        else np.zeros((2, 3))
+    return _MeshScene(mesh, kept, int(bad.sum()), steps, mid, n[kept] / length[kept][:, None], bounds)
+
+
+def _pivot(ms: _MeshScene, frames: np.ndarray, center: np.ndarray) -> np.ndarray:
+    """Where a mesh's vertices go to Embree from: float32 is most precise there.
+
+    The middle of its box, unless the camera (the centre, seen from the nearest of its instances
+    at mid-shutter) is within the box grown by its size on every side: then the box's point
+    nearest the camera, so that geometry near the camera keeps the precision the camera-centred
+    world had (a floor under the camera, a room around it). Elsewhere the vertices' rounding
+    is below the offsets' bound on it, which grows with the distance to the camera."""
+    lo, hi = ms.bounds
+    size = (hi - lo).max()
+    seen = (np.linalg.pinv(frames[:, :, :3]) @ (center - frames[:, :, 3])[:, :, None])[:, :, 0]
+    away = np.linalg.norm(np.maximum(np.maximum(lo - seen, seen - hi), 0.0), axis=1)
+    away = np.where(np.isfinite(away), away, np.inf)
+    nearest = seen[int(np.argmin(away))]
+    if np.all(nearest >= lo - size) and np.all(nearest <= hi + size):
+        return np.clip(nearest, lo, hi)
+    return 0.5 * (lo + hi)
+
+
+def _build(ms: _MeshScene, pivot: np.ndarray) -> _MeshScene:
+    local = (ms.steps - pivot).astype(np.float32)
+    if not np.isfinite(local).all():
+        raise SceneError(f"mesh {ms.mesh.name!r} too large to be represented in single precision")
+    return replace(ms, pivot=pivot, scene=embree.TriangleScene(local, ms.mesh.triangles[ms.kept]))
+
+
 class Geometry:
     """All instanced triangles and the Embree scenes that answer ray queries.
 
-    Global per-triangle arrays: ``triangles`` (indices into ``vertices``: world space
-    for static and deforming parts, object space for rigid ones), ``material``,
-    ``part``, ``ng``/``ns`` in the same space as the vertices, and mid-shutter world
-    copies ``world_vertices``, ``world_ng``, ``area`` for light sampling.
+    Per mesh (``tables``): object-space vertices (every time step), triangles, normals. Per
+    instance: its mesh, its first global triangle id, its transform (or steps). Per global
+    triangle, for materials, lights and attributes: ``material``, ``source`` (instance,
+    triangle in its mesh), ``triangles`` into ``world_vertices`` with ``world_ng`` and
+    ``area`` at mid-shutter, and ``tri_scale`` for offsets.
+
+    ``previous``: a Geometry of an earlier version of the scene (a viewport edit): meshes it
+    holds as the same objects keep their Embree scenes (unless the camera's nearness moves a
+    mesh's pivot); the top level is built again.
     """
 
-    def __init__(self, scene: SceneData, center: np.ndarray):
+    def __init__(self, scene: SceneData, center: np.ndarray, previous: "Geometry | None" = None):
         self.center = np.asarray(center, dtype=np.float64)
         self.warnings: list[str] = []
-        self.parts: list[_Part] = []
-        verts, world_verts, tris, mats, normals, flips, sources = [], [], [], [], [], [], []
-        self._dropped = 0
-        static = []
-        moving = []
-        for i_inst, inst in enumerate(scene.instances):
+        known = previous._meshes if previous is not None else {}
+        analysed: dict[int, _MeshScene] = {}  # by mesh index in the scene
+        dropped = 0
+        kept = []  # (instance index, mesh index, matrices)
+        for k, inst in enumerate(scene.instances):
             mesh = scene.meshes[inst.mesh]
             if len(mesh.triangles) == 0:
                 continue
-            motion = Motion(inst.matrices)
-            deforming = mesh.motion_vertices is not None and not np.allclose(
-                mesh.motion_vertices, mesh.motion_vertices[:1])
-            (moving if motion.moving or deforming else static).append((i_inst, mesh, motion, deforming))
+            if inst.mesh not in analysed:
+                ms = known.get(id(mesh))
+                analysed[inst.mesh] = ms if ms is not None and ms.mesh is mesh else _analyse(mesh)
+            ms = analysed[inst.mesh]
+            if not np.isfinite(inst.matrices).all():
+                dropped += len(mesh.triangles)
+                continue
+            dropped += ms.bad
+            flat = (np.linalg.det(inst.matrices[:, :3, :3]) == 0).all()  # scaled to nothing: no area to hit
+            if len(ms.kept) and not flat:
+                kept.append((k, inst.mesh, inst.matrices))
+        if dropped:
+            self.warnings.append(f"{dropped} triangles with NaN or infinite vertex coordinates were left out")
+        self._motion_steps(kept)
+        self._mesh_scenes(kept, analysed, known)
+        self._instances(kept)
+        self._world(kept)
+        self.tables = self._tables()
 
-        vertex_count = [0]  # vertices appended so far (a running count: summing is quadratic in objects)
-
-        def add(mesh, linear, translation, in_world, inst_index):
-            """Append one mesh's triangles; returns the (kept) triangle count."""
-            v_obj = mesh.vertices
-            with np.errstate(invalid="ignore", over="ignore"):  # NaN / Inf vertices are dropped below
-                v_world = v_obj @ linear.T + translation
-            v = v_world if in_world else v_obj
-            bad = ~np.isfinite(v_world).all(axis=1)
-            tri = mesh.triangles
-            keep = ~bad[tri].any(axis=1)
-            p = v_world[tri]
-            keep &= _cross_normals(np.where(np.isfinite(p), p, 0.0))[1] > 0
-            self._dropped += int((~keep & bad[tri].any(axis=1)).sum())
-            offset = vertex_count[0]
-            vertex_count[0] += len(v)
-            verts.append(np.where(bad[:, None], 0.0, v))
-            world_verts.append(np.where(bad[:, None], 0.0, v_world))
-            tris.append(tri[keep] + offset)
-            mats.append(mesh.material_indices[keep])
-            kept = np.flatnonzero(keep)
-            sources.append(np.stack([np.full(len(kept), inst_index), kept], axis=1))
-            det = np.linalg.det(linear)
-            if mesh.corner_normals is not None:
-                ns = mesh.corner_normals[keep].astype(np.float64)
-                if in_world:
-                    ns = ns @ _normal_matrix(linear).T
-                normals.append(ns)
+    # -- construction helpers ------------------------------------------------------
+    def _motion_steps(self, kept):
+        """Per instance: its transform at mid-shutter and, for a moving one, the rows of its steps
+        in the motion tables (translation, quaternion, upper-triangular factor: Embree's split)."""
+        n = len(kept)
+        self._frames = np.zeros((n, 3, 4))
+        self._steps = np.zeros((n, 2), np.int64)  # first row and count in the motion tables (0: still)
+        motion, rows = [[np.zeros((0, 3))], [np.zeros((0, 4))], [np.zeros((0, 3, 3))]], 0
+        for j, (_, _, matrices) in enumerate(kept):
+            if _moving(matrices):
+                quat, upper = embree.quaternion_decomposition(matrices[:, :3])
+                for table, step in zip(motion, (matrices[:, :3, 3], quat, upper)):
+                    table.append(step)
+                self._steps[j] = rows, len(matrices)
+                rows += len(matrices)
+                frame_at(matrices[:, :3, 3], quat, upper, 0.5, self._frames[j])
             else:
-                normals.append(int(keep.sum()))
-            # baked world triangles wind backwards under mirroring; object-space ones do not
-            flips.append(np.full(int(keep.sum()), in_world and det < 0))
-            return int(keep.sum()), offset
+                self._frames[j] = matrices[0, :3]
+        self._motion = [np.concatenate(table) for table in motion]
 
-        count = 0
-        if static:
-            start = count
-            for inst, mesh, motion, _ in static:
-                n, _ = add(mesh, motion.linear[0], motion.translation[0], True, inst)
-                count += n
-            self.parts.append(_Part("static", start, count - start, self.center, []))
-        for inst, mesh, motion, deforming in moving:
-            if deforming:
-                mid = motion.matrix_at(0.5)
-                n, first = add(_mid_mesh(mesh), mid[:3, :3], mid[:3, 3], True, inst)
-                part = _Part("deform", count, n, self.center, [], first_vertex=first)
-                part.buckets = [(mesh, motion)]
-            else:
-                n, first = add(mesh, motion.linear[len(motion.linear) // 2],
-                               motion.translation[len(motion.translation) // 2], False, inst)
-                lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
-                part = _Part("rigid", count, n, 0.5 * (lo + hi), [], motion=motion, first_vertex=first)
-            count += n
-            self.parts.append(part)
+    def _mesh_scenes(self, kept, analysed, known):
+        """An Embree scene per mesh the kept instances show (a previous geometry's when the mesh
+        and its pivot are the same), in the order of first use: the rows of the mesh tables."""
+        self._meshes: dict[int, _MeshScene] = {}  # by id(mesh), for the next update
+        self._mesh_list: list[_MeshScene] = []
+        self._inst_mesh = np.zeros(len(kept), np.int64)
+        order: dict[int, int] = {}
+        for j, (_, index, _) in enumerate(kept):
+            order.setdefault(index, len(order))
+            self._inst_mesh[j] = order[index]
+        for index, row in order.items():
+            ms = analysed[index]
+            pivot = _pivot(ms, self._frames[self._inst_mesh == row], self.center)
+            ms = known.get(id(ms.mesh), ms)
+            if ms.mesh is not analysed[index].mesh or ms.scene is None or not np.array_equal(ms.pivot, pivot):
+                ms = _build(analysed[index], pivot)
+            self._meshes[id(ms.mesh)] = ms
+            self._mesh_list.append(ms)
+        self._moving = any(len(ms.steps) > 1 for ms in self._mesh_list) or bool(self._steps[:, 1].any())
 
-        if self._dropped:
-            self.warnings.append(f"{self._dropped} triangles with NaN or infinite vertex coordinates were left out")
-        self.vertices = np.concatenate(verts) if verts else np.zeros((0, 3))
-        self.world_vertices = np.concatenate(world_verts) if world_verts else np.zeros((0, 3))
+    def _instances(self, kept):
+        """The top-level Embree scene: each instance with the centre taken off its transforms."""
+        n = len(kept)
+        self._top = embree.InstanceScene() if n else None
+        self._base = np.zeros(n + 1, np.int64)
+        self._inverses = np.zeros((n, 3, 4))
+        for j, (_, _, matrices) in enumerate(kept):
+            ms = self._mesh_list[self._inst_mesh[j]]
+            self._base[j + 1] = self._base[j] + len(ms.kept)
+            placed = matrices.copy()
+            placed[:, :3, 3] -= self.center  # Embree works relative to the centre
+            self._top.add(ms.scene, placed if self._steps[j, 1] else placed[0], ms.pivot)
+            invert_frame(self._frames[j], self._inverses[j])
+        if self._top is not None:
+            self._top.commit()
+
+    def _world(self, kept):
+        """Per global triangle: material, source, mid-shutter world triangles, normals, areas."""
+        world, tris, mats, sources, flips = [], [], [], [], []
+        offset = 0
+        for j, (k, _, _) in enumerate(kept):
+            ms = self._mesh_list[self._inst_mesh[j]]
+            m = self._frames[j]
+            world.append(ms.mid @ m[:, :3].T + m[:, 3])
+            tris.append(ms.mesh.triangles[ms.kept] + offset)
+            offset += len(ms.mid)
+            mats.append(ms.mesh.material_indices[ms.kept])
+            sources.append(np.stack([np.full(len(ms.kept), k), ms.kept], axis=1))
+            flips.append(np.full(len(ms.kept), np.linalg.det(m[:, :3]) < 0))
+        self.world_vertices = np.concatenate(world) if world else np.zeros((0, 3))
         self.triangles = np.concatenate(tris) if tris else np.zeros((0, 3), np.int32)
         self.material = np.concatenate(mats) if mats else np.zeros(0, np.int32)
         self.source = np.concatenate(sources) if sources else np.zeros((0, 2), np.int64)
         """Per triangle: (instance index in the scene, triangle index in its mesh), for attributes."""
         flip = np.concatenate(flips) if flips else np.zeros(0, bool)
-        self.part = np.zeros(len(self.triangles), np.int64)
-        for k, part in enumerate(self.parts):
-            self.part[part.base:part.base + part.count] = k
-
-        n_local, length = _cross_normals(self.vertices[self.triangles])
-        self.ng = n_local / np.maximum(length, 1e-300)[:, None] * np.where(flip, -1.0, 1.0)[:, None]
-        n_world, world_len = _cross_normals(self.world_vertices[self.triangles])
+        p = self.world_vertices[self.triangles]
+        n_world, world_len = _cross_normals(p)
         self.area = 0.5 * world_len
-        self.world_ng = self._mid_world_normals(n_world / np.maximum(world_len, 1e-300)[:, None])
-        self.ns = self._shading_normals(normals)
-        rel = self.world_vertices[self.triangles] - self.center
+        # world triangles wind backwards under mirroring: keep the normals outward
+        self.world_ng = n_world / np.maximum(world_len, 1e-300)[:, None] * np.where(flip, -1.0, 1.0)[:, None]
+        rel = p - self.center
         # the offset also clears the float64 rounding of world positions far from the origin
-        world = np.abs(self.world_vertices[self.triangles]).max(axis=(1, 2)) * _EPS_ABS if len(rel) else 0.0
-        self.tri_scale = np.maximum(np.abs(rel).max(axis=(1, 2)), world) if len(rel) else np.zeros(0)
-        for part in self.parts:
-            self._build(part)
-        self.tables = self._tables()
-
-    # -- construction helpers ------------------------------------------------------
-    def _mid_world_normals(self, n_world):
-        """World normals at mid-shutter, oriented like ``ng`` (outward under mirroring)."""
-        out = n_world.copy()
-        for part in self.parts:
-            s = slice(part.base, part.base + part.count)
-            det = np.linalg.det(part.motion.linear[len(part.motion.linear) // 2]) if part.motion else 1.0
-            if part.kind == "rigid" and det < 0:
-                out[s] = -out[s]
-            elif part.kind != "rigid":
-                out[s] = self.ng[s]
-        return out
-
-    def _shading_normals(self, normals):
-        """Corner normals per triangle; ``normals`` holds an array, or a flat mesh's count."""
-        if all(isinstance(n, int) for n in normals):
-            return None
-        ns = np.repeat(self.ng[:, None, :], 3, axis=1)
-        start = 0
-        for n in normals:
-            if isinstance(n, int):
-                start += n
-                continue
-            seg = ns[start:start + len(n)]
-            length = np.linalg.norm(n, axis=2, keepdims=True)
-            good = (length > 1e-12) & np.isfinite(length)
-            ns[start:start + len(n)] = np.where(good, n / np.where(good, length, 1.0), seg)
-            start += len(n)
-        return ns
-
-    def _build(self, part: _Part):
-        tri = self.triangles[part.base:part.base + part.count]
-        if part.count == 0:
-            return
-        if part.kind == "static":
-            part.scenes = [_embree(self.vertices - part.center, tri)]
-        elif part.kind == "rigid":
-            part.scenes = [_embree(self.vertices - part.center, tri)]
-        else:
-            mesh, motion = part.buckets[0]
-            part.buckets = []
-            keep_tri = tri - part.first_vertex
-            for b in range(DEFORM_BUCKETS):
-                time = (b + 0.5) / DEFORM_BUCKETS
-                m = motion.matrix_at(time)
-                v = _vertices_at(mesh, time) @ m[:3, :3].T + m[:3, 3]
-                part.buckets.append((v, np.linalg.det(m[:3, :3]) < 0))
-                part.scenes.append(_embree(v - part.center, keep_tri))
+        world_scale = np.abs(p).max(axis=(1, 2)) * _EPS_ABS if len(rel) else 0.0
+        self.tri_scale = np.maximum(np.abs(rel).max(axis=(1, 2)), world_scale) if len(rel) else np.zeros(0)
 
     def _tables(self):
         """Everything the hit kernels read, as one tuple of flat arrays (see ``hit_surface``).
 
-        Per part: kind, the rows of its shutter steps in the stacked motion tables, the
-        first row of its vertices in the stacked deform buckets (and which buckets mirror)."""
-        n_parts = max(len(self.parts), 1)
-        kind = np.zeros(n_parts, np.int64)
-        steps = np.zeros((n_parts, 2), np.int64)  # first row and count in the motion tables
-        deform = np.zeros(n_parts, np.int64)  # offset from global vertex ids to bucket rows
-        mirrored = np.zeros((n_parts, DEFORM_BUCKETS), np.bool_)
-        motion = [np.zeros((0, 3)), np.zeros((0, 4)), np.zeros((0, 3, 3))]
-        buckets, rows = [], 0
-        for k, part in enumerate(self.parts):
-            kind[k] = _KINDS[part.kind]
-            if part.kind == "rigid":
-                table = part.motion.table
-                steps[k] = len(motion[0]), len(table[0])
-                motion = [np.concatenate([a, b]) for a, b in zip(motion, table)]
-            elif part.kind == "deform" and part.scenes:
-                deform[k] = rows - part.first_vertex
-                buckets.append(np.stack([v for v, _ in part.buckets]))
-                mirrored[k] = [m for _, m in part.buckets]
-                rows += buckets[-1].shape[1]
-                part.buckets = None  # the rows below hold them
-        bucket_vertices = np.concatenate(buckets, axis=1) if buckets else np.zeros((DEFORM_BUCKETS, 0, 3))
-        ns = self.ns if self.ns is not None else np.zeros((0, 3, 3))
-        return (self.vertices, self.triangles, self.ng, ns, self.part, kind, steps,
-                motion[0], motion[1], motion[2], deform, bucket_vertices, mirrored, self.center, self.tri_scale)
+        Per mesh row: first vertex row, time steps, vertex count, first triangle row. Per
+        instance: mesh row, first global id (and the total after the last), still frame and
+        inverse, rows of its motion steps."""
+        verts, tris, ng, ns, info = [], [], [], [], np.zeros((max(len(self._mesh_list), 1), 4), np.int64)
+        rows = tri_rows = 0
+        smooth = any(ms.mesh.corner_normals is not None for ms in self._mesh_list)
+        for r, ms in enumerate(self._mesh_list):
+            s, v = ms.steps.shape[:2]
+            info[r] = rows, s, v, tri_rows
+            verts.append(ms.steps.reshape(-1, 3))
+            tris.append(ms.mesh.triangles[ms.kept])
+            ng.append(ms.ng)
+            rows += s * v
+            tri_rows += len(ms.kept)
+            if smooth:
+                ns.append(_corner_normals(ms))
+        return (np.concatenate(verts) if verts else np.zeros((0, 3)),
+                np.concatenate(tris) if tris else np.zeros((0, 3), np.int32),
+                np.concatenate(ng) if ng else np.zeros((0, 3)),
+                np.concatenate(ns) if ns else np.zeros((0, 3, 3)),
+                info, self._inst_mesh, self._base, self._frames, self._inverses, self._steps,
+                self._motion[0], self._motion[1], self._motion[2], self.center, self.tri_scale)
 
     # -- queries ---------------------------------------------------------------------
     @property
@@ -291,13 +303,12 @@ class Geometry:
 
     @property
     def moving(self) -> bool:
-        return any(p.kind != "static" for p in self.parts)
+        return self._moving
 
-    def _run(self, scene, o, d, tmax, query):
-        far = np.minimum(tmax, _FAR).astype(np.float32)
-        output = 1 if query == "INTERSECT" else 0
-        return [scene.run(o[a:a + _CHUNK], d[a:a + _CHUNK], far[a:a + _CHUNK], query=query, output=output)
-                for a in range(0, max(len(o), 1), _CHUNK)]
+    @property
+    def instance_scene(self) -> "embree.InstanceScene | None":
+        """The top-level Embree scene (None when there is nothing to hit)."""
+        return self._top
 
     def ray_times(self, time) -> RayTimes:
         """The times as a RayTimes (None when nothing moves)."""
@@ -305,51 +316,21 @@ class Geometry:
             return time
         return RayTimes(None if time is None else np.asarray(time, dtype=np.float64))
 
-    def _rays_in(self, k: int, origins, directions, times: RayTimes, index):
-        """float32 (origins, directions) of rays ``index`` in part k's Embree frame."""
-        o = np.empty((len(index), 3), np.float32)
-        d = np.empty((len(index), 3), np.float32)
-        t = times.values if self.parts[k].kind == "rigid" else np.zeros(0)
-        _to_part(self.tables, k, origins, directions, t, index, self.parts[k].center, o, d)
-        return o, d
-
-    def _groups(self, part: _Part, n: int, time):
-        """(scene, ray indices) pairs a part must answer for n rays."""
-        if part.kind != "deform":
-            return [(part.scenes[0], np.arange(n))]
-        bucket = np.minimum((time.values * DEFORM_BUCKETS).astype(np.int64), DEFORM_BUCKETS - 1)
-        return [(part.scenes[b], np.flatnonzero(bucket == b)) for b in range(DEFORM_BUCKETS)]
-
     def intersect(self, origins, directions, tmax, time=None) -> Hits:
         n = len(origins)
-        best = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
-        limit = np.array(tmax, dtype=np.float64, copy=True)
-        times = self.ray_times(time)
-        for pk, part in enumerate(self.parts):
-            if not part.scenes:
-                continue
-            for scene, idx in self._groups(part, n, times):
-                if len(idx) == 0:
-                    continue
-                o, d = self._rays_in(pk, origins, directions, times, idx)
-                for a, found in zip(range(0, len(idx), _CHUNK), self._run(scene, o, d, limit[idx], "INTERSECT")):
-                    _keep_closer(idx[a:a + _CHUNK], found["primID"], found["tfar"], found["u"], found["v"],
-                                 part.base, best.t, best.prim, best.u, best.v, limit)
-        return best
+        hits = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
+        if self._top is not None and n:
+            _intersects(self._top.handle, self.tables, np.asarray(origins, np.float64),
+                        np.asarray(directions, np.float64), np.asarray(tmax, np.float64), self._time_values(time),
+                        hits.t, hits.prim, hits.u, hits.v)
+        return hits
 
     def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
         n = len(origins)
         blocked = np.zeros(n, dtype=bool)
-        times = self.ray_times(time)
-        for k, part in enumerate(self.parts):
-            if not part.scenes:
-                continue
-            for scene, idx in self._groups(part, n, times):
-                idx = idx[~blocked[idx]]
-                if len(idx) == 0:
-                    continue
-                o, d = self._rays_in(k, origins, directions, times, idx)
-                blocked[idx] = np.concatenate(self._run(scene, o, d, tmax[idx], "OCCLUDED")) >= 0
+        if self._top is not None and n:
+            _occludeds(self._top.handle, np.asarray(origins, np.float64), np.asarray(directions, np.float64),
+                       np.asarray(tmax, np.float64), self._time_values(time), self.center, blocked)
         return blocked
 
     def surface(self, hits: Hits, index: np.ndarray, time=None):
@@ -363,7 +344,7 @@ class Geometry:
         """World vector from hits[index] to the smooth surface its corner normals describe (see
         ``lift``); zero on flat triangles."""
         out = np.zeros((len(index), 3))
-        if self.ns is None or len(index) == 0:
+        if len(self.tables[3]) == 0 or len(index) == 0:
             return out
         _lifts(self.tables, hits.prim, hits.u, hits.v, self._time_values(time), np.asarray(index), out)
         return out
@@ -387,107 +368,155 @@ def spawn(pos: np.ndarray, ng: np.ndarray, direction: np.ndarray, scale: np.ndar
     return out
 
 
+def _corner_normals(ms: _MeshScene) -> np.ndarray:
+    """Unit object-space corner normals of a mesh's kept triangles (the triangle's normal where
+    the mesh has none or one is unusable)."""
+    flat = np.repeat(ms.ng[:, None, :], 3, axis=1)
+    if ms.mesh.corner_normals is None:
+        return flat
+    n = ms.mesh.corner_normals[ms.kept].astype(np.float64)
+    length = np.linalg.norm(n, axis=2, keepdims=True)
+    good = (length > 1e-12) & np.isfinite(length)
+    return np.where(good, n / np.where(good, length, 1.0), flat)
+
+
 # -- kernels: one hit, one ray -----------------------------------------------------------
-@kernel
-def part_frame(geo, k, time, m):
-    """Object-to-world transform m (3, 4) of rigid part k at shutter fraction ``time``."""
-    steps, translation, quat, stretch = geo[6], geo[7], geo[8], geo[9]
-    a, count = steps[k, 0], steps[k, 1]
-    frame_at(translation[a:a + count], quat[a:a + count], stretch[a:a + count], time, m)
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
+def instance_of(geo, prim):
+    """The instance (its row in the instance tables) whose triangles include global id ``prim``."""
+    return np.searchsorted(geo[6], prim, side="right") - 1
+
+
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
+def instance_frame(geo, i, time, frame):
+    """Object-to-world transform of instance i at shutter fraction ``time`` into frame[0] (3, 4), its
+    inverse into frame[1]. Copied element by element: array views cost more than the copy."""
+    count = geo[9][i, 1]
+    if count == 0:
+        still, inverse = geo[7], geo[8]
+        for r in range(3):
+            for c in range(4):
+                frame[0, r, c] = still[i, r, c]
+                frame[1, r, c] = inverse[i, r, c]
+    else:
+        _moving_frame(geo[10], geo[11], geo[12], geo[9][i, 0], count, time, frame)
 
 
 @kernel
-def _bucket(time):
-    return min(int(time * DEFORM_BUCKETS), DEFORM_BUCKETS - 1)
+def _moving_frame(translation, quat, upper, first, count, time, frame):
+    """instance_frame of a moving instance (apart: its slices cost every caller ~40 ns a hit when inlined)."""
+    frame_at(translation[first:first + count], quat[first:first + count], upper[first:first + count], time, frame[0])
+    invert_frame(frame[0], frame[1])
+
+
+@kernel(inline="always")  # a call would pass (and count references to) all of geo
+def _corners(geo, i, prim, time):
+    """Object-space corners (9 coordinates) of global triangle ``prim`` of instance i at ``time``
+    (a deforming mesh's vertices interpolated linearly between its steps, as Embree does), its
+    row in the mesh tables, and whether it deforms."""
+    vertices, triangles, info = geo[0], geo[1], geo[4]
+    r = geo[5][i]
+    first, steps, count = info[r, 0], info[r, 1], info[r, 2]
+    row = info[r, 3] + prim - geo[6][i]
+    i0, i1, i2 = triangles[row, 0], triangles[row, 1], triangles[row, 2]
+    if steps == 1:
+        return (vertices[first + i0, 0], vertices[first + i0, 1], vertices[first + i0, 2],
+                vertices[first + i1, 0], vertices[first + i1, 1], vertices[first + i1, 2],
+                vertices[first + i2, 0], vertices[first + i2, 1], vertices[first + i2, 2]), row, False
+    x = min(max(time, 0.0), 1.0) * (steps - 1)
+    s = min(int(x), steps - 2)
+    f = x - s
+    a = first + s * count
+    b = a + count
+    return ((1 - f) * vertices[a + i0, 0] + f * vertices[b + i0, 0], (1 - f) * vertices[a + i0, 1] + f * vertices[b + i0, 1],
+            (1 - f) * vertices[a + i0, 2] + f * vertices[b + i0, 2], (1 - f) * vertices[a + i1, 0] + f * vertices[b + i1, 0],
+            (1 - f) * vertices[a + i1, 1] + f * vertices[b + i1, 1], (1 - f) * vertices[a + i1, 2] + f * vertices[b + i1, 2],
+            (1 - f) * vertices[a + i2, 0] + f * vertices[b + i2, 0], (1 - f) * vertices[a + i2, 1] + f * vertices[b + i2, 1],
+            (1 - f) * vertices[a + i2, 2] + f * vertices[b + i2, 2]), row, True
 
 
 @kernel
+def _to_world_normal(f, x, y, z):
+    """A normal carried to the world by the inverse transpose of frame f (outward under mirroring
+    too), unit."""
+    return unit(f[1, 0, 0] * x + f[1, 1, 0] * y + f[1, 2, 0] * z, f[1, 0, 1] * x + f[1, 1, 1] * y + f[1, 2, 1] * z,
+                f[1, 0, 2] * x + f[1, 1, 2] * y + f[1, 2, 2] * z, 1e-300)
+
+
+@kernel
+def _to_world_point(f, x, y, z):
+    """A point carried to the world by frame f."""
+    return (f[0, 0, 0] * x + f[0, 0, 1] * y + f[0, 0, 2] * z + f[0, 0, 3],
+            f[0, 1, 0] * x + f[0, 1, 1] * y + f[0, 1, 2] * z + f[0, 1, 3],
+            f[0, 2, 0] * x + f[0, 2, 1] * y + f[0, 2, 2] * z + f[0, 2, 3])
+
+
+@kernel(inline="always")  # see instance_of
 def hit_surface(geo, prim, u, v, time, scratch):
     """World position, geometric and shading normal of the hit (prim, u, v) at ``time``.
 
-    Positions are rebuilt in float64 from the barycentrics; a rigid part's are carried to
-    the world by its transform at the ray's time, its normals by the inverse transpose; a
-    deforming part's come from the time bucket the ray was traced in. ``scratch`` is a
-    (2, 3, 4) work array.
+    Positions are rebuilt in float64 from the barycentrics on the mesh's object-space
+    triangle (at the ray's time if it deforms), carried to the world by the instance's
+    transform at that time; normals by the inverse transpose, the corner normals each before
+    they are blended. ``scratch`` is a (2, 3, 4) work array.
     """
-    vertices, triangles, ng_all, ns_all, part, kind = geo[0], geo[1], geo[2], geo[3], geo[4], geo[5]
+    ng_all, ns_all = geo[2], geo[3]
+    i = instance_of(geo, prim)
+    instance_frame(geo, i, time, scratch)
+    c, row, deforming = _corners(geo, i, prim, time)
     w = 1.0 - u - v
-    k = part[prim]
-    i0, i1, i2 = triangles[prim, 0], triangles[prim, 1], triangles[prim, 2]
-    if kind[k] == 2:
-        b = _bucket(time)
-        rows, src = geo[10][k], geo[11][b]
-        ax, ay, az = src[i0 + rows, 0], src[i0 + rows, 1], src[i0 + rows, 2]
-        bx, by, bz = src[i1 + rows, 0], src[i1 + rows, 1], src[i1 + rows, 2]
-        cx, cy, cz = src[i2 + rows, 0], src[i2 + rows, 1], src[i2 + rows, 2]
+    px, py, pz = _to_world_point(scratch, w * c[0] + u * c[3] + v * c[6], w * c[1] + u * c[4] + v * c[7],
+                                 w * c[2] + u * c[5] + v * c[8])
+    if deforming:
+        ex, ey, ez = c[3] - c[0], c[4] - c[1], c[5] - c[2]
+        fx, fy, fz = c[6] - c[0], c[7] - c[1], c[8] - c[2]
+        gx, gy, gz = _to_world_normal(scratch, ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx)
     else:
-        ax, ay, az = vertices[i0, 0], vertices[i0, 1], vertices[i0, 2]
-        bx, by, bz = vertices[i1, 0], vertices[i1, 1], vertices[i1, 2]
-        cx, cy, cz = vertices[i2, 0], vertices[i2, 1], vertices[i2, 2]
-    gx, gy, gz = ng_all[prim, 0], ng_all[prim, 1], ng_all[prim, 2]
+        gx, gy, gz = _to_world_normal(scratch, ng_all[row, 0], ng_all[row, 1], ng_all[row, 2])
     if len(ns_all):
-        c = ns_all[prim]
-        sx, sy, sz = unit(w * c[0, 0] + u * c[1, 0] + v * c[2, 0], w * c[0, 1] + u * c[1, 1] + v * c[2, 1],
-                           w * c[0, 2] + u * c[1, 2] + v * c[2, 2], 1e-300)
+        sx = sy = sz = 0.0
+        bary = (w, u, v)
+        for j in range(3):
+            nx, ny, nz = _to_world_normal(scratch, ns_all[row, j, 0], ns_all[row, j, 1], ns_all[row, j, 2])
+            sx += bary[j] * nx
+            sy += bary[j] * ny
+            sz += bary[j] * nz
+        sx, sy, sz = unit(sx, sy, sz, 1e-300)
     else:
         sx, sy, sz = gx, gy, gz
-    px = w * ax + u * bx + v * cx
-    py = w * ay + u * by + v * cy
-    pz = w * az + u * bz + v * cz
-    if kind[k] == 1:
-        m, inv = scratch[0], scratch[1]
-        part_frame(geo, k, time, m)
-        invert_frame(m, inv)
-        px, py, pz = (m[0, 0] * px + m[0, 1] * py + m[0, 2] * pz + m[0, 3],
-                      m[1, 0] * px + m[1, 1] * py + m[1, 2] * pz + m[1, 3],
-                      m[2, 0] * px + m[2, 1] * py + m[2, 2] * pz + m[2, 3])
-        gx, gy, gz = unit(inv[0, 0] * gx + inv[1, 0] * gy + inv[2, 0] * gz,
-                           inv[0, 1] * gx + inv[1, 1] * gy + inv[2, 1] * gz,
-                           inv[0, 2] * gx + inv[1, 2] * gy + inv[2, 2] * gz, 1e-300)
-        sx, sy, sz = unit(inv[0, 0] * sx + inv[1, 0] * sy + inv[2, 0] * sz,
-                           inv[0, 1] * sx + inv[1, 1] * sy + inv[2, 1] * sz,
-                           inv[0, 2] * sx + inv[1, 2] * sy + inv[2, 2] * sz, 1e-300)
-    elif kind[k] == 2:
-        ex, ey, ez = bx - ax, by - ay, bz - az
-        fx, fy, fz = cx - ax, cy - ay, cz - az
-        gx, gy, gz = unit(ey * fz - ez * fy, ez * fx - ex * fz, ex * fy - ey * fx, 1e-300)
-        if geo[12][k, _bucket(time)]:
-            gx, gy, gz = -gx, -gy, -gz
     return px, py, pz, gx, gy, gz, sx, sy, sz
 
 
-@kernel
+@kernel(inline="always")  # see instance_of
 def lift(geo, prim, u, v, time, scratch):
     """World vector from the hit to the smooth surface its corner normals describe.
 
     Hanika's shadow-terminator fix (Ray Tracing Gems II, ch. 4), as Cycles applies it:
     the hit is moved, for each corner, onto that corner's tangent plane where it lies
     below it, and the moves are blended by the barycentrics. Zero on flat triangles.
+    Worked in world space (corners and their normals carried there first).
     """
-    vertices, triangles, ns = geo[0], geo[1], geo[3]
+    ns = geo[3]
     if len(ns) == 0:
         return 0.0, 0.0, 0.0
+    i = instance_of(geo, prim)
+    instance_frame(geo, i, time, scratch)
+    c, row, _ = _corners(geo, i, prim, time)
     bary = (1.0 - u - v, u, v)
-    px = py = pz = 0.0
-    for j in range(3):
-        i = triangles[prim, j]
-        px += bary[j] * vertices[i, 0]
-        py += bary[j] * vertices[i, 1]
-        pz += bary[j] * vertices[i, 2]
+    ax, ay, az = _to_world_point(scratch, c[0], c[1], c[2])
+    bx, by, bz = _to_world_point(scratch, c[3], c[4], c[5])
+    cx, cy, cz = _to_world_point(scratch, c[6], c[7], c[8])
+    world = (ax, ay, az, bx, by, bz, cx, cy, cz)
+    px = bary[0] * ax + bary[1] * bx + bary[2] * cx
+    py = bary[0] * ay + bary[1] * by + bary[2] * cy
+    pz = bary[0] * az + bary[1] * bz + bary[2] * cz
     ox = oy = oz = 0.0
     for j in range(3):
-        i = triangles[prim, j]
-        nx, ny, nz = ns[prim, j, 0], ns[prim, j, 1], ns[prim, j, 2]
-        below = min((px - vertices[i, 0]) * nx + (py - vertices[i, 1]) * ny + (pz - vertices[i, 2]) * nz, 0.0)
+        nx, ny, nz = _to_world_normal(scratch, ns[row, j, 0], ns[row, j, 1], ns[row, j, 2])
+        below = min((px - world[3 * j]) * nx + (py - world[3 * j + 1]) * ny + (pz - world[3 * j + 2]) * nz, 0.0)
         ox -= bary[j] * below * nx
         oy -= bary[j] * below * ny
         oz -= bary[j] * below * nz
-    k = geo[4][prim]
-    if geo[5][k] == 1:
-        m = scratch[0]
-        part_frame(geo, k, time, m)
-        ox, oy, oz = (m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz, m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz,
-                      m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz)
     return ox, oy, oz
 
 
@@ -511,6 +540,63 @@ def spawn_point(px, py, pz, gx, gy, gz, dx, dy, dz, scale):
 @kernel
 def _time_of(times, r):
     return times[r] if len(times) else 0.5
+
+
+@kernel
+def _intersects(scene, geo, origins, directions, tmax, times, t, prim, u, v):
+    """Closest hits of rays from float64 world origins (made relative to the centre here, then
+    float32 for Embree); the hit's global triangle id is its instance's first id plus primID, its
+    distance and barycentrics those of the float64 ray on the float64 triangle (``refine``)."""
+    center, base = geo[13], geo[6]
+    rayhit = embree.new_rayhit()
+    scratch = np.empty((2, 3, 4))
+    for r in range(len(origins)):
+        time = _time_of(times, r)
+        th, uh, vh, _, _, _, p, _, inst = embree.intersect1(
+            scene, rayhit, origins[r, 0] - center[0], origins[r, 1] - center[1], origins[r, 2] - center[2],
+            directions[r, 0], directions[r, 1], directions[r, 2], 0.0, min(tmax[r], _FAR), time)
+        if p >= 0:
+            prim[r] = base[inst] + p
+            t[r], u[r], v[r] = refine(geo, prim[r], origins[r, 0], origins[r, 1], origins[r, 2], directions[r, 0],
+                                      directions[r, 1], directions[r, 2], time, th, uh, vh, scratch)
+
+
+@kernel(inline="always")  # see instance_of
+def refine(geo, prim, ox, oy, oz, dx, dy, dz, time, t, u, v, scratch):
+    """(t, u, v) of the ray's hit on triangle ``prim`` in float64 (Moller-Trumbore on the world
+    triangle at ``time``), clamped into the triangle; Embree's float32 (t, u, v) if the triangle
+    is too thin to say. Embree's barycentrics can be off by 1e-3 on grazing hits, and differently
+    for an instance than for the same triangles in one mesh; these are not."""
+    i = instance_of(geo, prim)
+    instance_frame(geo, i, time, scratch)
+    c, _, _ = _corners(geo, i, prim, time)
+    ax, ay, az = _to_world_point(scratch, c[0], c[1], c[2])
+    bx, by, bz = _to_world_point(scratch, c[3], c[4], c[5])
+    cx, cy, cz = _to_world_point(scratch, c[6], c[7], c[8])
+    ex, ey, ez = bx - ax, by - ay, bz - az
+    fx, fy, fz = cx - ax, cy - ay, cz - az
+    px, py, pz = dy * fz - dz * fy, dz * fx - dx * fz, dx * fy - dy * fx
+    det = ex * px + ey * py + ez * pz
+    scale = math.sqrt((ex * ex + ey * ey + ez * ez) * (fx * fx + fy * fy + fz * fz) * (dx * dx + dy * dy + dz * dz))
+    if not abs(det) > 1e-12 * scale:
+        return t, u, v
+    sx, sy, sz = ox - ax, oy - ay, oz - az
+    qx, qy, qz = sy * ez - sz * ey, sz * ex - sx * ez, sx * ey - sy * ex
+    u64 = max((sx * px + sy * py + sz * pz) / det, 0.0)
+    v64 = max((dx * qx + dy * qy + dz * qz) / det, 0.0)
+    total = u64 + v64
+    if total > 1.0:
+        u64, v64 = u64 / total, v64 / total
+    return (fx * qx + fy * qy + fz * qz) / det, u64, v64
+
+
+@kernel
+def _occludeds(scene, origins, directions, tmax, times, center, out):
+    rayhit = embree.new_rayhit()
+    for r in range(len(origins)):
+        out[r] = embree.occluded1(scene, rayhit, origins[r, 0] - center[0], origins[r, 1] - center[1],
+                                  origins[r, 2] - center[2], directions[r, 0], directions[r, 1], directions[r, 2],
+                                  0.0, min(tmax[r], _FAR), _time_of(times, r))
 
 
 @kernel
@@ -543,49 +629,6 @@ def _spawns(pos, ng, direction, scale, out):
                                                       direction[i, 0], direction[i, 1], direction[i, 2], scale[i])
 
 
-@kernel
-def _keep_closer(index, prim, t, u, v, base, best_t, best_prim, best_u, best_v, limit):
-    """Merge one Embree answer for rays ``index`` into the closest hits so far."""
-    for j in range(len(index)):
-        r = index[j]
-        if prim[j] >= 0 and t[j] < best_t[r]:
-            best_t[r] = limit[r] = t[j]
-            best_prim[r] = prim[j] + base
-            best_u[r], best_v[r] = u[j], v[j]
-
-
-@kernel
-def _to_part(geo, k, origins, directions, times, index, center, o, d):
-    """Rays ``index`` in part k's Embree frame (float32): object space at each ray's time for a
-    rigid part (directions not renormalised: distances stay world distances), less the centre."""
-    m = np.empty((3, 4))
-    inv = np.empty((3, 4))
-    rigid = geo[5][k] == 1
-    for i in range(len(index)):
-        r = index[i]
-        x, y, z = origins[r, 0], origins[r, 1], origins[r, 2]
-        dx, dy, dz = directions[r, 0], directions[r, 1], directions[r, 2]
-        if rigid:
-            part_frame(geo, k, times[r], m)
-            invert_frame(m, inv)
-            x, y, z = x - m[0, 3], y - m[1, 3], z - m[2, 3]
-            x, y, z = (inv[0, 0] * x + inv[0, 1] * y + inv[0, 2] * z, inv[1, 0] * x + inv[1, 1] * y + inv[1, 2] * z,
-                       inv[2, 0] * x + inv[2, 1] * y + inv[2, 2] * z)
-            dx, dy, dz = (inv[0, 0] * dx + inv[0, 1] * dy + inv[0, 2] * dz,
-                          inv[1, 0] * dx + inv[1, 1] * dy + inv[1, 2] * dz,
-                          inv[2, 0] * dx + inv[2, 1] * dy + inv[2, 2] * dz)
-        o[i, 0], o[i, 1], o[i, 2] = x - center[0], y - center[1], z - center[2]
-        d[i, 0], d[i, 1], d[i, 2] = dx, dy, dz
-
-
-def _normal_matrix(linear: np.ndarray) -> np.ndarray:
-    """Inverse transpose: keeps normals perpendicular, and outward under mirroring."""
-    try:
-        return np.linalg.inv(linear).T
-    except np.linalg.LinAlgError:
-        return np.eye(3)
-
-
 def _vertices_at(mesh, time: float) -> np.ndarray:
     """Object-space vertices of a deforming mesh at a shutter fraction (linear between steps)."""
     steps = mesh.motion_vertices
@@ -593,10 +636,3 @@ def _vertices_at(mesh, time: float) -> np.ndarray:
     i = min(int(x), len(steps) - 2)
     u = x - i
     return (1 - u) * steps[i] + u * steps[i + 1]
-
-
-def _mid_mesh(mesh):
-    """The mesh with its mid-shutter vertices (for normals, areas and light sampling)."""
-    from dataclasses import replace
-
-    return replace(mesh, vertices=_vertices_at(mesh, 0.5), motion_vertices=None)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 from llvmlite import binding as llvm
-from numba import types
+from numba import config, types
 
 from ..base.jit import kernel
 from ..errors import DRTError
@@ -98,6 +98,8 @@ for _name in ("rtcIntersect1", "rtcOccluded1"):
     llvm.add_symbol("drt_" + _name, ctypes.cast(getattr(_lib, _name), ctypes.c_void_p).value)
 _intersect1 = types.ExternalFunction("drt_rtcIntersect1", _RAY_QUERY)
 _occluded1 = types.ExternalFunction("drt_rtcOccluded1", _RAY_QUERY)
+if config.DISABLE_JIT:  # kernels run as plain Python (NUMBA_DISABLE_JIT=1): call through ctypes
+    _intersect1, _occluded1 = _lib.rtcIntersect1, _lib.rtcOccluded1
 
 # Enum values (rtcore_common.h, rtcore_buffer.h, rtcore_geometry.h, rtcore_device.h).
 _GEOMETRY_TRIANGLE, _GEOMETRY_INSTANCE = 0, 121
@@ -199,10 +201,14 @@ class TriangleScene(_Scene):
     steps spread evenly over ray times [0, 1] (deformation blur); ``triangles`` (T, 3).
 
     Embree reads vertices with 16-byte loads, so each step's buffer carries one float past its
-    last vertex (rtcSetSharedGeometryBuffer's documentation)."""
+    last vertex (rtcSetSharedGeometryBuffer's documentation). ``builds`` counts the scenes made in
+    this process (what a viewport edit must not multiply)."""
+
+    builds = 0
 
     def __init__(self, vertices, triangles):
         super().__init__()
+        TriangleScene.builds += 1
         indices = np.ascontiguousarray(triangles, dtype=np.uint32)
         if indices.ndim != 2 or indices.shape[1] != 3:
             raise DRTError(f"triangles must be (T, 3), got {indices.shape}")
@@ -234,17 +240,21 @@ class InstanceScene(_Scene):
     DRT's motion does (geometry/motion.py): rotation by slerp, translation and the rest
     linearly, so a spinning object keeps its size; interpolated matrices would shrink it.
 
+    ``pivot``: the object-space point the instanced scene's vertices were given relative to
+    (vertices near zero keep float32 precise); the transforms stay the object's own, the pivot
+    turning about the object's origin with it.
+
     Call ``commit()`` after adding or moving instances and before tracing."""
 
     def __init__(self):
         super().__init__()
         self._instances: list = []  # RTCGeometry handles, kept so that a transform can be changed
 
-    def add(self, scene: TriangleScene, transforms) -> int:
+    def add(self, scene: TriangleScene, transforms, pivot=None) -> int:
         geometry = _lib.rtcNewGeometry(self.device.handle, _GEOMETRY_INSTANCE)
         try:
             _lib.rtcSetGeometryInstancedScene(geometry, scene.handle)
-            self._set_transforms(geometry, transforms)  # checks for errors
+            self._set_transforms(geometry, transforms, pivot)  # checks for errors
         except DRTError:
             _lib.rtcReleaseGeometry(geometry)
             raise
@@ -252,38 +262,53 @@ class InstanceScene(_Scene):
         self._instances.append(geometry)
         return self._attach(geometry)
 
-    def move(self, instance: int, transforms) -> None:
+    def move(self, instance: int, transforms, pivot=None) -> None:
         """New transform(s) for one instance (a viewport edit): only the top level is rebuilt."""
         geometry = self._instances[instance]
-        self._set_transforms(geometry, transforms)
+        self._set_transforms(geometry, transforms, pivot)
         _lib.rtcCommitGeometry(geometry)
 
-    def _set_transforms(self, geometry, transforms) -> None:
-        steps = _time_steps(np.asarray(transforms)[..., :3, :4], 2)
+    def _set_transforms(self, geometry, transforms, pivot) -> None:
+        steps = np.asarray(transforms, dtype=np.float64)[..., :3, :4]
+        _time_steps(steps, 2)  # checks the shape
+        steps = steps[None] if steps.ndim == 2 else steps
+        pivot = np.zeros(3) if pivot is None else np.asarray(pivot, dtype=np.float64)
         _lib.rtcSetGeometryTimeStepCount(geometry, len(steps))
         if len(steps) == 1:  # RTC_FORMAT_FLOAT3X4_ROW_MAJOR: the top 3 rows of a 4x4, as given
-            _lib.rtcSetGeometryTransform(geometry, 0, _FORMAT_FLOAT3X4_ROW_MAJOR, steps[0].ctypes.data)
+            step = steps[0].copy()
+            step[:, 3] += step[:, :3] @ pivot
+            step = np.ascontiguousarray(step, dtype=np.float32)
+            _lib.rtcSetGeometryTransform(geometry, 0, _FORMAT_FLOAT3X4_ROW_MAJOR, step.ctypes.data)
         else:
-            for step, decomposition in enumerate(_quaternion_decompositions(steps)):
+            for step, decomposition in enumerate(_quaternion_decompositions(steps, pivot)):
                 _lib.rtcSetGeometryTransformQuaternion(geometry, step, decomposition.ctypes.data)
         self.device.check("placing an instance")
 
 
-def _quaternion_decompositions(steps: np.ndarray) -> np.ndarray:
-    """(S, 3, 4) affine steps as (S, 16) RTCQuaternionDecomposition records (rtcore_quaternion.h:
-    scale xyz, skew xy xz yz, shift xyz, quaternion r i j k, translation xyz; Embree's transform is
-    translation @ rotation @ upper-triangular scale/skew). The linear part is split by QR into a
-    proper rotation and an upper-triangular factor (a mirror stays in its last diagonal entry)."""
-    rotation, upper = np.linalg.qr(steps[:, :, :3].astype(np.float64))
+def quaternion_decomposition(steps: np.ndarray):
+    """(S, 3, 3+) affine steps' linear parts as (S, 4) quaternions (w, x, y, z), each on the shorter
+    arc from the one before, and (S, 3, 3) upper-triangular factors: linear = rotation @ upper, the
+    split (QR) Embree interpolates (rotation by slerp, upper linearly). A mirror stays in the last
+    diagonal entry of ``upper``. ``geometry.motion.frame_at`` takes them to rebuild a transform."""
+    rotation, upper = np.linalg.qr(np.asarray(steps, dtype=np.float64)[:, :, :3])
     sign = np.where(np.diagonal(upper, axis1=1, axis2=2) < 0, -1.0, 1.0)
     rotation, upper = rotation * sign[:, None, :], upper * sign[:, :, None]
     mirror = np.linalg.det(rotation) < 0
     rotation[mirror, :, 2] *= -1
     upper[mirror, 2, :] *= -1
+    return quaternions(rotation), upper
+
+
+def _quaternion_decompositions(steps: np.ndarray, pivot: np.ndarray) -> np.ndarray:
+    """(S, 3, 4) affine steps as (S, 16) RTCQuaternionDecomposition records (rtcore_quaternion.h:
+    scale xyz, skew xy xz yz, shift xyz, quaternion r i j k, translation xyz; Embree's transform is
+    translation @ rotation @ (upper-triangular scale/skew + shift)); the shift places the pivot."""
+    quat, upper = quaternion_decomposition(steps)
     records = np.zeros((len(steps), 16), dtype=np.float32)  # RTC_ALIGN(16): NumPy's buffers are, rows 64 bytes apart
     records[:, 0:3] = np.diagonal(upper, axis1=1, axis2=2)
     records[:, 3:6] = np.stack([upper[:, 0, 1], upper[:, 0, 2], upper[:, 1, 2]], axis=1)
-    records[:, 9:13] = quaternions(rotation)
+    records[:, 6:9] = upper @ pivot
+    records[:, 9:13] = quat
     records[:, 13:16] = steps[:, :, 3]
     return records
 

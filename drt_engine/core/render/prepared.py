@@ -81,10 +81,12 @@ class PreparedScene:
         return new
 
     def update_geometry(self, scene: SceneData) -> "PreparedScene":
-        """New meshes or instance transforms: Embree scenes and triangle tables again (around the
-        same centre), then the lights (emissive triangles); materials and textures are kept."""
+        """New meshes or instance transforms: a new top-level Embree scene and triangle tables
+        (around the same centre) over the Embree scenes of the meshes left as they were (only an
+        edited mesh's is built again), then the lights (emissive triangles); materials and
+        textures are kept."""
         new = self._copy(scene)
-        new.geometry = new._geometry(scene, self.geometry.center)
+        new.geometry = new._geometry(scene, self.geometry.center, self.geometry)
         new._shading_done()
         new._lights_done()
         return new
@@ -118,12 +120,12 @@ class PreparedScene:
         return new
 
     # -- the steps of a preparation -------------------------------------------------------
-    def _geometry(self, scene: SceneData, center) -> Geometry:
+    def _geometry(self, scene: SceneData, center, previous: Geometry | None = None) -> Geometry:
         for mesh in scene.meshes:
             if len(mesh.material_indices) and (mesh.material_indices.max() >= len(scene.materials)
                                                or mesh.material_indices.min() < 0):
                 raise SceneError(f"mesh {mesh.name!r} refers to a material that does not exist")
-        return Geometry(scene, center)
+        return Geometry(scene, center, previous)
 
     def _shading_done(self) -> None:
         """What follows from the materials (and the geometry, for surface attributes)."""
