@@ -33,7 +33,7 @@ from ..base.vectors import unit
 from ..errors import SceneError
 from ..scene import Mesh, SceneData
 from . import embree
-from .motion import frame_at, invert_frame
+from .motion import deforms, frame_at, invert_frame, moves
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
 _EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates hit points are rebuilt in
@@ -89,17 +89,9 @@ def _cross_normals(p: np.ndarray):
     return n, length
 
 
-def _deforming(mesh: Mesh) -> bool:
-    return mesh.motion_vertices is not None and not np.allclose(mesh.motion_vertices, mesh.motion_vertices[:1])
-
-
-def _moving(matrices: np.ndarray) -> bool:
-    return len(matrices) > 1 and not np.allclose(matrices, matrices[:1], rtol=0, atol=1e-12)
-
-
 def _analyse(mesh: Mesh) -> _MeshScene:
     """The triangles of a mesh Embree can hold (finite, with an area) and their object-space data."""
-    steps = mesh.motion_vertices if _deforming(mesh) else mesh.vertices[None]
+    steps = mesh.motion_vertices if deforms(mesh) else mesh.vertices[None]
     mid = _vertices_at(mesh, 0.5) if len(steps) > 1 else mesh.vertices
     finite = np.isfinite(steps).all(axis=(0, 2))
     tri = mesh.triangles
@@ -194,7 +186,7 @@ class Geometry:
         self._steps = np.zeros((n, 2), np.int64)  # first row and count in the motion tables (0: still)
         motion, rows = [[np.zeros((0, 3))], [np.zeros((0, 4))], [np.zeros((0, 3, 3))]], 0
         for j, (_, _, matrices) in enumerate(kept):
-            if _moving(matrices):
+            if moves(matrices):
                 quat, upper = embree.quaternion_decomposition(matrices[:, :3])
                 for table, step in zip(motion, (matrices[:, :3, 3], quat, upper)):
                     table.append(step)

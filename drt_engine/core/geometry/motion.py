@@ -58,6 +58,17 @@ def _polar(m3: np.ndarray):
     return r, p
 
 
+def moves(matrices: np.ndarray) -> bool:
+    """Whether transforms over the shutter (S, 4, 4) differ at all (to 1e-12)."""
+    return len(matrices) > 1 and not np.allclose(matrices, matrices[:1], rtol=0, atol=1e-12)
+
+
+def deforms(mesh) -> bool:
+    """Whether a mesh's vertices move over the shutter (its ``motion_vertices`` differ)."""
+    steps = mesh.motion_vertices
+    return steps is not None and not np.allclose(steps, steps[:1])
+
+
 class Motion:
     """Object-to-world transforms over the shutter (S >= 1 steps)."""
 
@@ -68,7 +79,7 @@ class Motion:
         self.linear = matrices[:, :3, :3]
         rotation, self.stretch = _polar(self.linear)
         self.quat = quaternions(rotation)
-        self.moving = self.steps > 1 and not np.allclose(matrices, matrices[:1], rtol=0, atol=1e-12)
+        self.moving = moves(matrices)
 
     @property
     def table(self):

@@ -105,7 +105,7 @@ class Integrator:
         """Per-sample values of every pass for the camera samples of one wave."""
         s = self.settings
         state, cam = self._camera_rays(samples, sampler)
-        times = self.geometry.ray_times(state.time)  # moving parts' transforms, once per camera sample
+        times = self.geometry.ray_times(state.time)  # each camera sample's shutter time, down its path
         n = len(state)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
                                                         if name in s.passes},

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.motion import Motion
+from ..geometry.motion import Motion, deforms
 from .ratio import delta_light, ratio_strategies
 
 RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent")
@@ -55,7 +55,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     camera = scene.camera
     lens = camera.aperture_radius > 0
     moving = [inst.name or f"instance {i}" for i, inst in enumerate(scene.instances)
-              if Motion(inst.matrices).moving or _deforms(scene.meshes[inst.mesh])]
+              if Motion(inst.matrices).moving or deforms(scene.meshes[inst.mesh])]
     moving += [f"light {light.name or i}" for i, light in enumerate(lights.lights) if i in lights.motions]
     camera_moves = Motion(camera.matrices).moving
     if camera_moves:
@@ -96,9 +96,3 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     by_ratio = settings.shadow_estimator == "RATIO"
     monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
     return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo)
-
-
-def _deforms(mesh) -> bool:
-    steps = mesh.motion_vertices
-    return steps is not None and not np.allclose(steps, steps[:1])  # as accel.Geometry decides
-
