@@ -29,7 +29,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.errors import DRTError
-from ..core.film.denoising import PASSES as FEATURE_PASSES
+from ..core.film.denoising import PASSES as FEATURE_PASSES, with_features
 from .oidn import oidn_library
 from .properties import settings_from_scene
 from .status import done_line, one_line, stats_line
@@ -70,8 +70,7 @@ class ViewDenoise:
 
     def settings(self, settings):
         """The viewport's settings with the features the denoiser needs traced."""
-        return dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
-            name for name in FEATURE_PASSES if name not in settings.passes))
+        return with_features(settings)
 
     def image(self, passes: dict, samples: int) -> tuple[np.ndarray, bool]:
         """(RGBA image to show, whether it is denoised) of a render's passes with ``samples`` in

@@ -12,6 +12,8 @@ both over the pixel's samples.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 ALBEDO, NORMAL = "Denoising Albedo", "Denoising Normal"
@@ -63,3 +65,10 @@ class Features:
             self.normal[done] = normal
         self.open[done] = False
         self.throughput[going] *= specular[~take]
+
+
+def with_features(settings):
+    """``settings`` (core.settings.RenderSettings) with the features a denoiser reads traced too:
+    OpenImageDenoise is guided by them even where the user asked for no such passes."""
+    return dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
+        name for name in PASSES if name not in settings.passes))

@@ -7,7 +7,6 @@ adaptive.replicate_samplers), so the film's two halves are independent estimates
 """
 from __future__ import annotations
 
-import dataclasses
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -16,7 +15,7 @@ import numpy as np
 
 from ..base import jit
 from ..errors import SceneError, SettingsError
-from ..film.denoising import PASSES as FEATURE_PASSES
+from ..film.denoising import PASSES as FEATURE_PASSES, with_features
 from ..film.film import Film
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
@@ -72,8 +71,7 @@ class Renderer:
         if self.denoising and denoiser is None:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
         if self.denoising:  # the features guide the denoiser: traced even when not asked for as passes
-            settings = dataclasses.replace(settings, passes=tuple(settings.passes) + tuple(
-                name for name in FEATURE_PASSES if name not in settings.passes))
+            settings = with_features(settings)
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
