@@ -110,9 +110,17 @@ class Tree:
         assert not alive, [p.cmdline() for p in alive]
 
 
+def _default_sigint():  # pragma: no cover (runs in the child, before exec)
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(*args):
+    """The CLI as a terminal's foreground job: a process group of its own (Ctrl-C signals the whole group), and
+    SIGINT's default action even when pytest itself ignores SIGINT, as a background job of a script does
+    (`make test > log &`): an ignored SIGINT is inherited through exec by the CLI, its workers and their
+    renders, so a Ctrl-C would reach no one and the render would run on."""
     return subprocess.Popen(cli(*args), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=_default_sigint)
 
 
 def wait_for_render(proc, tree, timeout=90.0):
@@ -231,7 +239,11 @@ def test_worker_without_drt_is_named_in_one_line(cornell_box, tmp_path):
 def test_ctrl_c_cancels_and_leaves_no_process(cornell_box, tmp_path):
     # samples enough that no task can end before Ctrl-C reaches it (the render is cancelled, not waited for)
     long = ["--samples", 1 << 20, *OPTIONS[2:]]
-    proc = start("render", cornell_box, "-o", tmp_path / "x.exr", *long, "--workers", 2)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # pytest as a script's `make test &` runs it
+    try:
+        proc = start("render", cornell_box, "-o", tmp_path / "x.exr", *long, "--workers", 2)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     tree = Tree(proc.pid)
     try:
         wait_for_render(proc, tree)
