@@ -94,7 +94,7 @@ def _normalize(v):
 def _vector_math(op, a, b, c, s):
     """(vector, value) of Cycles' svm_vector_math."""
     with np.errstate(all="ignore"):
-        vec = {
+        vectors = {
             "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
             "DIVIDE": lambda: _safe_div(a, b), "MULTIPLY_ADD": lambda: a * b + c,
             "CROSS_PRODUCT": lambda: np.cross(a, b),
@@ -114,7 +114,7 @@ def _vector_math(op, a, b, c, s):
         n = len(a)
         if op in val:
             return np.zeros((n, 3)), val[op]()
-        return vec[op](), np.zeros(n)
+        return vectors[op](), np.zeros(n)
 
 
 VECTOR_MATH_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT", "PROJECT",
