@@ -78,6 +78,10 @@ class Material:
     closures: list[Closure]
     program: Program | None = None
     """The shader nodes feeding the closures' varying ``inputs``."""
+    displacement: tuple | None = None
+    """The shading normal bumped by the output's Displacement socket (Cycles' "Bump Only"): an
+    output ``(node, socket)`` of ``program``, evaluated before the closures' inputs, which then
+    see it as the hit's normal."""
 
     @property
     def emission(self) -> np.ndarray:
@@ -186,8 +190,14 @@ class Instance:
     name: str = ""
     attributes: dict = field(default_factory=dict)
     """Object and Instancer attributes its materials read (Attribute node): key -> RGBA (4,)."""
+    color: np.ndarray = field(default_factory=lambda: np.ones(4))
+    """The object's colour and alpha (Object Info)."""
+    pass_index: int = 0
+    random: float = 0.0
+    """Object Info's Random: Cycles' per-object (or per-instance) random number in [0, 1]."""
 
     def __post_init__(self):
+        self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
 
     @property

@@ -17,7 +17,7 @@ import bpy
 import numpy as np
 
 from ...core.scene import Instance, Mesh
-from ...core.shading.proctex.hash import hash_uint, to_unit
+from ...core.shading.proctex.hash import hash_uint, hash_uint2, to_unit
 from .materials import MaterialTable
 from .shader_graph import ISLANDS, POINTINESS, find_rgba
 
@@ -112,6 +112,22 @@ def random_per_island(mesh, tri_vertices) -> np.ndarray:
     roots = island_roots(edges, len(mesh.vertices))[tri_vertices[:, 0]]
     values = {r: to_unit(hash_uint(r)) for r in np.unique(roots).tolist()}
     return np.array([values[r] for r in roots.tolist()], np.float32)
+
+
+def hash_string(name: str) -> int:
+    """Cycles' hash_string (util/hash.h) of a name's UTF-8 bytes, each unsigned (as Blender's
+    Cycles hashes them: measured with a non-ASCII object name)."""
+    h = 0
+    for byte in name.encode("utf-8"):
+        h = (h * 37 + byte) & 0xFFFFFFFF
+    return h
+
+
+def object_random(name: str, random_id: int | None = None) -> float:
+    """Object Info's Random as Cycles (blender/object.cpp, scene/object.cpp): an object's is the
+    hash of its name, an instance's the depsgraph's random id, as a float in [0, 1]."""
+    word = hash_uint2(hash_string(name), 0) if random_id is None else random_id & 0xFFFFFFFF
+    return to_unit(word)
 
 
 FLT_EPSILON = float(np.finfo(np.float32).eps)
@@ -275,14 +291,14 @@ class GeometryExporter:
             return np.zeros(1, np.int32)
         return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
 
-    def add(self, obj, matrix: np.ndarray, key=None, parent=None) -> None:
-        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it);
-        non-geometry objects are ignored."""
+    def add(self, obj, matrix: np.ndarray, key=None, parent=None, random_id=None) -> None:
+        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it,
+        ``random_id``: the depsgraph's random id of that instance); non-geometry objects are ignored."""
         if obj.type == "META":
             self._metaballs.append((obj, matrix, key))
         elif isinstance(obj.data, bpy.types.Mesh):
             self._meshed.add(obj.original.as_pointer())
-            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent)
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent, random_id)
 
     def finish(self) -> None:
         """Add metaballs that the depsgraph did not already hand over as mesh instances."""
@@ -306,24 +322,34 @@ class GeometryExporter:
                     out[node.params["key"]] = find_rgba(owners, name)
         return out
 
-    def _place(self, obj, matrix, source, key, parent=None) -> None:
+    def _place(self, obj, matrix, source, key, parent=None, random_id=None) -> None:
         slot_materials = self._slot_materials(obj)
         mesh_key = source + (slot_materials.tobytes(),)
         index = self._mesh_index.get(mesh_key)
         if index is None:
             index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
+            random = 0.0
+            if self._uses(slot_materials, "object_info"):
+                random = object_random(obj.name, random_id)
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
-                                           attributes=self._instance_attributes(obj, parent, slot_materials)))
+                                           attributes=self._instance_attributes(obj, parent, slot_materials),
+                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random))
             self.keys.append(key)
 
+    def _uses(self, slot_materials, op) -> bool:
+        """Whether the programs of the slots' materials have an ``op`` node."""
+        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+        return any(n.op == op for p in programs if p is not None for n in p.nodes)
+
     def _tangent_maps(self, slot_materials) -> set:
+        """The UV maps whose tangents the slots' materials read (tangent-space normal maps and
+        vector displacement, the Tangent node's UV map direction)."""
         maps = set()
         for index in set(slot_materials.tolist()):
             program = self.materials.materials[index].program
             if program is not None:
-                maps |= {n.params.get("map", "") for n in program.nodes
-                         if n.op == "normal_map" and n.params.get("space", "TANGENT") == "TANGENT"}
+                maps |= {n.params.get("map", "") for n in program.nodes if n.params.get("tangents")}
         return maps
 
     def _needs(self, slot_materials, name) -> bool:
