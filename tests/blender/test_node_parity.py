@@ -160,7 +160,7 @@ def test_wireframe_in_pixels_matches_cycles(drt, tmp_path):
 
 def test_displacement_renders_as_cycles_bump(drt, tmp_path):
     """The Displacement socket as Cycles' "Bump Only": the shading normal bumped by the
-    displacement's height along the normal (0.31 off with it left out)."""
+    displacement's height along the normal (0.32 off with it left out)."""
     _matches_cycles(ns.displacement_scene(), tmp_path, "displacement", "Displacement as bump")
 
 

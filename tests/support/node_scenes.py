@@ -774,14 +774,15 @@ def _height(tree, kind, scale):
     return wave.outputs["Fac"], wave.outputs["Color"]
 
 
-def displacement_scene(size=64):
-    """Four diffuse squares lit by a sun, each bumped by its material's Displacement socket
+def displacement_scene(size=32):
+    """Six diffuse squares lit by a sun, each bumped by its material's Displacement socket
     (method Bump Only): a Displacement node in object space on a square scaled 0.7 (the offset
-    scales with it), one in world space, a Vector Displacement in object space, and a Math node's
-    height linked straight in, that square coloured by its Geometry Normal (the surface seeing
-    the bumped normal)."""
-    scene = ps._scene(size, size)
-    ps.aim(scene.camera, (0.0, -4.0, 6.0))
+    scales with it), one in world space, a Vector Displacement in object space and one in tangent
+    space (a turned UV map), a Math node's height linked straight in, that square coloured by its
+    Geometry Normal (the surface seeing the bumped normal), and a Displacement node along a linked,
+    tilted normal."""
+    scene = ps._scene(3 * size, 2 * size)
+    ps.aim(scene.camera, (0.0, -5.0, 7.5))
     ps.black_world(scene)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 3.0
@@ -789,13 +790,15 @@ def displacement_scene(size=64):
     scene.collection.objects.link(sun)
     grey = lambda tree: _node(tree, "ShaderNodeRGB").outputs[0]  # noqa: E731
 
-    def square(name, x, y, build, colour=grey, scale=1.0):
+    def square(name, x, y, build, colour=grey, scale=1.0, setup=None):
         mat, tree, out = _lit_diffuse(name, colour)
         tree.links.new(build(tree), out.inputs["Displacement"])
         obj = _plane(name, x, mat, scene.collection)
         obj.location.y = y
         obj.scale = (scale, scale, scale)
         obj.rotation_euler.z = 0.4
+        if setup is not None:
+            setup(obj.data)
 
     def object_space(tree):
         fac, _ = _height(tree, "noise", 2.0)
@@ -806,10 +809,18 @@ def displacement_scene(size=64):
         fac, _ = _height(tree, "wave", 0.4)
         return _link(tree, _node(tree, "ShaderNodeDisplacement", space="WORLD"), Height=fac, Scale=0.25).outputs[0]
 
-    def vector(tree):
-        _, colour = _height(tree, "noise", 1.5)
-        return _link(tree, _node(tree, "ShaderNodeVectorDisplacement", space="OBJECT"), Vector=colour, Midlevel=0.5,
-                     Scale=0.3).outputs[0]
+    def vector(space):
+        def build(tree):
+            _, colour = _height(tree, "noise", 1.5)
+            return _link(tree, _node(tree, "ShaderNodeVectorDisplacement", space=space), Vector=colour, Midlevel=0.5,
+                         Scale=0.3).outputs[0]
+        return build
+
+    def tilted_normal(tree):
+        fac, _ = _height(tree, "wave", 0.5)
+        normal = _normalized(tree, _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs["Normal"], 1.0, 0.3))
+        return _link(tree, _node(tree, "ShaderNodeDisplacement", space="OBJECT"), Height=fac, Scale=0.3,
+                     Normal=normal).outputs[0]
 
     def straight(tree):
         fac, _ = _height(tree, "wave", 0.3)
@@ -818,8 +829,10 @@ def displacement_scene(size=64):
     def normal_colour(tree):
         return _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs["Normal"], 0.5, 0.5)
 
-    square("Object space", -1.1, 1.1, object_space, scale=0.7)
-    square("World space", 1.1, 1.1, world_space)
-    square("Vector", -1.1, -1.1, vector)
-    square("Straight", 1.1, -1.1, straight, normal_colour)
+    square("Object space", -2.2, 1.1, object_space, scale=0.7)
+    square("World space", 0.0, 1.1, world_space)
+    square("Vector", 2.2, 1.1, vector("OBJECT"))
+    square("Vector tangent", -2.2, -1.1, vector("TANGENT"), setup=_turned_uvs)
+    square("Straight", 0.0, -1.1, straight, normal_colour)
+    square("Normal linked", 2.2, -1.1, tilted_normal)
     return scene
