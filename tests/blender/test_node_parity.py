@@ -182,3 +182,14 @@ def test_surface_point_nodes_in_the_world_are_named_in_its_warning(drt):
     tree.links.new(info.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     warnings = _cannot(render_export(scene))
     assert len(warnings) == 1 and "Object Info in the world" in warnings[0], warnings
+
+
+def test_a_wireframe_feeding_the_displacement_is_named(drt):
+    """Cycles takes a Wireframe's derivative inside a bump by its own rule, which DRT does not."""
+    scene = ns.displacement_scene()
+    tree = bpy.data.materials["World space"].node_tree
+    wire = tree.nodes.new("ShaderNodeWireframe")
+    displace = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeDisplacement")
+    tree.links.new(wire.outputs[0], displace.inputs["Height"])
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Wireframe feeding the displacement" in warnings[0], warnings

@@ -548,8 +548,23 @@ class Compiler:
         args = (self._in(node, "Strength", "float"), self._in(node, "Color", "color"))
         return self.op("normal_map", args, map=node.uv_map, space=node.space, tangents=node.space == "TANGENT"), 0
 
+    def _bump_height(self, height, owner):
+        """A bump's height; a Wireframe feeding it is named: Cycles takes that node's derivative by
+        its own rule there (svm_node_wireframe's bump offsets), not DRT's finite difference."""
+        stack, seen = [height[0]], set()
+        while stack:
+            i = stack.pop()
+            if i not in seen:
+                seen.add(i)
+                node = self.program.nodes[i]
+                if node.op == "wireframe":
+                    self.issues.add(f"a Wireframe feeding {owner} (its bump as a plain difference)")
+                    break
+                stack.extend(r[0] for r in node.inputs if r is not None)
+        return height
+
     def _node_ShaderNodeBump(self, node, output):
-        height = self.ref(self._in(node, "Height", "float"), "float")
+        height = self._bump_height(self.ref(self._in(node, "Height", "float"), "float"), f"'{node.name}'")
         normal_socket = node.inputs.get("Normal")
         normal = self.ref(self.value(normal_socket, "vector")) if normal_socket.is_linked else None
         refs = (self.ref(self._in(node, "Strength", "float")), self.ref(self._in(node, "Distance", "float")),
@@ -660,8 +675,8 @@ class Compiler:
         vector = self.value(socket, "vector")
         if not is_ref(vector):
             return None  # a constant offset has no gradient
-        height = self.op("vector_math", (vector, self._coord("normal_world"), np.zeros(3), 1.0),
-                         operation="DOT_PRODUCT"), 1
+        along = self.op("vector_math", (vector, self._coord("normal_world"), np.zeros(3), 1.0), operation="DOT_PRODUCT")
+        height = self._bump_height((along, 1), "the displacement")
         return self.program.add("bump", (self.ref(1.0), self.ref(1.0), height, None), invert=False), 0
 
     def _node_ShaderNodeDisplacement(self, node, output):
