@@ -193,3 +193,24 @@ def test_a_wireframe_feeding_the_displacement_is_named(drt):
     tree.links.new(wire.outputs[0], displace.inputs["Height"])
     warnings = _cannot(render_export(scene))
     assert len(warnings) == 1 and "Wireframe feeding the displacement" in warnings[0], warnings
+
+
+def test_geometry_nodes_attributes_are_exported_only_when_read(drt):
+    """An attribute no material reads stays out of the export; a 2D integer one (which Cycles reads
+    as 0: measured) stays out even when read."""
+    case = next(c for c in ns.CASES if c.name == "Attribute float on points")
+    scene = ns.grid_scene([case])
+    mesh = scene.objects[case.name].data
+    mesh.attributes.new("unread", "FLOAT", "POINT")
+    mesh.attributes.new("turn", "INT32_2D", "POINT")
+    tree = mesh.materials[0].node_tree
+    turn = tree.nodes.new("ShaderNodeAttribute")
+    turn.attribute_name = "turn"
+    emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    tree.links.new(turn.outputs["Fac"], emission.inputs["Strength"])
+    data = render_export(scene)
+    assert any(n.op == "attribute" and n.params["name"] == "turn" for m in data.materials if m.program
+               for n in m.program.nodes)
+    (exported,) = data.meshes
+    assert exported.attributes["height"].shape[1:] == (3, 1)
+    assert "unread" not in exported.attributes and "turn" not in exported.attributes

@@ -389,6 +389,27 @@ def _tangent(direction, axis="Z", uv_map=""):
     return build
 
 
+def _generic(name, data_type, domain, low=0.05, high=0.95):
+    """Adds a Geometry Nodes attribute ``name`` of ``data_type`` on ``domain`` to the tile's mesh,
+    random values in [low, high] (integers: 0 to 9)."""
+    def setup(mesh):
+        attr = mesh.attributes.new(name, data_type, domain)
+        rng = np.random.default_rng(len(name))
+        field = "vector" if data_type in ("FLOAT2", "FLOAT_VECTOR") else "value"
+        width = {"FLOAT2": 2, "FLOAT_VECTOR": 3, "QUATERNION": 4}.get(data_type, 1)
+        whole = data_type == "INT"
+        values = rng.integers(0, 10, len(attr.data) * width) if whole else rng.uniform(low, high, len(attr.data) * width)
+        attr.data.foreach_set(field, values.astype(np.int32 if whole else np.float32))
+    return setup
+
+
+def _attribute(name, output, scale=1.0):
+    def build(tree, v):
+        value = _node(tree, "ShaderNodeAttribute", attribute_name=name).outputs[output]
+        return _scaled(tree, value, scale, 0.0) if output == "Fac" else value
+    return build
+
+
 CASES = (
     NodeCase("Brightness/Contrast", _brightness),
     NodeCase("RGB Curves, extrapolated", _rgb_curves),
@@ -453,6 +474,18 @@ CASES = (
     NodeCase("Tangent radial Y", _tangent("RADIAL", "Y"), mesh=_terrain()),
     NodeCase("Tangent radial Z", _tangent("RADIAL", "Z"), mesh=_terrain()),
     NodeCase("Tangent UV map", _tangent("UV_MAP", uv_map="Turned"), mesh=_terrain(), setup=_turned_uvs),
+    NodeCase("Attribute float on points", _attribute("height", "Color"), mesh=_terrain(),
+             setup=_generic("height", "FLOAT", "POINT")),
+    NodeCase("Attribute vector on faces", _attribute("tint", "Vector"), mesh=_terrain(),
+             setup=_generic("tint", "FLOAT_VECTOR", "FACE")),
+    NodeCase("Attribute integer on corners, Fac", _attribute("count", "Fac", 0.1), mesh=_terrain(),
+             setup=_generic("count", "INT", "CORNER")),
+    NodeCase("Attribute 2D vector on points", _attribute("offset", "Vector"), mesh=_terrain(),
+             setup=_generic("offset", "FLOAT2", "POINT")),
+    NodeCase("Attribute float on edges", _attribute("crease", "Color"), mesh=_terrain(),
+             setup=_generic("crease", "FLOAT", "EDGE")),
+    NodeCase("Attribute quaternion on points, Alpha", _attribute("turn", "Alpha"), mesh=_terrain(),
+             setup=_generic("turn", "QUATERNION", "POINT")),
 )
 
 

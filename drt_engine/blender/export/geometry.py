@@ -40,6 +40,47 @@ def _corner_normals(mesh, tri_vertices, tri_loops):
     return normals[tri_loops]
 
 
+GENERIC = {"FLOAT": ("value", 1), "INT": ("value", 1), "BOOLEAN": ("value", 1), "INT8": ("value", 1),
+           "FLOAT2": ("vector", 2), "FLOAT_VECTOR": ("vector", 3),
+           "FLOAT_COLOR": ("color", 4), "BYTE_COLOR": ("color", 4), "QUATERNION": ("value", 4)}
+"""Mesh attribute types Cycles reads for the Attribute node, as floats: (RNA field, components;
+a quaternion's w first, as Blender stores it and Cycles reads it: w, x, y as the colour, z as alpha)."""
+
+
+def _edges_to_points(mesh, values, boolean):
+    """Blender's edge-to-point interpolation, which Cycles asks for: the mean of a vertex's edges'
+    values (a boolean: whether any is true); 0 at a vertex without edges."""
+    edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+    total = np.zeros((len(mesh.vertices), values.shape[1]))
+    count = np.zeros(len(mesh.vertices))
+    for end in (0, 1):
+        np.add.at(total, edges[:, end], values)
+        np.add.at(count, edges[:, end], 1.0)
+    if boolean:
+        return (total > 0).astype(np.float32)
+    return (total / np.maximum(count, 1.0)[:, None]).astype(np.float32)
+
+
+def _generic_attributes(mesh, names, tri_vertices, tri_loops, out) -> None:
+    """The attributes ``names`` (Geometry Nodes' float, integer, boolean, vector, 2D vector, colour
+    and quaternion attributes on points, corners, faces or edges) per triangle corner into ``out``, where UV maps
+    and colour attributes have not put them, as Cycles reads them: a face's value at its three
+    corners, edges' carried to the points."""
+    for name in names:
+        attr = mesh.attributes.get(name)
+        if name in out or attr is None or attr.data_type not in GENERIC:
+            continue  # Cycles, too, reads no 2D integer or matrix attribute (measured: 0)
+        field, width = GENERIC[attr.data_type]
+        values = _read(attr.data, field, len(attr.data), width, np.float32).reshape(len(attr.data), width)
+        if attr.domain == "EDGE":
+            values = _edges_to_points(mesh, values, attr.data_type == "BOOLEAN")
+        if attr.domain == "FACE":
+            faces = _read(mesh.loop_triangles, "polygon_index", len(tri_loops), 1, np.int32)
+            out[name] = np.repeat(values[faces][:, None], 3, axis=1)
+        else:
+            out[name] = values[tri_loops if attr.domain == "CORNER" else tri_vertices]
+
+
 def _corner_attributes(mesh, tri_vertices, tri_loops):
     """(UV maps and colour attributes by name, per triangle corner; the render UV map; the
     default colour attribute)."""
@@ -187,12 +228,13 @@ def pointiness(positions: np.ndarray, normals: np.ndarray, edges: np.ndarray) ->
 
 
 def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None,
-                      islands=False, pointy=False) -> Mesh | None:
+                      islands=False, pointy=False, generic=()) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
     a face's slot index is clamped to the slots present, as Cycles does. ``tangent_maps``:
-    UV maps whose tangents the materials' Normal Map nodes need.
+    UV maps whose tangents the materials' Normal Map nodes need; ``generic``: the names of other
+    attributes their Attribute nodes read.
     """
     triangles = mesh.loop_triangles
     count = len(triangles)
@@ -204,6 +246,7 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
     slots = _read(triangles, "material_index", count, 1, np.int32)
     materials = slot_materials[np.clip(slots, 0, len(slot_materials) - 1)]
     attributes, uvs, colors = _corner_attributes(mesh, tri_vertices, tri_loops)
+    _generic_attributes(mesh, generic, tri_vertices, tri_loops, attributes)
     if tangent_maps and len(mesh.loops):
         _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
     if islands:  # the same value at the three corners: read back exactly
@@ -358,24 +401,32 @@ class GeometryExporter:
         return any(n.op == "attribute" and n.params.get("name") == name
                    for p in programs if p is not None for n in p.nodes)
 
+    def _attribute_names(self, slot_materials) -> tuple:
+        """The mesh attributes the slots' materials read by name (Attribute, Color Attribute)."""
+        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+        return tuple(sorted({n.params["name"] for p in programs if p is not None for n in p.nodes
+                             if n.op == "attribute" and n.params["name"] not in (ISLANDS, POINTINESS)}))
+
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
         islands, pointy = self._needs(slot_materials, ISLANDS), self._needs(slot_materials, POINTINESS)
+        generic = self._attribute_names(slot_materials)
         warnings = self.materials.warnings
         cache_key = None
         if self.cache is not None and obj.type != "META":
-            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy)
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy, generic)
             mesh = self.cache.get(cache_key)
             if mesh is not None:
                 self.meshes.append(mesh)
                 return len(self.meshes) - 1
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy,
+                                         generic)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy, generic)
         if mesh is None:
             return -1
         if cache_key is not None:

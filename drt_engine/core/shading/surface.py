@@ -216,9 +216,11 @@ class SurfaceAttributes:
                 data = mesh.attributes.get(name)
             else:
                 data = mesh.uvs if kind == "uv" else mesh.colors
-            if data is None or data.shape[2] < width - (2 if kind == "color" else 0):
+            if data is None or data.shape[2] < (2 if kind == "uv" else 1):
                 continue
             values = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
+            if kind == "color" and values.shape[1] == 1:  # a float attribute: its colour is grey, as Cycles'
+                values = np.repeat(values, 3, axis=1)
             out[sel, :values.shape[1]] = values[:, :width]
             if kind == "color" and values.shape[1] < 4:
                 out[sel, 3] = 1.0
