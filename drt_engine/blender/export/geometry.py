@@ -324,6 +324,7 @@ class GeometryExporter:
         self._mesh_index: dict[tuple, int] = {}
         self._metaballs: list = []
         self._meshed: set[int] = set()
+        self._info: dict[bytes, bool] = {}  # slot materials -> whether they read Object Info
 
     def _slot_materials(self, obj) -> np.ndarray:
         """Scene material index per slot, as Cycles' ``find_used_shaders``."""
@@ -373,17 +374,22 @@ class GeometryExporter:
             index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
             random = 0.0
-            if self._uses(slot_materials, "object_info"):
+            if self._reads_object_info(slot_materials):
                 random = object_random(obj.name, random_id)
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
                                            color=tuple(obj.color), pass_index=obj.pass_index, random=random))
             self.keys.append(key)
 
-    def _uses(self, slot_materials, op) -> bool:
-        """Whether the programs of the slots' materials have an ``op`` node."""
-        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
-        return any(n.op == op for p in programs if p is not None for n in p.nodes)
+    def _reads_object_info(self, slot_materials) -> bool:
+        """Whether the slots' materials have an Object Info node, found once per set of slots (an
+        object's random number is then worth hashing its name for)."""
+        key = slot_materials.tobytes()
+        found = self._info.get(key)
+        if found is None:
+            programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+            found = self._info[key] = any(n.op == "object_info" for p in programs if p is not None for n in p.nodes)
+        return found
 
     def _tangent_maps(self, slot_materials) -> set:
         """The UV maps whose tangents the slots' materials read (tangent-space normal maps and
