@@ -175,13 +175,19 @@ def test_true_displacement_renders_as_bump_with_one_warning(drt):
 
 
 def test_surface_point_nodes_in_the_world_are_named_in_its_warning(drt):
-    """The world has no object, triangle or camera-space point to read."""
+    """The world has no triangle or surface point to read: Camera Data there is named; it has no
+    object either, and Object Info gives 0 there, as in Cycles."""
     scene = ns.grid_scene(ns.CASES[:1])
     tree = scene.world.node_tree
+    camera = tree.nodes.new("ShaderNodeCameraData")
+    tree.links.new(camera.outputs["View Vector"], tree.nodes["Background"].inputs["Color"])
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Camera Data in the world" in warnings[0], warnings
     info = tree.nodes.new("ShaderNodeObjectInfo")
     tree.links.new(info.outputs["Color"], tree.nodes["Background"].inputs["Color"])
-    warnings = _cannot(render_export(scene))
-    assert len(warnings) == 1 and "Object Info in the world" in warnings[0], warnings
+    tree.links.new(info.outputs["Random"], tree.nodes["Background"].inputs["Strength"])
+    data = render_export(scene)
+    assert not _cannot(data) and data.world.program is None and not np.any(data.world.radiance)
 
 
 def test_a_wireframe_feeding_the_displacement_is_named(drt):

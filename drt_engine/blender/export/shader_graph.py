@@ -692,8 +692,8 @@ class Compiler:
         return self.op("vector_displacement", args, space=node.space, map="", tangents=node.space == "TANGENT"), 0
 
     def _node_ShaderNodeObjectInfo(self, node, output):
-        if self._in_world(node):
-            return None
+        if self.world:  # Cycles' world has no object (nor a pass index): every output 0
+            return np.zeros(3) if output.identifier in ("Location", "Color") else 0.0
         if output.identifier == "Material Index":
             return float(self.pass_index)
         names = ("Location", "Color", "Alpha", "Object Index", "Random")
