@@ -9,6 +9,8 @@ leaves out keeps its one warning.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import bpy
 import numpy as np
 import pytest
@@ -220,3 +222,11 @@ def test_geometry_nodes_attributes_are_exported_only_when_read(drt):
     (exported,) = data.meshes
     assert exported.attributes["height"].shape[1:] == (3, 1)
     assert "unread" not in exported.attributes and "turn" not in exported.attributes
+
+
+def test_tangents_asked_of_a_mesh_without_uv_map_are_named(drt):
+    """Cycles derives such tangents from a sphere mapping of the Generated coordinates; DRT does not."""
+    case = next(c for c in ns.CASES if c.name == "Vector Displacement object space")
+    scene = ns.grid_scene([replace(case, name="No UV map", build=ns._vector_displacement("TANGENT"))])
+    warnings = [w for w in render_export(scene).warnings if "no UV map" in w]
+    assert len(warnings) == 1 and "No UV map" in warnings[0], warnings

@@ -356,6 +356,12 @@ def _terrain():
     return vertices, faces
 
 
+def _smooth(mesh):
+    """Smooth shading: a tangent that follows the normal without a jump at the triangles' edges,
+    whose pixels the renderers' samples split differently."""
+    mesh.shade_smooth()
+
+
 def _turned_uvs(mesh):
     """A UV map "Turned": the vertices' x and y turned by 0.6 rad and squeezed, per corner; the
     mesh smooth, since Cycles' MikkTSpace tangents of a flat-shaded quad that is not planar are
@@ -407,6 +413,15 @@ def _attribute(name, output, scale=1.0):
     def build(tree, v):
         value = _node(tree, "ShaderNodeAttribute", attribute_name=name).outputs[output]
         return _scaled(tree, value, scale, 0.0) if output == "Fac" else value
+    return build
+
+
+def _vector_displacement(space):
+    """Vector Displacement's offset of the unit coordinates, shown as a colour."""
+    def build(tree, v):
+        node = _link(tree, _node(tree, "ShaderNodeVectorDisplacement", space=space), Vector=_unit(tree, v),
+                     Midlevel=0.3, Scale=0.8)
+        return _affine(tree, node.outputs[0], 1.0, 0.5)
     return build
 
 
@@ -470,9 +485,9 @@ CASES = (
     NodeCase("Camera Data View Z Depth", _camera_data("View Z Depth", 1.0, -9.5), mesh=_terrain()),
     NodeCase("Camera Data View Distance", _camera_data("View Distance", 0.5, -4.6), mesh=_terrain()),
     NodeCase("Wireframe world size", _wireframe(False, 0.06, 0.12), mesh=_terrain()),
-    NodeCase("Tangent radial X", _tangent("RADIAL", "X"), mesh=_terrain()),
-    NodeCase("Tangent radial Y", _tangent("RADIAL", "Y"), mesh=_terrain()),
-    NodeCase("Tangent radial Z", _tangent("RADIAL", "Z"), mesh=_terrain()),
+    NodeCase("Tangent radial X", _tangent("RADIAL", "X"), mesh=_terrain(), setup=_smooth),
+    NodeCase("Tangent radial Y", _tangent("RADIAL", "Y"), mesh=_terrain(), setup=_smooth),
+    NodeCase("Tangent radial Z", _tangent("RADIAL", "Z"), mesh=_terrain(), setup=_smooth),
     NodeCase("Tangent UV map", _tangent("UV_MAP", uv_map="Turned"), mesh=_terrain(), setup=_turned_uvs),
     NodeCase("Attribute float on points", _attribute("height", "Color"), mesh=_terrain(),
              setup=_generic("height", "FLOAT", "POINT")),
@@ -482,6 +497,8 @@ CASES = (
              setup=_generic("count", "INT", "CORNER")),
     NodeCase("Attribute 2D vector on points", _attribute("offset", "Vector"), mesh=_terrain(),
              setup=_generic("offset", "FLOAT2", "POINT")),
+    NodeCase("Vector Displacement tangent space", _vector_displacement("TANGENT"), setup=_turned_uvs),
+    NodeCase("Vector Displacement object space", _vector_displacement("OBJECT")),
     NodeCase("Attribute float on edges", _attribute("crease", "Color"), mesh=_terrain(),
              setup=_generic("crease", "FLOAT", "EDGE")),
     NodeCase("Attribute quaternion on points, Alpha", _attribute("turn", "Alpha"), mesh=_terrain(),

@@ -107,6 +107,9 @@ def _tangents(mesh, uv_maps, tri_loops, attributes, warnings):
     for name in uv_maps:
         layer = name or render
         if layer is None or layer not in mesh.uv_layers:
+            missing = f"no UV map '{name}'" if name else "no UV map"
+            warnings.append(f"mesh '{mesh.name}': {missing} for the tangents its materials read (Cycles then "
+                            "derives them from a sphere mapping of the Generated coordinates, which DRT does not)")
             continue
         try:
             mesh.calc_tangents(uvmap=layer)

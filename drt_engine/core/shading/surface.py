@@ -118,15 +118,13 @@ class SurfaceContext:
         return gn.surface_tangent(t, self.normal, self.object_matrix())
 
     def object_tangent(self, uv_map):
-        """(N, 3) object-space tangents of the UV map and their bitangent signs: the mesh's exported
-        ones, else the triangle's dP/du carried into object space."""
+        """(N, 3) object-space tangents of the UV map and their bitangent signs, as Vector
+        Displacement reads them: the mesh's exported ones, else (no UV map) Cycles' fallback, the
+        triangle's normalised dP/du (its second corner less its first, in the world) with sign 1."""
         t, sign, found = self.attrs.object_tangent(self.prim, self.bary, uv_map)
         if not found.all():
-            world, world_sign = self.attrs.tangent(self.prim, self.normal, uv_map)
-            m = self.object_matrix()
-            own = vec.normalize(np.einsum("nij,nj->ni", np.linalg.inv(m[:, :3, :3]), world), 1e-300)
-            t = np.where(found[:, None], t, own)
-            sign = np.where(found, sign, world_sign)
+            corners = self.attrs.world_corners(self.prim)
+            t = np.where(found[:, None], t, vec.normalize(corners[:, 1] - corners[:, 0], 1e-300))
         return t, sign
 
     def object_info(self):
