@@ -141,7 +141,8 @@ class Mesh:
     ``motion_vertices`` (S, V, 3): object-space vertices at S evenly spaced shutter times
     for a mesh that deforms (same topology throughout), else None.
     ``attributes``: per-corner data by name, (T, 3, 2) for UV maps, (T, 3, 4) for colour
-    attributes, (T, 3, 1 to 4) for other attributes (a float, a 2D or 3D vector, a colour); ``uvs`` is the default (active render) UV map and ``colors`` the default
+    attributes, (T, 3, 1 to 4) for other attributes (a float, a 2D or 3D vector, a colour, a
+    quaternion); ``uvs`` is the default (active render) UV map and ``colors`` the default
     colour attribute. ``texspace`` (location, size) maps object space to generated
     coordinates ((p - location + size) / (2 size)); None: the vertices' bounds.
     """

@@ -49,7 +49,8 @@ def test_camera_data_is_the_point_in_camera_space():
 
 def test_wireframe_is_one_within_half_the_size_of_an_edge():
     corners = np.broadcast_to(np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]), (3, 3, 3))
-    pos = np.array([[0.5, 0.04, 0.0], [0.5, 0.06, 0.0], [0.97, 0.99, 0.0]])  # 0.04 and 0.06 from y = 0; 0.028 from the diagonal
+    # 0.04 and 0.06 from the edge along x, 0.028 from the diagonal
+    pos = np.array([[0.5, 0.04, 0.0], [0.5, 0.06, 0.0], [0.97, 0.99, 0.0]])
     assert np.array_equal(gn.wireframe(pos, corners, np.full(3, 0.1)), [1.0, 0.0, 1.0])
     assert np.array_equal(gn.wireframe(pos, corners, np.full(3, 2.0), np.full(3, 0.05)), [1.0, 0.0, 1.0])
 
@@ -70,6 +71,7 @@ def test_pixel_size_wireframe_in_an_emission_is_named_in_a_warning():
         size = prog.add("const", value=np.asarray(2.0))
         fac = prog.add("wireframe", [(size, 0)], pixel_size=pixel_size)
         col = prog.add("convert", [(fac, 0)], kind="float_to_vector")
-        return MaterialShading(Material("m", [Closure("EMISSION", inputs={"emission": (col, 0)})], program=prog), [], [])
+        material = Material("m", [Closure("EMISSION", inputs={"emission": (col, 0)})], program=prog)
+        return MaterialShading(material, [], [])
     warned = shading(True).warnings
     assert len(warned) == 1 and "Wireframe in pixels" in warned[0] and not shading(False).warnings

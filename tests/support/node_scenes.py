@@ -404,7 +404,8 @@ def _generic(name, data_type, domain, low=0.05, high=0.95):
         field = "vector" if data_type in ("FLOAT2", "FLOAT_VECTOR") else "value"
         width = {"FLOAT2": 2, "FLOAT_VECTOR": 3, "QUATERNION": 4}.get(data_type, 1)
         whole = data_type == "INT"
-        values = rng.integers(0, 10, len(attr.data) * width) if whole else rng.uniform(low, high, len(attr.data) * width)
+        count = len(attr.data) * width
+        values = rng.integers(0, 10, count) if whole else rng.uniform(low, high, count)
         attr.data.foreach_set(field, values.astype(np.int32 if whole else np.float32))
     return setup
 

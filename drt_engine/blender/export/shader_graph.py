@@ -688,7 +688,8 @@ class Compiler:
     def _node_ShaderNodeVectorDisplacement(self, node, output):
         if self._in_world(node):
             return None
-        args = (self._in(node, "Vector", "vector"), self._in(node, "Midlevel", "float"), self._in(node, "Scale", "float"))
+        args = (self._in(node, "Vector", "vector"), self._in(node, "Midlevel", "float"),
+                self._in(node, "Scale", "float"))
         return self.op("vector_displacement", args, space=node.space, map="", tangents=node.space == "TANGENT"), 0
 
     def _node_ShaderNodeObjectInfo(self, node, output):
@@ -702,7 +703,8 @@ class Compiler:
     def _node_ShaderNodeCameraData(self, node, output):
         if self._in_world(node):
             return None
-        return self.program.add("camera_data"), ("View Vector", "View Z Depth", "View Distance").index(output.identifier)
+        outputs = ("View Vector", "View Z Depth", "View Distance")
+        return self.program.add("camera_data"), outputs.index(output.identifier)
 
     def _node_ShaderNodeWireframe(self, node, output):
         if self._in_world(node):
