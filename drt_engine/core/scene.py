@@ -78,6 +78,10 @@ class Material:
     closures: list[Closure]
     program: Program | None = None
     """The shader nodes feeding the closures' varying ``inputs``."""
+    displacement: tuple | None = None
+    """The shading normal bumped by the output's Displacement socket (Cycles' "Bump Only"): an
+    output ``(node, socket)`` of ``program``, evaluated before the closures' inputs, which then
+    see it as the hit's normal."""
 
     @property
     def emission(self) -> np.ndarray:
@@ -136,8 +140,9 @@ class Mesh:
     ``material_indices`` (T,) index ``SceneData.materials``. ``uvs`` (T, 3, 2) or None.
     ``motion_vertices`` (S, V, 3): object-space vertices at S evenly spaced shutter times
     for a mesh that deforms (same topology throughout), else None.
-    ``attributes``: per-corner data by name, (T, 3, 2) for UV maps and (T, 3, 4) for colour
-    attributes; ``uvs`` is the default (active render) UV map and ``colors`` the default
+    ``attributes``: per-corner data by name, (T, 3, 2) for UV maps, (T, 3, 4) for colour
+    attributes, (T, 3, 1 to 4) for other attributes (a float, a 2D or 3D vector, a colour, a
+    quaternion); ``uvs`` is the default (active render) UV map and ``colors`` the default
     colour attribute. ``texspace`` (location, size) maps object space to generated
     coordinates ((p - location + size) / (2 size)); None: the vertices' bounds.
     """
@@ -186,8 +191,14 @@ class Instance:
     name: str = ""
     attributes: dict = field(default_factory=dict)
     """Object and Instancer attributes its materials read (Attribute node): key -> RGBA (4,)."""
+    color: np.ndarray = field(default_factory=lambda: np.ones(4))
+    """The object's colour and alpha (Object Info)."""
+    pass_index: int = 0
+    random: float = 0.0
+    """Object Info's Random: Cycles' per-object (or per-instance) random number in [0, 1]."""
 
     def __post_init__(self):
+        self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
 
     @property

@@ -1,12 +1,17 @@
 """Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
 and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
-Weight as the colour of diffuse spheres seen at every angle, from the front and the back. The rule is the procedural textures' (procedural_scenes.parity):
+Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
+Info, a Wireframe in pixels and the material's Displacement (as bump) in scenes of their own.
+The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
 1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
 leaves out keeps its one warning.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
+import bpy
 import numpy as np
 import pytest
 
@@ -143,3 +148,85 @@ def test_box_projection_of_a_udim_image_reads_tile_1001(drt):
     data = render_export(scene)
     (node,) = [n for m in data.materials if m.program is not None for n in m.program.nodes if n.op == "image"]
     assert node.params["tiles"] is None and data.images[node.params["image"]].path.endswith("tiles.1001.exr")
+
+
+def test_object_info_matches_cycles(drt, tmp_path):
+    """Random (the hash of plain, numbered and non-ASCII names; an instance's own), Object and
+    Material Index, colour, alpha and location."""
+    _matches_cycles(ns.object_info_scene(), tmp_path, "object-info", "Object Info")
+
+
+def test_wireframe_in_pixels_matches_cycles(drt, tmp_path):
+    _matches_cycles(ns.wireframe_scene(), tmp_path, "wireframe-pixels", "Wireframe in pixels")
+
+
+def test_displacement_renders_as_cycles_bump(drt, tmp_path):
+    """The Displacement socket as Cycles' "Bump Only": the shading normal bumped by the
+    displacement's height along the normal (0.32 off with it left out)."""
+    _matches_cycles(ns.displacement_scene(), tmp_path, "displacement", "Displacement as bump")
+
+
+def test_true_displacement_renders_as_bump_with_one_warning(drt):
+    scene = ns.displacement_scene()
+    mat = bpy.data.materials["World space"]
+    mat.displacement_method = "BOTH"
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "World space" in warnings[0] and "Both" in warnings[0], warnings
+    material = next(m for m in render_export(scene).materials if m.name == "World space")
+    assert material.displacement is not None
+
+
+def test_surface_point_nodes_in_the_world_are_named_in_its_warning(drt):
+    """The world has no triangle or surface point to read: Camera Data there is named; it has no
+    object either, and Object Info gives 0 there, as in Cycles."""
+    scene = ns.grid_scene(ns.CASES[:1])
+    tree = scene.world.node_tree
+    camera = tree.nodes.new("ShaderNodeCameraData")
+    tree.links.new(camera.outputs["View Vector"], tree.nodes["Background"].inputs["Color"])
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Camera Data in the world" in warnings[0], warnings
+    info = tree.nodes.new("ShaderNodeObjectInfo")
+    tree.links.new(info.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    tree.links.new(info.outputs["Random"], tree.nodes["Background"].inputs["Strength"])
+    data = render_export(scene)
+    assert not _cannot(data) and data.world.program is None and not np.any(data.world.radiance)
+
+
+def test_a_wireframe_feeding_the_displacement_is_named(drt):
+    """Cycles takes a Wireframe's derivative inside a bump by its own rule, which DRT does not."""
+    scene = ns.displacement_scene()
+    tree = bpy.data.materials["World space"].node_tree
+    wire = tree.nodes.new("ShaderNodeWireframe")
+    displace = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeDisplacement")
+    tree.links.new(wire.outputs[0], displace.inputs["Height"])
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Wireframe feeding the displacement" in warnings[0], warnings
+
+
+def test_geometry_nodes_attributes_are_exported_only_when_read(drt):
+    """An attribute no material reads stays out of the export; a 2D integer one (which Cycles reads
+    as 0: measured) stays out even when read."""
+    case = next(c for c in ns.CASES if c.name == "Attribute float on points")
+    scene = ns.grid_scene([case])
+    mesh = scene.objects[case.name].data
+    mesh.attributes.new("unread", "FLOAT", "POINT")
+    mesh.attributes.new("turn", "INT32_2D", "POINT")
+    tree = mesh.materials[0].node_tree
+    turn = tree.nodes.new("ShaderNodeAttribute")
+    turn.attribute_name = "turn"
+    emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    tree.links.new(turn.outputs["Fac"], emission.inputs["Strength"])
+    data = render_export(scene)
+    assert any(n.op == "attribute" and n.params["name"] == "turn" for m in data.materials if m.program
+               for n in m.program.nodes)
+    (exported,) = data.meshes
+    assert exported.attributes["height"].shape[1:] == (3, 1)
+    assert "unread" not in exported.attributes and "turn" not in exported.attributes
+
+
+def test_tangents_asked_of_a_mesh_without_uv_map_are_named(drt):
+    """Cycles derives such tangents from a sphere mapping of the Generated coordinates; DRT does not."""
+    case = next(c for c in ns.CASES if c.name == "Vector Displacement object space")
+    scene = ns.grid_scene([replace(case, name="No UV map", build=ns._vector_displacement("TANGENT"))])
+    warnings = [w for w in render_export(scene).warnings if "no UV map" in w]
+    assert len(warnings) == 1 and "No UV map" in warnings[0], warnings

@@ -288,3 +288,15 @@ def test_mirror_ball_is_the_ball_seen_from_minus_y():
     d = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     # straight back to the viewer: the ball's centre; sideways: 45 degrees round it
     assert np.allclose(mirror_ball_uv(d), [[0.5, 0.5], [0.5 + 0.5 * np.sqrt(0.5), 0.5], [0.5, 0.5 + 0.5 * np.sqrt(0.5)]])
+
+
+def vector_math(op, a, b, output=0):
+    return run(lambda p, k: (p.add("vector_math", [k(a), k(b), k([0.0, 0.0, 0.0]), k(1.0)], operation=op), output))
+
+
+def test_vector_math_dot_product_project_and_reflect():
+    """The operations that take a dot product (they once failed on a name the function shadowed)."""
+    a, b = np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 2.0])
+    assert np.allclose(vector_math("DOT_PRODUCT", a, b, 1), 6.0)
+    assert np.allclose(vector_math("PROJECT", a, b), [0.0, 0.0, 3.0])
+    assert np.allclose(vector_math("REFLECT", a, b), [1.0, 2.0, -3.0])

@@ -346,6 +346,86 @@ def _ramp(interpolation, color_mode="RGB"):
     return build
 
 
+def _terrain():
+    """A 5 x 5 grid of vertices over the tile, its heights a smooth bump (+-0.4 m): triangles
+    facing every way for the nodes that read the surface's shape, the camera's distance or the
+    triangles' edges."""
+    xs = np.linspace(-1.0, 1.0, 5)
+    vertices = [(x, y, 0.4 * np.sin(1.7 * x + 0.3) * np.cos(1.4 * y - 0.2)) for y in xs for x in xs]
+    faces = [(5 * j + i, 5 * j + i + 1, 5 * j + i + 6, 5 * j + i + 5) for j in range(4) for i in range(4)]
+    return vertices, faces
+
+
+def _smooth(mesh):
+    """Smooth shading: a tangent that follows the normal without a jump at the triangles' edges,
+    whose pixels the renderers' samples split differently."""
+    mesh.shade_smooth()
+
+
+def _turned_uvs(mesh):
+    """A UV map "Turned": the vertices' x and y turned by 0.6 rad and squeezed, per corner; the
+    mesh smooth, since Cycles' MikkTSpace tangents of a flat-shaded quad that is not planar are
+    those of its two triangles apart, and Blender's of the whole quad."""
+    mesh.shade_smooth()
+    uv = mesh.uv_layers.new(name="Turned")
+    c, s = np.cos(0.6), np.sin(0.6)
+    for loop, value in zip(mesh.loops, uv.data):
+        x, y, _ = mesh.vertices[loop.vertex_index].co
+        value.uv = (0.5 + 0.4 * (c * x - s * y), 0.5 + 0.3 * (s * x + c * y))
+
+
+def _camera_data(output, scale, offset):
+    def build(tree, v):
+        value = _node(tree, "ShaderNodeCameraData").outputs[output]
+        return _affine(tree, value, scale, offset) if output == "View Vector" else _scaled(tree, value, scale, offset)
+    return build
+
+
+def _wireframe(pixel_size, scale, offset):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeWireframe", use_pixel_size=pixel_size)
+        return _link(tree, node, Size=_scaled(tree, _component(tree, v, "X"), scale, offset)).outputs[0]
+    return build
+
+
+def _tangent(direction, axis="Z", uv_map=""):
+    def build(tree, v):
+        node = _node(tree, "ShaderNodeTangent", direction_type=direction, axis=axis, uv_map=uv_map)
+        return _affine(tree, node.outputs[0], 0.5, 0.5)
+    return build
+
+
+def _generic(name, data_type, domain, low=0.05, high=0.95):
+    """Adds a Geometry Nodes attribute ``name`` of ``data_type`` on ``domain`` to the tile's mesh,
+    random values in [low, high] (integers: 0 to 9)."""
+    def setup(mesh):
+        attr = mesh.attributes.new(name, data_type, domain)
+        rng = np.random.default_rng(len(name))
+        field = "vector" if data_type in ("FLOAT2", "FLOAT_VECTOR") else "value"
+        width = {"FLOAT2": 2, "FLOAT_VECTOR": 3, "QUATERNION": 4}.get(data_type, 1)
+        whole = data_type == "INT"
+        count = len(attr.data) * width
+        values = rng.integers(0, 10, count) if whole else rng.uniform(low, high, count)
+        attr.data.foreach_set(field, values.astype(np.int32 if whole else np.float32))
+    return setup
+
+
+def _attribute(name, output, scale=1.0):
+    def build(tree, v):
+        value = _node(tree, "ShaderNodeAttribute", attribute_name=name).outputs[output]
+        return _scaled(tree, value, scale, 0.0) if output == "Fac" else value
+    return build
+
+
+def _vector_displacement(space):
+    """Vector Displacement's offset of the unit coordinates, shown as a colour."""
+    def build(tree, v):
+        node = _link(tree, _node(tree, "ShaderNodeVectorDisplacement", space=space), Vector=_unit(tree, v),
+                     Midlevel=0.3, Scale=0.8)
+        return _affine(tree, node.outputs[0], 1.0, 0.5)
+    return build
+
+
 CASES = (
     NodeCase("Brightness/Contrast", _brightness),
     NodeCase("RGB Curves, extrapolated", _rgb_curves),
@@ -402,6 +482,28 @@ CASES = (
     NodeCase("Color Ramp B-Spline", _ramp("B_SPLINE")),
     NodeCase("Color Ramp Cardinal", _ramp("CARDINAL")),
     NodeCase("Color Ramp linear in HSV", _ramp("LINEAR", "HSV")),
+    NodeCase("Camera Data View Vector", _camera_data("View Vector", 0.5, 0.5), mesh=_terrain()),
+    NodeCase("Camera Data View Z Depth", _camera_data("View Z Depth", 1.0, -9.5), mesh=_terrain()),
+    NodeCase("Camera Data View Distance", _camera_data("View Distance", 0.5, -4.6), mesh=_terrain()),
+    NodeCase("Wireframe world size", _wireframe(False, 0.06, 0.12), mesh=_terrain()),
+    NodeCase("Tangent radial X", _tangent("RADIAL", "X"), mesh=_terrain(), setup=_smooth),
+    NodeCase("Tangent radial Y", _tangent("RADIAL", "Y"), mesh=_terrain(), setup=_smooth),
+    NodeCase("Tangent radial Z", _tangent("RADIAL", "Z"), mesh=_terrain(), setup=_smooth),
+    NodeCase("Tangent UV map", _tangent("UV_MAP", uv_map="Turned"), mesh=_terrain(), setup=_turned_uvs),
+    NodeCase("Attribute float on points", _attribute("height", "Color"), mesh=_terrain(),
+             setup=_generic("height", "FLOAT", "POINT")),
+    NodeCase("Attribute vector on faces", _attribute("tint", "Vector"), mesh=_terrain(),
+             setup=_generic("tint", "FLOAT_VECTOR", "FACE")),
+    NodeCase("Attribute integer on corners, Fac", _attribute("count", "Fac", 0.1), mesh=_terrain(),
+             setup=_generic("count", "INT", "CORNER")),
+    NodeCase("Attribute 2D vector on points", _attribute("offset", "Vector"), mesh=_terrain(),
+             setup=_generic("offset", "FLOAT2", "POINT")),
+    NodeCase("Vector Displacement tangent space", _vector_displacement("TANGENT"), setup=_turned_uvs),
+    NodeCase("Vector Displacement object space", _vector_displacement("OBJECT")),
+    NodeCase("Attribute float on edges", _attribute("crease", "Color"), mesh=_terrain(),
+             setup=_generic("crease", "FLOAT", "EDGE")),
+    NodeCase("Attribute quaternion on points, Alpha", _attribute("turn", "Alpha"), mesh=_terrain(),
+             setup=_generic("turn", "QUATERNION", "POINT")),
 )
 
 
@@ -609,4 +711,179 @@ def mirror_ball_scene(size=48):
     env = _node(tree, "ShaderNodeTexEnvironment", image=_texels(), interpolation="Closest", projection="MIRROR_BALL")
     tree.links.new(env.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     scene.world = world
+    return scene
+
+
+def _lit_diffuse(name, build):
+    """A Diffuse BSDF material whose colour ``build(tree)`` (an output socket) gives."""
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
+    tree.links.new(build(tree), bsdf.inputs["Color"])
+    out = _node(tree, "ShaderNodeOutputMaterial")
+    tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return mat, tree, out
+
+
+def wireframe_scene(size=64):
+    """Wireframe in pixels (Size 0.6 to 2.6 px across the square) as the colour of a flat diffuse
+    square of 6 x 6 jittered quads under a white world, seen straight down: the pixel footprint
+    comes from the camera ray, which DRT's emission does not see."""
+    scene = ps._scene(size, size)
+    scene.camera.data.type = "ORTHO"
+    scene.camera.data.ortho_scale = 2.2
+    scene.world = new_world("World")
+    xs = np.linspace(-1.0, 1.0, 7)
+    jitter = np.random.default_rng(3).uniform(-0.08, 0.08, (7, 7, 2))
+    vertices = [(x + (0 < i < 6) * jitter[j, i, 0], y + (0 < j < 6) * jitter[j, i, 1], 0.0)
+                for j, y in enumerate(xs) for i, x in enumerate(xs)]
+    faces = [(7 * j + i, 7 * j + i + 1, 7 * j + i + 8, 7 * j + i + 7) for j in range(6) for i in range(6)]
+    mesh = bpy.data.meshes.new("Wires")
+    mesh.from_pydata(vertices, [], faces)
+
+    def wires(tree):
+        coords = _node(tree, "ShaderNodeTexCoord")
+        node = _node(tree, "ShaderNodeWireframe", use_pixel_size=True)
+        return _link(tree, node, Size=_scaled(tree, _component(tree, coords.outputs["Object"], "X"), 1.0, 1.6)).outputs[0]
+    mesh.materials.append(_lit_diffuse("Wires", wires)[0])
+    obj = bpy.data.objects.new("Wires", mesh)
+    scene.collection.objects.link(obj)
+    return scene
+
+
+def _info_material(name, build):
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    _emissive(tree, build(tree, _node(tree, "ShaderNodeObjectInfo")), 1.0)
+    return mat
+
+
+def _random_and_indices(tree, info):
+    join = _node(tree, "ShaderNodeCombineXYZ")
+    tree.links.new(info.outputs["Random"], join.inputs[0])
+    tree.links.new(_scaled(tree, info.outputs["Object Index"], 0.1, 0.0), join.inputs[1])
+    tree.links.new(_scaled(tree, info.outputs["Material Index"], 0.1, 0.0), join.inputs[2])
+    return join.outputs[0]
+
+
+def _colour_alpha_location(tree, info):
+    """Colour times alpha, plus a fifth of the location's x and y."""
+    colour = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+    tree.links.new(info.outputs["Color"], colour.inputs[0])
+    tree.links.new(info.outputs["Alpha"], colour.inputs["Scale"])
+    place = _node(tree, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+    tree.links.new(info.outputs["Location"], place.inputs[0])
+    place.inputs[1].default_value = (0.05, 0.05, 0.0)
+    tree.links.new(colour.outputs[0], place.inputs[2])
+    return place.outputs[0]
+
+
+def object_info_scene():
+    """Two rows of emissive squares seen from above, coloured by Object Info: Random, Object Index
+    and Material Index on top, colour times alpha plus location below. The squares' objects have
+    plain, numbered and non-ASCII names, colours, alphas and pass indices; two of each row are
+    instances of a collection (Random from the instance, not the name)."""
+    scene = ps._scene(6 * ps.TILE, 2 * ps.TILE)
+    cam = scene.camera
+    cam.data.type = "ORTHO"
+    cam.data.ortho_scale = 12.0
+    ps.black_world(scene)
+    hidden = bpy.data.collections.new("Instanced")
+    for row, (name, build, pass_index) in enumerate((("Indices", _random_and_indices, 3),
+                                                     ("Colour", _colour_alpha_location, 0))):
+        mat = _info_material(name, build)
+        mat.pass_index = pass_index
+        y = 1.0 - 2.0 * row
+        names = ("Cube", "Cube.001", "Säule ünd Ölbaum", "Z")
+        for i, obj_name in enumerate(names):
+            obj = _plane(f"{obj_name} {name}" if row else obj_name, -5.0 + 2.0 * i, mat, scene.collection)
+            obj.location.y = y
+            obj.pass_index = 2 * i + 1
+            obj.color = (0.2 + 0.2 * i, 0.9 - 0.2 * i, 0.5, 1.0 - 0.15 * i)
+        inner = _plane(f"Inner {name}", 0.0, mat, hidden)
+        inner.location.y = y
+        inner.pass_index = 7
+        inner.color = (0.9, 0.3, 0.6, 0.8)
+    for x in (3.0, 5.0):
+        instancer = bpy.data.objects.new(f"Instancer {x}", None)
+        instancer.instance_type = "COLLECTION"
+        instancer.instance_collection = hidden
+        instancer.location = (x, 0.0, 0.0)
+        scene.collection.objects.link(instancer)
+    return scene
+
+
+def _height(tree, kind, scale):
+    """A smooth height over the object's coordinates: a noise texture or a sine wave."""
+    coords = _node(tree, "ShaderNodeTexCoord")
+    if kind == "noise":
+        node = _link(tree, _node(tree, "ShaderNodeTexNoise"), Vector=coords.outputs["Object"], Scale=scale, Detail=0.0)
+        return node.outputs["Fac"], node.outputs["Color"]
+    wave = _link(tree, _node(tree, "ShaderNodeTexWave", wave_type="RINGS"), Vector=coords.outputs["Object"], Scale=scale)
+    return wave.outputs["Fac"], wave.outputs["Color"]
+
+
+def displacement_scene(size=32):
+    """Six diffuse squares lit by a sun, each bumped by its material's Displacement socket
+    (method Bump Only): a Displacement node in object space on a square scaled 0.7 (the offset
+    scales with it), one in world space, a Vector Displacement in object space and one in tangent
+    space (a turned UV map), a Math node's height linked straight in, that square coloured by its
+    Geometry Normal (the surface seeing the bumped normal), and a Displacement node along a linked,
+    tilted normal."""
+    scene = ps._scene(3 * size, 2 * size)
+    ps.aim(scene.camera, (0.0, -5.0, 7.5))
+    ps.black_world(scene)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    sun.rotation_euler = (0.35, 0.25, 0.0)
+    scene.collection.objects.link(sun)
+    grey = lambda tree: _node(tree, "ShaderNodeRGB").outputs[0]  # noqa: E731
+
+    def square(name, x, y, build, colour=grey, scale=1.0, setup=None):
+        mat, tree, out = _lit_diffuse(name, colour)
+        tree.links.new(build(tree), out.inputs["Displacement"])
+        obj = _plane(name, x, mat, scene.collection)
+        obj.location.y = y
+        obj.scale = (scale, scale, scale)
+        obj.rotation_euler.z = 0.4
+        if setup is not None:
+            setup(obj.data)
+
+    def object_space(tree):
+        fac, _ = _height(tree, "noise", 2.0)
+        return _link(tree, _node(tree, "ShaderNodeDisplacement", space="OBJECT"), Height=fac, Midlevel=0.5,
+                     Scale=0.5).outputs[0]
+
+    def world_space(tree):
+        fac, _ = _height(tree, "wave", 0.4)
+        return _link(tree, _node(tree, "ShaderNodeDisplacement", space="WORLD"), Height=fac, Scale=0.25).outputs[0]
+
+    def vector(space):
+        def build(tree):
+            _, colour = _height(tree, "noise", 1.5)
+            return _link(tree, _node(tree, "ShaderNodeVectorDisplacement", space=space), Vector=colour, Midlevel=0.5,
+                         Scale=0.3).outputs[0]
+        return build
+
+    def tilted_normal(tree):
+        fac, _ = _height(tree, "wave", 0.5)
+        normal = _normalized(tree, _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs["Normal"], 1.0, 0.3))
+        return _link(tree, _node(tree, "ShaderNodeDisplacement", space="OBJECT"), Height=fac, Scale=0.3,
+                     Normal=normal).outputs[0]
+
+    def straight(tree):
+        fac, _ = _height(tree, "wave", 0.3)
+        return _scaled(tree, fac, 0.2, 0.0)
+
+    def normal_colour(tree):
+        return _affine(tree, _node(tree, "ShaderNodeNewGeometry").outputs["Normal"], 0.5, 0.5)
+
+    square("Object space", -2.2, 1.1, object_space, scale=0.7)
+    square("World space", 0.0, 1.1, world_space)
+    square("Vector", 2.2, 1.1, vector("OBJECT"))
+    square("Vector tangent", -2.2, -1.1, vector("TANGENT"), setup=_turned_uvs)
+    square("Straight", 0.0, -1.1, straight, normal_colour)
+    square("Normal linked", 2.2, -1.1, tilted_normal)
     return scene

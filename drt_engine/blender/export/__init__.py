@@ -62,7 +62,8 @@ def export_scene(
                 lights.append(light)
                 light_keys.append(instance_key(instance))
         else:
-            geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None)
+            geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
+                         instance.random_id if instance.is_instance else None)
     geometry.finish()
     scene_data = SceneData(
         camera=camera,

@@ -17,7 +17,7 @@ import bpy
 import numpy as np
 
 from ...core.scene import Instance, Mesh
-from ...core.shading.proctex.hash import hash_uint, to_unit
+from ...core.shading.proctex.hash import hash_uint, hash_uint2, to_unit
 from .materials import MaterialTable
 from .shader_graph import ISLANDS, POINTINESS, find_rgba
 
@@ -38,6 +38,47 @@ def _corner_normals(mesh, tri_vertices, tri_loops):
         return normals[tri_vertices]
     normals = _read(mesh.corner_normals, "vector", len(mesh.loops), 3, np.float32)
     return normals[tri_loops]
+
+
+GENERIC = {"FLOAT": ("value", 1), "INT": ("value", 1), "BOOLEAN": ("value", 1), "INT8": ("value", 1),
+           "FLOAT2": ("vector", 2), "FLOAT_VECTOR": ("vector", 3),
+           "FLOAT_COLOR": ("color", 4), "BYTE_COLOR": ("color", 4), "QUATERNION": ("value", 4)}
+"""Mesh attribute types Cycles reads for the Attribute node, as floats: (RNA field, components;
+a quaternion's w first, as Blender stores it and Cycles reads it: w, x, y as the colour, z as alpha)."""
+
+
+def _edges_to_points(mesh, values, boolean):
+    """Blender's edge-to-point interpolation, which Cycles asks for: the mean of a vertex's edges'
+    values (a boolean: whether any is true); 0 at a vertex without edges."""
+    edges = _read(mesh.edges, "vertices", len(mesh.edges), 2, np.int64)
+    total = np.zeros((len(mesh.vertices), values.shape[1]))
+    count = np.zeros(len(mesh.vertices))
+    for end in (0, 1):
+        np.add.at(total, edges[:, end], values)
+        np.add.at(count, edges[:, end], 1.0)
+    if boolean:
+        return (total > 0).astype(np.float32)
+    return (total / np.maximum(count, 1.0)[:, None]).astype(np.float32)
+
+
+def _generic_attributes(mesh, names, tri_vertices, tri_loops, out) -> None:
+    """The attributes ``names`` (Geometry Nodes' float, integer, boolean, vector, 2D vector, colour
+    and quaternion attributes on points, corners, faces or edges) per triangle corner into ``out``, where UV maps
+    and colour attributes have not put them, as Cycles reads them: a face's value at its three
+    corners, edges' carried to the points."""
+    for name in names:
+        attr = mesh.attributes.get(name)
+        if name in out or attr is None or attr.data_type not in GENERIC:
+            continue  # Cycles, too, reads no 2D integer or matrix attribute (measured: 0)
+        field, width = GENERIC[attr.data_type]
+        values = _read(attr.data, field, len(attr.data), width, np.float32).reshape(len(attr.data), width)
+        if attr.domain == "EDGE":
+            values = _edges_to_points(mesh, values, attr.data_type == "BOOLEAN")
+        if attr.domain == "FACE":
+            faces = _read(mesh.loop_triangles, "polygon_index", len(tri_loops), 1, np.int32)
+            out[name] = np.repeat(values[faces][:, None], 3, axis=1)
+        else:
+            out[name] = values[tri_loops if attr.domain == "CORNER" else tri_vertices]
 
 
 def _corner_attributes(mesh, tri_vertices, tri_loops):
@@ -66,6 +107,9 @@ def _tangents(mesh, uv_maps, tri_loops, attributes, warnings):
     for name in uv_maps:
         layer = name or render
         if layer is None or layer not in mesh.uv_layers:
+            missing = f"no UV map '{name}'" if name else "no UV map"
+            warnings.append(f"mesh '{mesh.name}': {missing} for the tangents its materials read (Cycles then "
+                            "derives them from a sphere mapping of the Generated coordinates, which DRT does not)")
             continue
         try:
             mesh.calc_tangents(uvmap=layer)
@@ -112,6 +156,22 @@ def random_per_island(mesh, tri_vertices) -> np.ndarray:
     roots = island_roots(edges, len(mesh.vertices))[tri_vertices[:, 0]]
     values = {r: to_unit(hash_uint(r)) for r in np.unique(roots).tolist()}
     return np.array([values[r] for r in roots.tolist()], np.float32)
+
+
+def hash_string(name: str) -> int:
+    """Cycles' hash_string (util/hash.h) of a name's UTF-8 bytes, each unsigned (as Blender's
+    Cycles hashes them: measured with a non-ASCII object name)."""
+    h = 0
+    for byte in name.encode("utf-8"):
+        h = (h * 37 + byte) & 0xFFFFFFFF
+    return h
+
+
+def object_random(name: str, random_id: int | None = None) -> float:
+    """Object Info's Random as Cycles (blender/object.cpp, scene/object.cpp): an object's is the
+    hash of its name, an instance's the depsgraph's random id, as a float in [0, 1]."""
+    word = hash_uint2(hash_string(name), 0) if random_id is None else random_id & 0xFFFFFFFF
+    return to_unit(word)
 
 
 FLT_EPSILON = float(np.finfo(np.float32).eps)
@@ -171,12 +231,13 @@ def pointiness(positions: np.ndarray, normals: np.ndarray, edges: np.ndarray) ->
 
 
 def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=(), warnings=None,
-                      islands=False, pointy=False) -> Mesh | None:
+                      islands=False, pointy=False, generic=()) -> Mesh | None:
     """Triangulated copy of a Blender mesh; None for a mesh without faces.
 
     ``slot_materials`` maps the object's material slots to scene material indices;
     a face's slot index is clamped to the slots present, as Cycles does. ``tangent_maps``:
-    UV maps whose tangents the materials' Normal Map nodes need.
+    UV maps whose tangents the materials' Normal Map nodes need; ``generic``: the names of other
+    attributes their Attribute nodes read.
     """
     triangles = mesh.loop_triangles
     count = len(triangles)
@@ -188,6 +249,7 @@ def mesh_from_blender(mesh, name: str, slot_materials: np.ndarray, tangent_maps=
     slots = _read(triangles, "material_index", count, 1, np.int32)
     materials = slot_materials[np.clip(slots, 0, len(slot_materials) - 1)]
     attributes, uvs, colors = _corner_attributes(mesh, tri_vertices, tri_loops)
+    _generic_attributes(mesh, generic, tri_vertices, tri_loops, attributes)
     if tangent_maps and len(mesh.loops):
         _tangents(mesh, tangent_maps, tri_loops, attributes, warnings if warnings is not None else [])
     if islands:  # the same value at the three corners: read back exactly
@@ -265,6 +327,7 @@ class GeometryExporter:
         self._mesh_index: dict[tuple, int] = {}
         self._metaballs: list = []
         self._meshed: set[int] = set()
+        self._info: dict[bytes, bool] = {}  # slot materials -> whether they read Object Info
 
     def _slot_materials(self, obj) -> np.ndarray:
         """Scene material index per slot, as Cycles' ``find_used_shaders``."""
@@ -275,14 +338,14 @@ class GeometryExporter:
             return np.zeros(1, np.int32)
         return np.array([self.materials.index(slot.material) for slot in slots], np.int32)
 
-    def add(self, obj, matrix: np.ndarray, key=None, parent=None) -> None:
-        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it);
-        non-geometry objects are ignored."""
+    def add(self, obj, matrix: np.ndarray, key=None, parent=None, random_id=None) -> None:
+        """Add one evaluated object placed by ``matrix`` (``parent``: the object instancing it,
+        ``random_id``: the depsgraph's random id of that instance); non-geometry objects are ignored."""
         if obj.type == "META":
             self._metaballs.append((obj, matrix, key))
         elif isinstance(obj.data, bpy.types.Mesh):
             self._meshed.add(obj.original.as_pointer())
-            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent)
+            self._place(obj, matrix, ("mesh", obj.data.as_pointer()), key, parent, random_id)
 
     def finish(self) -> None:
         """Add metaballs that the depsgraph did not already hand over as mesh instances."""
@@ -306,24 +369,39 @@ class GeometryExporter:
                     out[node.params["key"]] = find_rgba(owners, name)
         return out
 
-    def _place(self, obj, matrix, source, key, parent=None) -> None:
+    def _place(self, obj, matrix, source, key, parent=None, random_id=None) -> None:
         slot_materials = self._slot_materials(obj)
         mesh_key = source + (slot_materials.tobytes(),)
         index = self._mesh_index.get(mesh_key)
         if index is None:
             index = self._mesh_index[mesh_key] = self._export(obj, slot_materials)
         if index >= 0:
+            random = 0.0
+            if self._reads_object_info(slot_materials):
+                random = object_random(obj.name, random_id)
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
-                                           attributes=self._instance_attributes(obj, parent, slot_materials)))
+                                           attributes=self._instance_attributes(obj, parent, slot_materials),
+                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random))
             self.keys.append(key)
 
+    def _reads_object_info(self, slot_materials) -> bool:
+        """Whether the slots' materials have an Object Info node, found once per set of slots (an
+        object's random number is then worth hashing its name for)."""
+        key = slot_materials.tobytes()
+        found = self._info.get(key)
+        if found is None:
+            programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+            found = self._info[key] = any(n.op == "object_info" for p in programs if p is not None for n in p.nodes)
+        return found
+
     def _tangent_maps(self, slot_materials) -> set:
+        """The UV maps whose tangents the slots' materials read (tangent-space normal maps and
+        vector displacement, the Tangent node's UV map direction)."""
         maps = set()
         for index in set(slot_materials.tolist()):
             program = self.materials.materials[index].program
             if program is not None:
-                maps |= {n.params.get("map", "") for n in program.nodes
-                         if n.op == "normal_map" and n.params.get("space", "TANGENT") == "TANGENT"}
+                maps |= {n.params.get("map", "") for n in program.nodes if n.params.get("tangents")}
         return maps
 
     def _needs(self, slot_materials, name) -> bool:
@@ -332,24 +410,32 @@ class GeometryExporter:
         return any(n.op == "attribute" and n.params.get("name") == name
                    for p in programs if p is not None for n in p.nodes)
 
+    def _attribute_names(self, slot_materials) -> tuple:
+        """The mesh attributes the slots' materials read by name (Attribute, Color Attribute)."""
+        programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+        return tuple(sorted({n.params["name"] for p in programs if p is not None for n in p.nodes
+                             if n.op == "attribute" and n.params["name"] not in (ISLANDS, POINTINESS)}))
+
     def _export(self, obj, slot_materials) -> int:
         maps = self._tangent_maps(slot_materials)
         islands, pointy = self._needs(slot_materials, ISLANDS), self._needs(slot_materials, POINTINESS)
+        generic = self._attribute_names(slot_materials)
         warnings = self.materials.warnings
         cache_key = None
         if self.cache is not None and obj.type != "META":
-            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy)
+            cache_key = (obj.data.as_pointer(), slot_materials.tobytes(), tuple(sorted(maps)), islands, pointy, generic)
             mesh = self.cache.get(cache_key)
             if mesh is not None:
                 self.meshes.append(mesh)
                 return len(self.meshes) - 1
         if obj.type == "META":
             try:
-                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy)
+                mesh = mesh_from_blender(obj.to_mesh(), obj.name, slot_materials, maps, warnings, islands, pointy,
+                                         generic)
             finally:
                 obj.to_mesh_clear()
         else:
-            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy)
+            mesh = mesh_from_blender(obj.data, obj.data.name, slot_materials, maps, warnings, islands, pointy, generic)
         if mesh is None:
             return -1
         if cache_key is not None:

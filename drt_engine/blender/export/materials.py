@@ -181,7 +181,7 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
         color = np.array(material.diffuse_color[:3], dtype=np.float64)
         return Material(material.name, [Closure("DIFFUSE", color=color, roughness=0.0)]), None
     issues = Issues()
-    compiler = Compiler(images, issues, layer=layer)
+    compiler = Compiler(images, issues, layer=layer, pass_index=material.pass_index)
 
     def leaf(node, weight):
         make = CLOSURE_NODES.get(node.bl_idname)
@@ -192,9 +192,23 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
 
     output = material.node_tree.get_output_node("CYCLES")
     closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
-    varying = any(c.inputs for c in closures)
-    return (Material(material.name, closures, compiler.program if varying else None),
+    displacement = None if output is None else _displacement(material, output, compiler, issues)
+    varying = any(c.inputs for c in closures) or displacement is not None
+    return (Material(material.name, closures, compiler.program if varying else None, displacement),
             issues.message(f"Material '{material.name}'"))
+
+
+def _displacement(material, output, compiler, issues):
+    """The output's Displacement as Cycles renders it with the material's method "Bump Only" (the
+    default): a bump of the shading normal. Moving the surface itself ("Displacement Only", "Both")
+    is not done: those render as bump, named in the warning."""
+    socket = output.inputs.get("Displacement")
+    if socket is None or not socket.is_linked:
+        return None
+    method = getattr(material, "displacement_method", "BUMP")
+    if method != "BUMP":
+        issues.add(f"displacement method {method.replace('_', ' ').title()} (rendered as Bump Only)")
+    return compiler.displacement(socket)
 
 
 class MaterialTable:

@@ -187,8 +187,9 @@ def _fit(value, kind):
 class Compiler:
     """Compiles the sockets of one material or world into one program."""
 
-    def __init__(self, images: ImageTable, issues: Issues, world: bool = False, layer=None):
+    def __init__(self, images: ImageTable, issues: Issues, world: bool = False, layer=None, pass_index=0):
         self.layer = layer  # (scene, view layer) for View Layer attributes
+        self.pass_index = pass_index  # the material's, Object Info's Material Index
         self.program = Program()
         self.images = images
         self.issues = issues
@@ -545,10 +546,25 @@ class Compiler:
 
     def _node_ShaderNodeNormalMap(self, node, output):
         args = (self._in(node, "Strength", "float"), self._in(node, "Color", "color"))
-        return self.op("normal_map", args, map=node.uv_map, space=node.space), 0
+        return self.op("normal_map", args, map=node.uv_map, space=node.space, tangents=node.space == "TANGENT"), 0
+
+    def _bump_height(self, height, owner):
+        """A bump's height; a Wireframe feeding it is named: Cycles takes that node's derivative by
+        its own rule there (svm_node_wireframe's bump offsets), not DRT's finite difference."""
+        stack, seen = [height[0]], set()
+        while stack:
+            i = stack.pop()
+            if i not in seen:
+                seen.add(i)
+                node = self.program.nodes[i]
+                if node.op == "wireframe":
+                    self.issues.add(f"a Wireframe feeding {owner} (its bump as a plain difference)")
+                    break
+                stack.extend(r[0] for r in node.inputs if r is not None)
+        return height
 
     def _node_ShaderNodeBump(self, node, output):
-        height = self.ref(self._in(node, "Height", "float"), "float")
+        height = self._bump_height(self.ref(self._in(node, "Height", "float"), "float"), f"'{node.name}'")
         normal_socket = node.inputs.get("Normal")
         normal = self.ref(self.value(normal_socket, "vector")) if normal_socket.is_linked else None
         refs = (self.ref(self._in(node, "Strength", "float")), self.ref(self._in(node, "Distance", "float")),
@@ -643,6 +659,64 @@ class Compiler:
 
     def _node_ShaderNodeWavelength(self, node, output):
         return self.op("wavelength", (self._in(node, "Wavelength", "float"),)), 0
+
+    # -- the hit's object, triangle and camera (core.shading.geometrynodes) ----------------------
+    def _in_world(self, node) -> bool:
+        """Whether the node is compiled for the world, where there is no object, triangle or surface
+        point to read: then with its one warning."""
+        if self.world:
+            self._unsupported(node, f"{node.bl_label} in the world")
+        return self.world
+
+    def displacement(self, socket):
+        """The shading normal bumped by the material output's Displacement socket, as Cycles'
+        bump_from_displacement: the displacement vector's component along the unbumped normal as
+        the height of a bump of strength 1 and distance 1; None when nothing varying feeds it."""
+        vector = self.value(socket, "vector")
+        if not is_ref(vector):
+            return None  # a constant offset has no gradient
+        along = self.op("vector_math", (vector, self._coord("normal_world"), np.zeros(3), 1.0), operation="DOT_PRODUCT")
+        height = self._bump_height((along, 1), "the displacement")
+        return self.program.add("bump", (self.ref(1.0), self.ref(1.0), height, None), invert=False), 0
+
+    def _node_ShaderNodeDisplacement(self, node, output):
+        if self._in_world(node):
+            return None
+        args = [self._in(node, n, "float") for n in ("Height", "Midlevel", "Scale")] + self._normal_in(node)
+        return self.op("displacement", args, space=node.space), 0
+
+    def _node_ShaderNodeVectorDisplacement(self, node, output):
+        if self._in_world(node):
+            return None
+        args = (self._in(node, "Vector", "vector"), self._in(node, "Midlevel", "float"),
+                self._in(node, "Scale", "float"))
+        return self.op("vector_displacement", args, space=node.space, map="", tangents=node.space == "TANGENT"), 0
+
+    def _node_ShaderNodeObjectInfo(self, node, output):
+        if self.world:  # Cycles' world has no object (nor a pass index): every output 0
+            return np.zeros(3) if output.identifier in ("Location", "Color") else 0.0
+        if output.identifier == "Material Index":
+            return float(self.pass_index)
+        names = ("Location", "Color", "Alpha", "Object Index", "Random")
+        return self.program.add("object_info"), names.index(output.identifier)
+
+    def _node_ShaderNodeCameraData(self, node, output):
+        if self._in_world(node):
+            return None
+        outputs = ("View Vector", "View Z Depth", "View Distance")
+        return self.program.add("camera_data"), outputs.index(output.identifier)
+
+    def _node_ShaderNodeWireframe(self, node, output):
+        if self._in_world(node):
+            return None
+        return self.op("wireframe", (self._in(node, "Size", "float"),), pixel_size=bool(node.use_pixel_size)), 0
+
+    def _node_ShaderNodeTangent(self, node, output):
+        if self._in_world(node):
+            return None
+        uv = node.direction_type == "UV_MAP"
+        return self.program.add("tangent", direction=node.direction_type, axis=node.axis,
+                                map=node.uv_map if uv else "", tangents=uv), 0
 
     # Blender 4.x's legacy colour nodes (5.0 opens them as Separate/Combine Color)
     def _node_ShaderNodeSeparateRGB(self, node, output):

@@ -21,6 +21,7 @@ from ..base.constants import TINY
 from ..base.vectors import orthonormal_basis
 from ..scene import Program
 from . import colornodes as cn
+from . import geometrynodes as gn
 from . import proctex
 from .textures import MAGENTA, Texture, equirect_uv
 
@@ -94,7 +95,7 @@ def _normalize(v):
 def _vector_math(op, a, b, c, s):
     """(vector, value) of Cycles' svm_vector_math."""
     with np.errstate(all="ignore"):
-        vec = {
+        vectors = {
             "ADD": lambda: a + b, "SUBTRACT": lambda: a - b, "MULTIPLY": lambda: a * b,
             "DIVIDE": lambda: _safe_div(a, b), "MULTIPLY_ADD": lambda: a * b + c,
             "CROSS_PRODUCT": lambda: np.cross(a, b),
@@ -114,7 +115,7 @@ def _vector_math(op, a, b, c, s):
         n = len(a)
         if op in val:
             return np.zeros((n, 3)), val[op]()
-        return vec[op](), np.zeros(n)
+        return vectors[op](), np.zeros(n)
 
 
 VECTOR_MATH_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT", "PROJECT",
@@ -318,6 +319,9 @@ def _map_range_vector(kind, v, a, b, c, d, steps, clamp):
     return out
 
 
+GEOMETRY_OPS = ("displacement", "vector_displacement", "object_info", "camera_data", "wireframe", "tangent")
+
+
 class Evaluator:
     """Evaluates program outputs in one context; each node at most once (memoised)."""
 
@@ -462,7 +466,26 @@ class Evaluator:
             return (_map_range_vector(p.get("type", "LINEAR"), *x[:6], p.get("clamp", True)),)
         if op == "convert":
             return (_convert(p["kind"], x[0]),)
+        if op in GEOMETRY_OPS:
+            return self._geometry(op, p, x)
         raise KeyError(f"unknown program op {op!r}")
+
+    def _geometry(self, op, p, x):
+        """The nodes of core.shading.geometrynodes, which read the hit's object, triangle or camera."""
+        ctx = self.ctx
+        if op == "displacement":  # height, midlevel, scale and, when linked, the normal
+            normal = x[3] if len(x) > 3 else ctx.normal
+            return (gn.displacement(p["space"], x[0], x[1], x[2], normal, ctx.object_matrix()),)
+        if op == "vector_displacement":
+            t, sign = ctx.object_tangent(p["map"]) if p["space"] == "TANGENT" else (None, None)
+            return (gn.vector_displacement(p["space"], x[0], x[1], x[2], ctx.normal, t, sign, ctx.object_matrix()),)
+        if op == "object_info":  # location, colour, alpha, object index, random
+            return ctx.object_info()
+        if op == "camera_data":  # view vector, z depth, distance
+            return gn.camera_data(ctx.coord("position"), ctx.camera_matrix())
+        if op == "wireframe":
+            return (ctx.wireframe(x[0], p["pixel_size"]),)
+        return (ctx.tangent_node(p["direction"], p["axis"], p["map"]),)  # "tangent"
 
     def _mix(self, p, x):
         fac, a, b = x

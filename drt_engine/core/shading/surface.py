@@ -18,6 +18,7 @@ from ..base import vectors as vec
 from ..base.constants import TINY
 from ..bsdf.shader import MaterialShader, Tables
 from ..scene import Closure, Material, SceneData
+from . import geometrynodes as gn
 from .nodes import Evaluator
 from .textures import Texture
 
@@ -41,13 +42,24 @@ class SurfaceContext:
         self.pos = pos
         self.normal = normal
         self.width = width
+        self.pixel_width = width
+        """The pixel's footprint across the ray, kept by ``shifted`` (which drops ``width``, so
+        that lookups there filter no further)."""
         self.direction = direction
         self.n = len(prim)
 
     def shifted(self, dp):
         db = self.attrs.bary_shift(self.prim, dp)
-        return SurfaceContext(self.attrs, self.prim, self.bary + db, self.pos + dp, self.normal, None,
-                              self.direction)
+        out = SurfaceContext(self.attrs, self.prim, self.bary + db, self.pos + dp, self.normal, None,
+                             self.direction)
+        out.pixel_width = self.pixel_width
+        return out
+
+    def turned(self, normal):
+        """The same hits with ``normal`` as their shading normal (a displacement's bump)."""
+        out = SurfaceContext(self.attrs, self.prim, self.bary, self.pos, normal, self.width, self.direction)
+        out.pixel_width = self.pixel_width
+        return out
 
     def coord(self, name, uv_map=""):
         a = self.attrs
@@ -76,7 +88,7 @@ class SurfaceContext:
         if name == "parametric":  # Cycles' (1 - u - v, u, 0): the weights of the triangle's first two corners
             return np.concatenate([self.bary[:, :2], np.zeros((self.n, 1))], axis=1)
         if name == "tangent":
-            return self._radial_tangent()
+            return self.tangent_node("RADIAL", "Z")
         p = a.object_position(self.prim, self.bary)
         if name == "generated":
             lo, size = a.texspace(self.prim)
@@ -94,14 +106,38 @@ class SurfaceContext:
         """(N,) components of attribute ``name`` on each hit's mesh (0 where it has none)."""
         return self.attrs.width(self.prim, name)
 
-    def _radial_tangent(self):
-        """Cycles' primitive_tangent: the direction around the object's z axis through its Generated
-        coordinates' centre, carried to the world as a normal and made perpendicular to the shading normal."""
-        g = self.coord("generated")
-        around = np.stack([-(g[:, 1] - 0.5), g[:, 0] - 0.5, np.zeros(self.n)], axis=1)
-        world = np.einsum("nji,nj->ni", np.linalg.inv(self.object_matrix()[:, :3, :3]), around)
-        side = vec.normalize(np.cross(world, self.normal), 1e-300)
-        return np.cross(self.normal, side)
+    def tangent_node(self, direction, axis="Z", uv_map=""):
+        """Cycles' svm_node_tangent (and Geometry's Tangent, its radial z): around ``axis`` through
+        the Generated coordinates' centre, or the UV map's tangent (zero where the mesh has none),
+        carried to the world as a normal and made perpendicular to the shading normal."""
+        if direction == "UV_MAP":
+            t, _, found = self.attrs.object_tangent(self.prim, self.bary, uv_map)
+            t = np.where(found[:, None], t, 0.0)
+        else:
+            t = gn.radial_tangent(axis, self.coord("generated"))
+        return gn.surface_tangent(t, self.normal, self.object_matrix())
+
+    def object_tangent(self, uv_map):
+        """(N, 3) object-space tangents of the UV map and their bitangent signs, as Vector
+        Displacement reads them: the mesh's exported ones, else (no UV map) Cycles' fallback, the
+        triangle's normalised dP/du (its second corner less its first, in the world) with sign 1."""
+        t, sign, found = self.attrs.object_tangent(self.prim, self.bary, uv_map)
+        if not found.all():
+            corners = self.attrs.world_corners(self.prim)
+            t = np.where(found[:, None], t, vec.normalize(corners[:, 1] - corners[:, 0], 1e-300))
+        return t, sign
+
+    def object_info(self):
+        """Object Info's outputs per hit: location, colour, alpha, pass index, random."""
+        return self.attrs.object_info(self.prim)
+
+    def wireframe(self, size, pixel_size):
+        """Cycles' Wireframe over the hits' triangles (mid-shutter); in pixels through the
+        pixel's footprint (0 where there is none, as Cycles' light samples)."""
+        width = None
+        if pixel_size:
+            width = self.pixel_width if self.pixel_width is not None else np.zeros(self.n)
+        return gn.wireframe(self.pos, self.attrs.world_corners(self.prim), size, width)
 
     def _window(self):
         """Cycles' camera_world_to_ndc: the point projected into the camera's full frame, (0, 0)
@@ -178,9 +214,11 @@ class SurfaceAttributes:
                 data = mesh.attributes.get(name)
             else:
                 data = mesh.uvs if kind == "uv" else mesh.colors
-            if data is None or data.shape[2] < width - (2 if kind == "color" else 0):
+            if data is None or data.shape[2] < (2 if kind == "uv" else 1):
                 continue
             values = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
+            if kind == "color" and values.shape[1] == 1:  # a float attribute: its colour is grey, as Cycles'
+                values = np.repeat(values, 3, axis=1)
             out[sel, :values.shape[1]] = values[:, :width]
             if kind == "color" and values.shape[1] < 4:
                 out[sel, 3] = 1.0
@@ -238,10 +276,38 @@ class SurfaceAttributes:
             found = self._texspaces[id(mesh)] = (loc - half, 2.0 * half)
         return found
 
+    def world_corners(self, prim):
+        """(N, 3, 3) world-space corners (mid-shutter) of triangles ``prim``."""
+        return self.geometry.world_vertices[self.geometry.triangles[prim]].astype(np.float64)
+
     def _edges(self, prim):
         """World-space edges (mid-shutter) of triangles ``prim`` from their first corner."""
-        p = self.geometry.world_vertices[self.geometry.triangles[prim]]
+        p = self.world_corners(prim)
         return p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+
+    def object_info(self, prim):
+        """Per hit: the object's location (mid-shutter), colour, alpha, pass index and random number."""
+        n = len(prim)
+        location, color = np.zeros((n, 3)), np.zeros((n, 4))
+        index, random = np.zeros(n), np.zeros(n)
+        for sel, inst, _, _ in self._groups(prim):
+            location[sel] = inst.matrix[:3, 3]
+            color[sel] = inst.color
+            index[sel] = inst.pass_index
+            random[sel] = inst.random
+        return location, color[:, :3], color[:, 3].copy(), index, random
+
+    def object_tangent(self, prim, bary, uv_map):
+        """Object-space MikkTSpace tangents of the UV map interpolated at the hits, their bitangent
+        signs, and where the mesh has them."""
+        n = len(prim)
+        t, sign, found = np.zeros((n, 3)), np.ones(n), np.zeros(n, bool)
+        for sel, _, mesh, tri in self._groups(prim):
+            data = mesh.attributes.get("tangent:" + uv_map)
+            if data is not None:
+                v = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
+                t[sel], sign[sel], found[sel] = v[:, :3], np.where(v[:, 3] < 0, -1.0, 1.0), True
+        return t, sign, found
 
     def bary_shift(self, prim, dp):
         """Barycentric change for a world-space step dp in the triangle's plane."""
@@ -297,7 +363,8 @@ VIEW_COORDS = ("incoming", "reflection", "true_normal")
 
 
 def views(program, refs) -> bool:
-    """Whether the program outputs ``refs`` depend on the direction the hit is seen from."""
+    """Whether the program outputs ``refs`` depend on the direction the hit is seen from (or on the
+    pixel's footprint there, as a Wireframe in pixels)."""
     stack, seen = [r[0] for r in refs], set()
     while stack:
         i = stack.pop()
@@ -305,7 +372,8 @@ def views(program, refs) -> bool:
             continue
         seen.add(i)
         node = program.nodes[i]
-        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") in VIEW_COORDS):
+        if node.op in VIEW_OPS or (node.op == "coord" and node.params.get("name") in VIEW_COORDS) \
+                or (node.op == "wireframe" and node.params.get("pixel_size")):
             return True
         stack.extend(r[0] for r in node.inputs if r is not None)
     return False
@@ -318,7 +386,8 @@ class MaterialShading:
         self.material = material
         self.textures = textures
         self.shader = MaterialShader(material)
-        self.varying = material.program is not None and any(c.inputs for c in material.closures)
+        self.displaced = material.program is not None and material.displacement is not None
+        self.varying = material.program is not None and (any(c.inputs for c in material.closures) or self.displaced)
         self.normal_ref = next((c.inputs["normal"] for c in material.closures if "normal" in c.inputs), None)
         self.emitters = [c for c in material.closures if c.kind in ("EMISSION", "PRINCIPLED")
                          and ("emission" in c.inputs or ("weight" in c.inputs and np.any(c.emission > 0)))]
@@ -329,8 +398,9 @@ class MaterialShading:
         if self.varying_emission and views(material.program, [r for c in self.emitters for k, r in c.inputs.items()
                                                                if k in ("emission", "weight")]):
             self.warnings.append(f"material '{material.name}': its emission uses Fresnel, Layer Weight, the "
-                                 "incoming or reflected direction or which side is seen, which DRT's emission "
-                                 "does not see yet: evaluated as if seen along the surface normal")
+                                 "incoming or reflected direction, which side is seen or a Wireframe in pixels, "
+                                 "which DRT's emission does not see yet: evaluated as if seen along the surface "
+                                 "normal, without a pixel footprint")
 
     @property
     def emission(self):
@@ -338,7 +408,7 @@ class MaterialShading:
 
     def emission_at(self, ctx: SurfaceContext) -> np.ndarray:
         """(N, 3) emitted radiance of a material with varying emission at the points of ``ctx``."""
-        ev = Evaluator(self.material.program, ctx, self.textures)
+        ev = Evaluator(self.material.program, self._displaced(ctx), self.textures)
         total = np.zeros((ctx.n, 3))
         for c in self.material.closures:
             if c.kind not in ("EMISSION", "PRINCIPLED"):
@@ -352,8 +422,9 @@ class MaterialShading:
         """[(hit indices, shader bound to them)] and the per-hit shading normal (or None)."""
         if not self.varying:
             return [(np.arange(ctx.n), self.shader)], None
+        ctx = self._displaced(ctx)
         ev = Evaluator(self.material.program, ctx, self.textures)
-        normal = ev(self.normal_ref) if self.normal_ref is not None else None
+        normal = ev(self.normal_ref) if self.normal_ref is not None else ctx.normal if self.displaced else None
         linear = {}
         keyed = []
         for i, c in enumerate(self.material.closures):
@@ -378,6 +449,13 @@ class MaterialShading:
             values = {i: {name: v[rows] for name, v in d.items()} for i, d in linear.items()}
             out.append((rows, shader.bind(values) if values else shader))
         return out, normal
+
+    def _displaced(self, ctx: SurfaceContext) -> SurfaceContext:
+        """The hits with their normal bumped by the material's displacement, as Cycles evaluates
+        its bump before the surface shader (whose nodes then see the bumped normal)."""
+        if not self.displaced:
+            return ctx
+        return ctx.turned(Evaluator(self.material.program, ctx, self.textures)(self.material.displacement))
 
     def _quantise(self, keyed):
         """Distinct rounded values of the keyed inputs: steps of 1/QUANTUM, coarsened by halves
