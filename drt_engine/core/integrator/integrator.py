@@ -24,9 +24,10 @@ from ..geometry import camera as camera_rays
 from ..geometry.accel import spawn
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
-from .mis import add_emitted, power_heuristic
+from .direct import direct_light
+from .mis import add_emitted
 from .ratio import RatioEstimator
-from .records import PathState, Samples, ShadowRays, SurfaceHits
+from .records import LightSamples, PathState, Samples, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
@@ -141,23 +142,26 @@ class Integrator:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
-            shadows, continued = [], []
-            for group, u_g, shader in self._bind_materials(surf, u, hits):
+            bound = list(self._bind_materials(surf, u, hits))
+            lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
+            light, start = self._sample_lights(lit) if lit else None, 0
+            continued = []
+            for group, u_g, shader in bound:
                 if depth == 0:
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
-                if self.lights.strategies and shader.lobes:
+                if light is not None and shader.lobes:
                     # the terminator lift is for diffuse shading over coarse facets (measured on
                     # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
                     diffuse = any(lobe.kind == "diffuse" for lobe in shader.lobes)
                     lift = self.geometry.smooth_offset(hits, group.row, ray_times) if diffuse else None
-                    shadows += self._direct(shader, group, u_g, lift, out)
+                    self._direct(shader, group, light.take(slice(start, start + len(group))), lift, out)
+                    start += len(group)
                 if shader.can_continue and depth < s.max_depth:
                     nxt = self._continue(shader, group, u_g)
                     if nxt is not None:
                         continued.append(nxt)
-            self._resolve_shadows(shadows, times, out)
             if not continued:
                 break
             state = PathState.concat(continued)
@@ -333,59 +337,44 @@ class Integrator:
                 yield group.take(sub), u_g.take(sub), shader
 
     # -- next-event estimation ----------------------------------------------------------
-    def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
-        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy, each
-        batch shown to the wave's ratio estimator when there is one (core.integrator.ratio)."""
+    def _sample_lights(self, lit) -> LightSamples:
+        """Every light strategy sampled at the hits of one depth step that have lobes (``lit``:
+        (hits, their samples) per shader), for all shaders at once and in their order; the
+        world around each hit's shading normal (a normal program's where there is one)."""
         lights = self.lights
-        out = []
-        time = hits.time if self.timed else None
-        sel_lobes = shader.selection(hits.wo_l[:, 2]) if shader.sampled else None
-        emissive = lights.light_slots if len(lights.emissive) else -1
-        for k in range(lights.strategies):
-            u_pick = u.choice[emissive] if emissive >= 0 else None
-            # the world is sampled around the shading normal, the one the BSDF's cosine follows
-            ls = lights.sample(k, hits.pos, hits.ns, u.point[k], u_pick, u.choice[k] if lights.selecting else None,
-                               time)
-            ok = vec.max3(ls.value) > 0
-            if not ok.any():
-                continue
-            wi_l = hits.frame.to_local(ls.wi)
-            above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
-            f = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
-            f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
-            w_l = power_heuristic(ls.pdf, f.pdf)
-            contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
-            ok &= vec.max3(contrib) > 0
-            sel = np.flatnonzero(ok)
-            if wave.ratio is not None:
-                wave.ratio.shadow_rays(k, shader, hits, sel_lobes, ls.value, f_diff, sel)
-            if len(sel) == 0:
-                continue
-            scale = hits.scale[sel]
-            lift_s = np.zeros((len(sel), 3)) if lift is None else lift[sel]
-            origin = _shadow_origin(hits.pos[sel], hits.ng[sel], ls.wi[sel], wi_l[sel, 2], lift_s, scale)
-            dist = ls.dist[sel]
-            stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
-            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
-            out.append(ShadowRays(path=hits.path[sel], origins=origin, dirs=ls.wi[sel], tmax=np.maximum(tmax, 0.0),
-                                  contrib=contrib[sel]))
-        return out
 
-    def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
-        """Trace the shadow rays of a depth step and add the unblocked ones' light."""
-        if not shadows:
-            return
-        rays = ShadowRays.concat(shadows)
-        self._count("shadow", len(rays))
-        blocked = self.geometry.occluded(rays.origins, rays.dirs, rays.tmax, times[rays.path])
-        # area lights are not geometry: a nearer area light does not block (lights cast shadows
-        # of each other's bodies in Cycles only when they are meshes, so it does not here)
-        visible = ~blocked
-        n = len(out.radiance)
-        for c in range(3):
-            out.radiance[:, c] += np.bincount(rays.path[visible], weights=rays.contrib[visible, c], minlength=n)
-        if out.ratio is not None:
-            out.ratio.resolved(rays.path, visible)
+        def joined(arrays):
+            return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
+
+        hits = [group for group, _ in lit]
+        pos, normal = joined([h.pos for h in hits]), joined([h.ns for h in hits])
+        time = joined([h.time for h in hits]) if self.timed else None
+        emissive = lights.light_slots if len(lights.emissive) else -1
+        u_pick = joined([u.choice[emissive] for _, u in lit]) if emissive >= 0 else None
+        samples = LightSamples.empty(lights.strategies, len(pos))
+        for k in range(lights.strategies):
+            chosen = lights.selecting and lit[0][1].choice[k] is not None
+            u_light = joined([u.choice[k] for _, u in lit]) if chosen else None
+            samples.put(k, lights.sample(k, pos, normal, joined([u.point[k] for _, u in lit]), u_pick, u_light, time))
+        return samples
+
+    def _direct(self, shader, hits: SurfaceHits, light: LightSamples, lift, wave: WaveOutput):
+        """Direct light at the hits of one shader, every strategy's shadow ray traced in the
+        kernel (core.integrator.direct); what the wave's ratio estimator needs, when there is one,
+        shown to it after (core.integrator.ratio)."""
+        n = len(hits)
+        keep = 0 if wave.ratio is None else n
+        f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
+        frame = np.ascontiguousarray(np.stack([hits.frame.t, hits.frame.b, hits.frame.n], axis=1))
+        traced = direct_light(
+            shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(hits.pos),
+            _c(hits.ng), frame, _c(hits.wo_l), _c(hits.inside), _c(hits.scale), _c(hits.throughput), _c(hits.path),
+            np.zeros((n, 3)) if lift is None else _c(lift), *light.arrays(), self.geometry.handle,
+            self.geometry.center, self.geometry.time_values(hits.time if self.timed else None), wave.radiance,
+            f_diff, visibility)
+        self._count("shadow", traced)
+        if wave.ratio is not None:
+            wave.ratio.direct(shader, hits, light.value, f_diff, visibility)
 
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
@@ -412,19 +401,5 @@ class Integrator:
                          straight=hits.straight[sel] & passthrough, time=hits.time[sel])
 
 
-TERMINATOR_CUTOFF = 0.1
-"""Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
-terminator geometry offset)."""
-
-
-def _shadow_origin(pos, ng, wi, cos_shading, lift, scale):
-    """Shadow-ray origin: on the side of the surface the shading normal puts wi, lifted by
-    ``lift`` toward the smooth surface near the terminator (Cycles' rule, faded in by the
-    cosines) so that light the shading normal sees is not cut off by the flat facet."""
-    cos_geo = vec.dot(ng, wi)
-    c = TERMINATOR_CUTOFF
-    amount = np.where(cos_shading < c, np.clip(2.0 - (cos_geo + cos_shading) / c, 0.0, 1.0),
-                      np.clip(1.0 - cos_geo / c, 0.0, 1.0))
-    amount = np.where(cos_shading > 0, amount, 0.0)
-    side = np.where(cos_shading > 0, 1.0, -1.0)[:, None] * ng
-    return spawn(pos + lift * amount[:, None], ng, side, scale)
+def _c(a):
+    return np.ascontiguousarray(a)
