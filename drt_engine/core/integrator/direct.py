@@ -14,7 +14,7 @@ import numpy as np
 from ..base.jit import kernel
 from ..bsdf.mixture import eval_lobes, selection
 from ..geometry import embree
-from ..geometry.accel import blocked, spawn_point
+from ..geometry.accel import blocked, lift, spawn_point
 from .mis import power
 
 TERMINATOR_CUTOFF = 0.1
@@ -56,13 +56,16 @@ def shadow_origin(px, py, pz, gx, gy, gz, wx, wy, wz, cos_shading, lx, ly, lz, s
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, lift,
-                 wi, dist, value, pdf, stop, restrict, scene, center, times, radiance, f_diff, visibility):
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, geo, prim,
+                 u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times, radiance, f_diff,
+                 visibility):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays traced.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
-    normal rows), wo in that frame, inside, offset scale, throughput, path, terminator lift.
+    normal rows), wo in that frame, inside, offset scale, throughput, path, and the triangle and
+    barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
+    (core.geometry.accel.lift).
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
     to stop short of an emitter that is geometry, and the BSDF parts each strategy lights
     (``restrict``). ``times``: each hit's shutter time (empty when nothing moves).
@@ -70,12 +73,16 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     estimator reads them): the diffuse part toward each sample and what became of its ray.
     """
     rayhit = embree.new_rayhit()
+    scratch = np.empty((2, 3, 4))
     sel = np.empty((1, max(n_sampled, 1)))
     keep = f_diff.shape[1] > 0
     traced = 0
     for j in range(len(pos)):
         selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0)
         time = times[j] if len(times) else 0.5
+        hx = hy = hz = 0.0
+        if lifted:
+            hx, hy, hz = lift(geo, prim[j], u[j], v[j], time, scratch)
         s0 = s1 = s2 = 0.0
         for k in range(wi.shape[0]):
             if keep:
@@ -104,8 +111,8 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
             if not _positive(c0, c1, c2):
                 continue
-            ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, lz,
-                                       lift[j, 0], lift[j, 1], lift[j, 2], scale[j])
+            ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, lz, hx, hy,
+                                       hz, scale[j])
             tmax = math.inf
             if not math.isinf(dist[k, j]):
                 tmax = max(dist[k, j] * (1.0 - 1e-6) - stop[k, j] - scale[j], 0.0)

@@ -24,7 +24,9 @@ from ..geometry import camera as camera_rays
 from ..geometry.accel import spawn
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
+from .continuation import continue_paths
 from .direct import direct_light
+from .hits import surface_hits
 from .mis import add_emitted
 from .ratio import RatioEstimator
 from .records import LightSamples, PathState, Samples, SurfaceHits
@@ -152,11 +154,7 @@ class Integrator:
                 if out.features is not None:
                     out.features.surface(group, shader)
                 if light is not None and shader.lobes:
-                    # the terminator lift is for diffuse shading over coarse facets (measured on
-                    # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
-                    diffuse = any(lobe.kind == "diffuse" for lobe in shader.lobes)
-                    lift = self.geometry.smooth_offset(hits, group.row, ray_times) if diffuse else None
-                    self._direct(shader, group, light.take(slice(start, start + len(group))), lift, out)
+                    self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out)
                     start += len(group)
                 if shader.can_continue and depth < s.max_depth:
                     nxt = self._continue(shader, group, u_g)
@@ -228,20 +226,19 @@ class Integrator:
             add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
 
     def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
-        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
-        pos, ng, ns = self.geometry.surface(hits, rows, ray_times)
+        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray
+        (core.integrator.hits)."""
+        n = len(rows)
+        pos, ng, frame, wo_l, normal = (np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3)),
+                                        np.empty((n, 3)))
+        inside, scale = np.empty(n, bool), np.empty(n)
+        surface_hits(self.geometry.tables, hits.prim, hits.u, hits.v, self.geometry.time_values(ray_times),
+                     rows, state.dirs, pos, ng, frame, wo_l, inside, scale, normal)
         prim = hits.prim[rows]
-        wo = -state.dirs[rows]
-        inside = vec.dot(wo, ng) < 0
-        flip = np.where(inside, -1.0, 1.0)[:, None]
-        ng_o, ns_o = ng * flip, ns * flip
-        bad = vec.dot(wo, ns_o) <= 1e-6
-        ns_o[bad] = ng_o[bad]
-        frame = Frame.about(ns_o)
         return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material[prim], pos=pos,
-                           ng=ng_o, frame=frame, wo=wo, wo_l=frame.to_local(wo), inside=inside,
-                           scale=self.geometry.offset_scale(prim, pos), throughput=state.throughput[rows],
-                           straight=state.straight[rows], time=state.time[rows], normal=ns)
+                           ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
+                           wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
+                           straight=state.straight[rows], time=state.time[rows], normal=normal)
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
@@ -358,47 +355,49 @@ class Integrator:
             samples.put(k, lights.sample(k, pos, normal, joined([u.point[k] for _, u in lit]), u_pick, u_light, time))
         return samples
 
-    def _direct(self, shader, hits: SurfaceHits, light: LightSamples, lift, wave: WaveOutput):
+    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
         kernel (core.integrator.direct); what the wave's ratio estimator needs, when there is one,
         shown to it after (core.integrator.ratio)."""
-        n = len(hits)
+        n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
-        frame = np.ascontiguousarray(np.stack([hits.frame.t, hits.frame.b, hits.frame.n], axis=1))
+        # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
+        # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
+        lifted = len(self.geometry.tables[3]) > 0 and any(lobe.kind == "diffuse" for lobe in shader.lobes)
+        geo = self.geometry
         traced = direct_light(
-            shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(hits.pos),
-            _c(hits.ng), frame, _c(hits.wo_l), _c(hits.inside), _c(hits.scale), _c(hits.throughput), _c(hits.path),
-            np.zeros((n, 3)) if lift is None else _c(lift), *light.arrays(), self.geometry.handle,
-            self.geometry.center, self.geometry.time_values(hits.time if self.timed else None), wave.radiance,
-            f_diff, visibility)
+            shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
+            _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
+            _c(group.path), geo.tables, group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
+            geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
+            visibility)
         self._count("shadow", traced)
         if wave.ratio is not None:
-            wave.ratio.direct(shader, hits, light.value, f_diff, visibility)
+            wave.ratio.direct(shader, group, light.value, f_diff, visibility)
 
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
-        """The paths of these hits continued through one sampled lobe (None if none goes on)."""
-        bs = shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside)
-        new_thr = hits.throughput * bs.weight
-        sel = np.flatnonzero(bs.valid & (vec.max3(new_thr) > 0))
-        wi = hits.frame[sel].to_world(bs.wi_l[sel])
-        # a sampled direction on the wrong side of the geometric surface would leak light
-        transmit = bs.wi_l[sel, 2] < 0
-        geo_ok = (vec.dot(wi, hits.ng[sel]) < 0) == transmit
-        sel, wi, transmit = sel[geo_ok], wi[geo_ok], transmit[geo_ok]
+        """The paths of these hits continued through one sampled lobe (None if none goes on;
+        core.integrator.continuation)."""
+        n = len(hits)
+        go, passthrough, transmit = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
+        origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
+                       _c(hits.frame.m),
+                       _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
+                       _c(hits.pos), _c(hits.ng), _c(hits.scale), go, origin, wi, weight, prev_pdf, passthrough,
+                       transmit)
+        sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
-        passthrough = bs.passthrough[sel]
-        origin = spawn(hits.pos[sel], hits.ng[sel], wi, hits.scale[sel])
+        passthrough, transmit = passthrough[sel], transmit[sel]
         self._count("refraction", (transmit & ~passthrough).sum())
         self._count("reflection", (~transmit).sum())
         self._count("transparent", passthrough.sum())
-        n = len(sel)
-        return PathState(path=hits.path[sel], origins=origin, dirs=wi, tmax=np.full(n, np.inf),
-                         throughput=new_thr[sel], prev_pdf=np.where(bs.delta[sel], np.inf, bs.pdf[sel]),
-                         prev_normal=hits.ng[sel], prev_shading=hits.ns[sel],
-                         straight=hits.straight[sel] & passthrough, time=hits.time[sel])
+        return PathState(path=hits.path[sel], origins=origin[sel], dirs=wi[sel], tmax=np.full(len(sel), np.inf),
+                         throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],
+                         prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel])
 
 
 def _c(a):
