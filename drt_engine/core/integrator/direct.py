@@ -15,15 +15,12 @@ from ..base.jit import kernel
 from ..bsdf.mixture import eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
+from ..lights.strategies import UNRESTRICTED
 from .mis import power
 
 TERMINATOR_CUTOFF = 0.1
 """Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
 terminator geometry offset)."""
-
-UNRESTRICTED = -1
-"""A light strategy that lights every BSDF part (``restrict[k, 0]``); otherwise the row holds
-whether it lights the diffuse, reflection and transmission parts (the world's ray visibility)."""
 
 NOT_TRACED, BLOCKED, VISIBLE = -1, 0, 1
 """What became of the shadow ray of a hit and strategy (``visibility``, for the ratio estimator)."""

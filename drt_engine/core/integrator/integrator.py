@@ -21,7 +21,7 @@ from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
-from ..geometry.accel import spawn
+from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
 from .continuation import continue_paths
@@ -29,7 +29,7 @@ from .direct import direct_light
 from .hits import surface_hits
 from .mis import add_emitted
 from .ratio import RatioEstimator
-from .records import LightSamples, PathState, Samples, SurfaceHits
+from .records import PathState, Samples, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
@@ -38,19 +38,24 @@ _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB
 
 @dataclass
 class StepSamples:
-    """The sample values the hits of one depth step use, one row per hit: per light strategy
-    k the point on the light (``point[k]``, (N, 2)) and the choice of light or triangle
-    (``choice[k]``, or None), valid where the material casts shadow rays; the lobe direction
-    (N, 2) and lobe choice (N,), valid where the path continues."""
+    """The sample values the hits of one depth step use, one row per hit: ``light`` (N, S, 2, 2),
+    per light strategy k the point on the light ``[:, k, 0]`` and the choice of light or
+    triangle ``[:, k, 1, 0]``, valid where the material casts shadow rays; ``path`` (N, 2, 2),
+    the lobe direction ``[:, 0]`` and the lobe choice ``[:, 1, 0]``, valid where the path continues."""
 
-    point: list
-    choice: list
-    lobe: np.ndarray
-    lobe_choice: np.ndarray
+    light: np.ndarray
+    path: np.ndarray
+
+    @property
+    def lobe(self) -> np.ndarray:
+        return self.path[:, 0]
+
+    @property
+    def lobe_choice(self) -> np.ndarray:
+        return self.path[:, 1, 0]
 
     def take(self, rows) -> "StepSamples":
-        return StepSamples([p[rows] for p in self.point], [None if c is None else c[rows] for c in self.choice],
-                           self.lobe[rows], self.lobe_choice[rows])
+        return StepSamples(self.light[rows], self.path[rows])
 
 
 @dataclass
@@ -277,34 +282,27 @@ class Integrator:
 
     # -- sample values of one depth step ------------------------------------------------
     def _draw(self, depth, pixel, sample, mat, sampler, bounce) -> StepSamples:
-        """Every sample value the hits of one depth step use, drawn in one call per dimension
-        for all materials at once (values are per (pixel, sample, dimension), so drawing them
+        """Every sample value the hits of one depth step use, drawn in two calls for all materials
+        and strategies at once (values are per (pixel, sample, dimension), so drawing them
         together gives the very numbers drawing per material would)."""
         n = len(pixel)
         lights = self.lights
+        light = np.zeros((n, lights.strategies, 2, 2))
         lit = np.flatnonzero(self.prepared.lit[mat]) if lights.strategies else np.zeros(0, np.int64)
-        whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats gathering
-
-        def subset(get, dim, shape):
-            if whole:
-                return get(pixel, sample, dim)
-            values = np.zeros(shape)
-            values[lit] = get(pixel[lit], sample[lit], dim)
-            return values
-
-        point, choice = [], []
         if len(lit):
             emissive = lights.light_slots if len(lights.emissive) else -1
+            dims = np.full((lights.strategies, 2), -1, np.int64)
             for k in range(lights.strategies):
-                point.append(subset(sampler.get2d, self.light_dims.point(depth, k), (n, 2)))
-                chooses = k == emissive or (lights.selecting and k < lights.light_slots)
-                choice.append(subset(sampler.get, self.light_dims.choice(depth, k), n) if chooses else None)
+                dims[k, 0] = self.light_dims.point(depth, k)
+                if k == emissive or (lights.selecting and k < lights.light_slots):
+                    dims[k, 1] = self.light_dims.choice(depth, k)
+            whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats listing them
+            sampler.pairs(pixel, sample, dims, None if whole else lit, light.reshape(n, -1, 2))
+        path = np.zeros((n, 2, 2))
         go = np.flatnonzero(self.prepared.continues[mat]) if bounce else np.zeros(0, np.int64)
-        lobe, lobe_choice = np.zeros((n, 2)), np.zeros(n)
         if len(go):
-            lobe[go] = sampler.get2d(pixel[go], sample[go], D.lobe(depth))
-            lobe_choice[go] = sampler.get(pixel[go], sample[go], D.lobe_choice(depth))
-        return StepSamples(point, choice, lobe, lobe_choice)
+            sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
+        return StepSamples(light, path)
 
     def _bind_materials(self, surf: SurfaceHits, u: StepSamples, hits):
         """(hits, their samples, shader) per material: a slice of
@@ -338,22 +336,13 @@ class Integrator:
         """Every light strategy sampled at the hits of one depth step that have lobes (``lit``:
         (hits, their samples) per shader), for all shaders at once and in their order; the
         world around each hit's shading normal (a normal program's where there is one)."""
-        lights = self.lights
-
         def joined(arrays):
             return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
 
         hits = [group for group, _ in lit]
-        pos, normal = joined([h.pos for h in hits]), joined([h.ns for h in hits])
-        time = joined([h.time for h in hits]) if self.timed else None
-        emissive = lights.light_slots if len(lights.emissive) else -1
-        u_pick = joined([u.choice[emissive] for _, u in lit]) if emissive >= 0 else None
-        samples = LightSamples.empty(lights.strategies, len(pos))
-        for k in range(lights.strategies):
-            chosen = lights.selecting and lit[0][1].choice[k] is not None
-            u_light = joined([u.choice[k] for _, u in lit]) if chosen else None
-            samples.put(k, lights.sample(k, pos, normal, joined([u.point[k] for _, u in lit]), u_pick, u_light, time))
-        return samples
+        return self.lights.sample_all(joined([h.pos for h in hits]), joined([h.ns for h in hits]),
+                                      joined([u.light for _, u in lit]),
+                                      joined([h.time for h in hits]) if self.timed else None)
 
     def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the

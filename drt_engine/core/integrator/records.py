@@ -9,7 +9,6 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from ..base.vectors import Frame
-from .direct import UNRESTRICTED
 
 
 def _take(record, rows):
@@ -104,43 +103,3 @@ class SurfaceHits:
         return self.frame.n
 
     take = _take
-
-
-@dataclass
-class LightSamples:
-    """Every light strategy's sample at the hits of one depth step, strategy by hit: direction,
-    distance (inf for distant), value (radiance / pdf; zero where nothing was sampled), pdf, the
-    distance to stop short of an emitter that is geometry, and per strategy the BSDF parts it
-    lights (core.integrator.direct's ``restrict``)."""
-
-    wi: np.ndarray
-    dist: np.ndarray
-    value: np.ndarray
-    pdf: np.ndarray
-    stop: np.ndarray
-    restrict: np.ndarray
-
-    @classmethod
-    def empty(cls, strategies: int, n: int) -> "LightSamples":
-        return cls(np.zeros((strategies, n, 3)), np.zeros((strategies, n)), np.zeros((strategies, n, 3)),
-                   np.zeros((strategies, n)), np.zeros((strategies, n)), np.full((strategies, 3), UNRESTRICTED, np.int8))
-
-    @property
-    def strategies(self) -> int:
-        return len(self.wi)
-
-    def put(self, k: int, sample) -> None:
-        """Strategy k's sample (a core.lights.collection.LightSample) at every hit."""
-        self.wi[k], self.dist[k], self.value[k], self.pdf[k] = sample.wi, sample.dist, sample.value, sample.pdf
-        if sample.tmax_scale is not None:
-            self.stop[k] = sample.tmax_scale
-        if sample.lobes is not None:
-            self.restrict[k] = sample.lobes
-
-    def take(self, rows) -> "LightSamples":
-        return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
-                            self.stop[:, rows], self.restrict)
-
-    def arrays(self) -> tuple:
-        """The fields, contiguous, in the order core.integrator.direct's kernel takes them."""
-        return tuple(np.ascontiguousarray(getattr(self, f.name)) for f in fields(self))
