@@ -6,6 +6,12 @@ direct light at every hit with one shadow ray per light strategy, and continues 
 through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
 Stages pass named records (core.integrator.records); every random number comes from the sampler the
 caller hands to ``trace``, at the dimensions core.sampling.dims lays out.
+
+A depth step is a few kernel calls over the wave's arrays: the closest hits (Embree from the
+kernel), the surface hits (integrator.hits), the step's sample values (two calls), every light
+strategy's samples (lights.strategies), and per material the direct light with its shadow rays
+traced in place (integrator.direct) and the continuation (integrator.continuation); between
+them only what shader programs compute (NumPy, per material) and the emission rays find.
 """
 from __future__ import annotations
 

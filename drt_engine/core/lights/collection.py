@@ -9,9 +9,10 @@ lights, emissive triangles and the world can also be hit by continued rays, and 
 The per-ray arithmetic is in kernels: each light kind's in its own module (lights.point,
 lights.sun, lights.area, behind the switch in lights.kinds, over one flat table of lights,
 lights.table), emissive triangles' in lights.triangles, the choice among many lights in
-lights.choice, the environment map's in lights.environment, the world's in lights.world. The methods
-here call one batch loop per wave and strategy (below too, with the table lights' closed-form
-unoccluded light for the ratio estimator); shader programs (textured emission, the
+lights.choice, the environment map's in lights.environment, the world's in lights.world. Every
+strategy is sampled in one kernel call per depth step (lights.strategies); hits and densities
+of rays that found a light are one batch loop per wave (below, with the table lights'
+closed-form unoccluded light for the ratio estimator); shader programs (textured emission, the
 environment's radiance) stay NumPy.
 """
 from __future__ import annotations
