@@ -8,13 +8,14 @@ checked to differ from their unclipped integral, so dropping the clip fails them
 import math
 from dataclasses import replace
 
+import numba
 import numpy as np
 import pytest
 
 from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _sample_batch, closed_forms, unoccluded_batch
 from drt_engine.core.scene import Light
-from drt_engine.core.lights.triangles import sample_emissive_batch, unoccluded_triangles_batch
+from drt_engine.core.lights.triangles import pick_triangle, sample_triangle, unoccluded_triangles_batch
 
 REL = 1e-6
 _X, _W = np.polynomial.legendre.leggauss(10)
@@ -474,13 +475,27 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
     rng, means = np.random.default_rng(9), []
     for _ in range(32):
         u = stratified(64, rng)
-        wi, _, value, *_ = sample_emissive_batch(verts, tris, ng, area, ids, np.cumsum(prob), prob, emission,
-                                                  np.tile(np.asarray(p, float), (len(u), 1)), u,
-                                                  rng.random(len(u)))
+        wi, value = _emissive_samples(verts, tris, ng, area, ids, np.cumsum(prob), prob, emission,
+                                      np.asarray(p, float), u, rng.random(len(u)))
         means.append((value * np.maximum(wi @ unit(n), 0.0)[:, None]).mean(axis=0))
     means = np.array(means)
     err = means.std(axis=0, ddof=1) / math.sqrt(len(means))
     assert (np.abs(out[0] - means.mean(axis=0)) <= 5 * err).all(), (out[0], means.mean(axis=0), err)
+
+
+@numba.njit
+def _emissive_samples(verts, tris, ng, area, ids, cdf, prob, emission, p, u, u_pick):
+    """Directions and values (emission / pdf where the triangle faces p) of the emissive strategy's
+    samples at p, as lights.strategies draws them."""
+    wi, value = np.zeros((len(u), 3)), np.zeros((len(u), 3))
+    for j in range(len(u)):
+        i = pick_triangle(ids, cdf, u_pick[j])
+        wx, wy, wz, _, pdf, _, _, cos_l = sample_triangle(verts, tris, ng, area, prob, i, p[0], p[1], p[2], u[j, 0],
+                                                          u[j, 1])
+        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
+        if cos_l > 0:
+            value[j] = emission[i] / pdf
+    return wi, value
 
 
 # -- the contract ----------------------------------------------------------------------------------------------

@@ -55,21 +55,32 @@ def orthonormal_basis(n):
 
 @dataclass(frozen=True)
 class Frame:
-    """Orthonormal frames, one per row: tangent ``t``, bitangent ``b`` and normal ``n``, (N, 3)
-    each. Shading works in the local frame (normal along +z); a frame carries both ways across."""
+    """Orthonormal frames, one per row of ``m`` (N, 3, 3): tangent ``t``, bitangent ``b`` and
+    normal ``n`` as its rows (the layout kernels read). Shading works in the local frame (normal
+    along +z); a frame carries both ways across."""
 
-    t: np.ndarray
-    b: np.ndarray
-    n: np.ndarray
+    m: np.ndarray
 
     @classmethod
     def about(cls, n) -> "Frame":
         """The frame completing each unit row of ``n`` (``orthonormal_basis``)."""
         t, b = orthonormal_basis(n)
-        return cls(t, b, n)
+        return cls(np.stack([t, b, n], axis=1))
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.m[:, 0]
+
+    @property
+    def b(self) -> np.ndarray:
+        return self.m[:, 1]
+
+    @property
+    def n(self) -> np.ndarray:
+        return self.m[:, 2]
 
     def __getitem__(self, rows) -> "Frame":
-        return Frame(self.t[rows], self.b[rows], self.n[rows])
+        return Frame(self.m[rows])
 
     def to_local(self, v):
         """World rows of ``v`` in each row's frame."""

@@ -452,7 +452,7 @@ class MaterialShader:
         bound.hp, bound.bound = hp, True
         return bound
 
-    def _rows(self, n, rows) -> np.ndarray:
+    def hit_rows(self, n, rows=None) -> np.ndarray:
         """Row of ``hp`` each of n rays reads."""
         if not self.bound:
             return np.zeros(n, np.int64)
@@ -462,7 +462,7 @@ class MaterialShader:
     def selection(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L) probabilities of continuing through each non-diffuse lobe."""
         out = np.zeros((len(mu_o), len(self.sampled)))
-        selection_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        selection_rows(self.lp, self.lt, self.hp, self.hit_rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
         return out
 
     # -- evaluation -----------------------------------------------------------------
@@ -482,7 +482,7 @@ class MaterialShader:
         f_diff = np.empty((n, 3))
         f_nd = np.empty((n, 3))
         pdf = np.empty(n)
-        evaluate_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(wi),
+        evaluate_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(wo), _floats(wi),
                       _bools(above), _bools(inside), _floats(sel), f_diff, f_nd, pdf)
         return BsdfValue(diffuse=f_diff, glossy=f_nd, pdf=pdf)
 
@@ -503,7 +503,7 @@ class MaterialShader:
         delta = np.empty(n, bool)
         valid = np.empty(n, bool)
         passthrough = np.empty(n, bool)
-        sample_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(wo), _floats(u_select),
+        sample_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(wo), _floats(u_select),
                     _floats(u2), _bools(inside), wi, weight, pdf, delta, valid, passthrough,
                     len(self.sampled))
         return BsdfSample(wi_l=wi, weight=weight, pdf=pdf, delta=delta, valid=valid, passthrough=passthrough)
@@ -514,7 +514,7 @@ class MaterialShader:
         n = len(mu_o)
         diff = np.empty((n, 3))
         gloss = np.empty((n, 3))
-        colours_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
+        colours_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
         return diff, gloss
 
     def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
@@ -524,7 +524,7 @@ class MaterialShader:
         diff = np.empty((n, 3))
         spec = np.empty((n, 3))
         take = np.empty(n, bool)
-        denoising_rows(self.lp, self.lt, self.hp, self._rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
+        denoising_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
                        diff, spec, take)
         return diff, spec, take
 
@@ -532,5 +532,5 @@ class MaterialShader:
         """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,
         per-hit scale) times its multiple-scattering factor, what the albedo tables decide."""
         out = np.empty((len(mu_o), len(self.lobes), 3))
-        weights_rows(self.lp, self.lt, self.hp, self._rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        weights_rows(self.lp, self.lt, self.hp, self.hit_rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
         return out

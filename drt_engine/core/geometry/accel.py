@@ -302,6 +302,11 @@ class Geometry:
         """The top-level Embree scene (None when there is nothing to hit)."""
         return self._top
 
+    @property
+    def handle(self) -> int:
+        """The top-level Embree scene's handle for kernels (``blocked``); 0 when there is nothing to hit."""
+        return 0 if self._top is None else self._top.handle
+
     def ray_times(self, time) -> RayTimes:
         """The times as a RayTimes (None when nothing moves)."""
         if isinstance(time, RayTimes):
@@ -313,7 +318,7 @@ class Geometry:
         hits = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
         if self._top is not None and n:
             _intersects(self._top.handle, self.tables, np.asarray(origins, np.float64),
-                        np.asarray(directions, np.float64), np.asarray(tmax, np.float64), self._time_values(time),
+                        np.asarray(directions, np.float64), np.asarray(tmax, np.float64), self.time_values(time),
                         hits.t, hits.prim, hits.u, hits.v)
         return hits
 
@@ -322,14 +327,14 @@ class Geometry:
         blocked = np.zeros(n, dtype=bool)
         if self._top is not None and n:
             _occludeds(self._top.handle, np.asarray(origins, np.float64), np.asarray(directions, np.float64),
-                       np.asarray(tmax, np.float64), self._time_values(time), self.center, blocked)
+                       np.asarray(tmax, np.float64), self.time_values(time), self.center, blocked)
         return blocked
 
     def surface(self, hits: Hits, index: np.ndarray, time=None):
         """Float64 world position, geometric and shading normal of hits[index]."""
         n = len(index)
         out = np.empty((n, 9))
-        _surfaces(self.tables, hits.prim, hits.u, hits.v, self._time_values(time), np.asarray(index), out)
+        _surfaces(self.tables, hits.prim, hits.u, hits.v, self.time_values(time), np.asarray(index), out)
         return out[:, 0:3], out[:, 3:6], out[:, 6:9]
 
     def smooth_offset(self, hits: Hits, index: np.ndarray, time=None) -> np.ndarray:
@@ -338,10 +343,11 @@ class Geometry:
         out = np.zeros((len(index), 3))
         if len(self.tables[3]) == 0 or len(index) == 0:
             return out
-        _lifts(self.tables, hits.prim, hits.u, hits.v, self._time_values(time), np.asarray(index), out)
+        _lifts(self.tables, hits.prim, hits.u, hits.v, self.time_values(time), np.asarray(index), out)
         return out
 
-    def _time_values(self, time) -> np.ndarray:
+    def time_values(self, time) -> np.ndarray:
+        """Each ray's shutter time for the kernels; empty when nothing moves (they then use 0.5)."""
         if not self.moving or time is None:
             return np.zeros(0)
         return self.ray_times(time).values
@@ -582,13 +588,22 @@ def refine(geo, prim, ox, oy, oz, dx, dy, dz, time, t, u, v, scratch):
     return (fx * qx + fy * qy + fz * qz) / det, u64, v64
 
 
+@kernel(inline="always")
+def blocked(scene, center, rayhit, ox, oy, oz, dx, dy, dz, tmax, time):
+    """Whether geometry lies on the ray from the float64 world origin before tmax at ``time``
+    (the top-level scene ``scene``, 0 when there is none; rayhit from embree.new_rayhit)."""
+    if scene == 0:
+        return False
+    return embree.occluded1(scene, rayhit, ox - center[0], oy - center[1], oz - center[2], dx, dy, dz, 0.0,
+                            min(tmax, _FAR), time)
+
+
 @kernel
 def _occludeds(scene, origins, directions, tmax, times, center, out):
     rayhit = embree.new_rayhit()
     for r in range(len(origins)):
-        out[r] = embree.occluded1(scene, rayhit, origins[r, 0] - center[0], origins[r, 1] - center[1],
-                                  origins[r, 2] - center[2], directions[r, 0], directions[r, 1], directions[r, 2],
-                                  0.0, min(tmax[r], _FAR), _time_of(times, r))
+        out[r] = blocked(scene, center, rayhit, origins[r, 0], origins[r, 1], origins[r, 2], directions[r, 0],
+                         directions[r, 1], directions[r, 2], tmax[r], _time_of(times, r))
 
 
 @kernel

@@ -6,6 +6,12 @@ direct light at every hit with one shadow ray per light strategy, and continues 
 through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
 Stages pass named records (core.integrator.records); every random number comes from the sampler the
 caller hands to ``trace``, at the dimensions core.sampling.dims lays out.
+
+A depth step is a few kernel calls over the wave's arrays: the closest hits (Embree from the
+kernel), the surface hits (integrator.hits), the step's sample values (two calls), every light
+strategy's samples (lights.strategies), and per material the direct light with its shadow rays
+traced in place (integrator.direct) and the continuation (integrator.continuation); between
+them only what shader programs compute (NumPy, per material) and the emission rays find.
 """
 from __future__ import annotations
 
@@ -21,12 +27,15 @@ from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
-from ..geometry.accel import spawn
+from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..shading.surface import SurfaceContext
-from .mis import add_emitted, power_heuristic
+from .continuation import continue_paths
+from .direct import direct_light
+from .hits import surface_hits
+from .mis import add_emitted
 from .ratio import RatioEstimator
-from .records import PathState, Samples, ShadowRays, SurfaceHits
+from .records import PathState, Samples, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
@@ -35,19 +44,24 @@ _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB
 
 @dataclass
 class StepSamples:
-    """The sample values the hits of one depth step use, one row per hit: per light strategy
-    k the point on the light (``point[k]``, (N, 2)) and the choice of light or triangle
-    (``choice[k]``, or None), valid where the material casts shadow rays; the lobe direction
-    (N, 2) and lobe choice (N,), valid where the path continues."""
+    """The sample values the hits of one depth step use, one row per hit: ``light`` (N, S, 2, 2),
+    per light strategy k the point on the light ``[:, k, 0]`` and the choice of light or
+    triangle ``[:, k, 1, 0]``, valid where the material casts shadow rays; ``path`` (N, 2, 2),
+    the lobe direction ``[:, 0]`` and the lobe choice ``[:, 1, 0]``, valid where the path continues."""
 
-    point: list
-    choice: list
-    lobe: np.ndarray
-    lobe_choice: np.ndarray
+    light: np.ndarray
+    path: np.ndarray
+
+    @property
+    def lobe(self) -> np.ndarray:
+        return self.path[:, 0]
+
+    @property
+    def lobe_choice(self) -> np.ndarray:
+        return self.path[:, 1, 0]
 
     def take(self, rows) -> "StepSamples":
-        return StepSamples([p[rows] for p in self.point], [None if c is None else c[rows] for c in self.choice],
-                           self.lobe[rows], self.lobe_choice[rows])
+        return StepSamples(self.light[rows], self.path[rows])
 
 
 @dataclass
@@ -141,23 +155,22 @@ class Integrator:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
-            shadows, continued = [], []
-            for group, u_g, shader in self._bind_materials(surf, u, hits):
+            bound = list(self._bind_materials(surf, u, hits))
+            lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
+            light, start = self._sample_lights(lit) if lit else None, 0
+            continued = []
+            for group, u_g, shader in bound:
                 if depth == 0:
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
-                if self.lights.strategies and shader.lobes:
-                    # the terminator lift is for diffuse shading over coarse facets (measured on
-                    # Ignis' rough-glass cylinder, lifting glass as well doubled its highlights' noise)
-                    diffuse = any(lobe.kind == "diffuse" for lobe in shader.lobes)
-                    lift = self.geometry.smooth_offset(hits, group.row, ray_times) if diffuse else None
-                    shadows += self._direct(shader, group, u_g, lift, out)
+                if light is not None and shader.lobes:
+                    self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out)
+                    start += len(group)
                 if shader.can_continue and depth < s.max_depth:
                     nxt = self._continue(shader, group, u_g)
                     if nxt is not None:
                         continued.append(nxt)
-            self._resolve_shadows(shadows, times, out)
             if not continued:
                 break
             state = PathState.concat(continued)
@@ -224,20 +237,19 @@ class Integrator:
             add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
 
     def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
-        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray."""
-        pos, ng, ns = self.geometry.surface(hits, rows, ray_times)
+        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray
+        (core.integrator.hits)."""
+        n = len(rows)
+        pos, ng, frame, wo_l, normal = (np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3)),
+                                        np.empty((n, 3)))
+        inside, scale = np.empty(n, bool), np.empty(n)
+        surface_hits(self.geometry.tables, hits.prim, hits.u, hits.v, self.geometry.time_values(ray_times),
+                     rows, state.dirs, pos, ng, frame, wo_l, inside, scale, normal)
         prim = hits.prim[rows]
-        wo = -state.dirs[rows]
-        inside = vec.dot(wo, ng) < 0
-        flip = np.where(inside, -1.0, 1.0)[:, None]
-        ng_o, ns_o = ng * flip, ns * flip
-        bad = vec.dot(wo, ns_o) <= 1e-6
-        ns_o[bad] = ng_o[bad]
-        frame = Frame.about(ns_o)
         return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material[prim], pos=pos,
-                           ng=ng_o, frame=frame, wo=wo, wo_l=frame.to_local(wo), inside=inside,
-                           scale=self.geometry.offset_scale(prim, pos), throughput=state.throughput[rows],
-                           straight=state.straight[rows], time=state.time[rows], normal=ns)
+                           ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
+                           wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
+                           straight=state.straight[rows], time=state.time[rows], normal=normal)
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
@@ -276,34 +288,27 @@ class Integrator:
 
     # -- sample values of one depth step ------------------------------------------------
     def _draw(self, depth, pixel, sample, mat, sampler, bounce) -> StepSamples:
-        """Every sample value the hits of one depth step use, drawn in one call per dimension
-        for all materials at once (values are per (pixel, sample, dimension), so drawing them
+        """Every sample value the hits of one depth step use, drawn in two calls for all materials
+        and strategies at once (values are per (pixel, sample, dimension), so drawing them
         together gives the very numbers drawing per material would)."""
         n = len(pixel)
         lights = self.lights
+        light = np.zeros((n, lights.strategies, 2, 2))
         lit = np.flatnonzero(self.prepared.lit[mat]) if lights.strategies else np.zeros(0, np.int64)
-        whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats gathering
-
-        def subset(get, dim, shape):
-            if whole:
-                return get(pixel, sample, dim)
-            values = np.zeros(shape)
-            values[lit] = get(pixel[lit], sample[lit], dim)
-            return values
-
-        point, choice = [], []
         if len(lit):
             emissive = lights.light_slots if len(lights.emissive) else -1
+            dims = np.full((lights.strategies, 2), -1, np.int64)
             for k in range(lights.strategies):
-                point.append(subset(sampler.get2d, self.light_dims.point(depth, k), (n, 2)))
-                chooses = k == emissive or (lights.selecting and k < lights.light_slots)
-                choice.append(subset(sampler.get, self.light_dims.choice(depth, k), n) if chooses else None)
+                dims[k, 0] = self.light_dims.point(depth, k)
+                if k == emissive or (lights.selecting and k < lights.light_slots):
+                    dims[k, 1] = self.light_dims.choice(depth, k)
+            whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats listing them
+            sampler.pairs(pixel, sample, dims, None if whole else lit, light.reshape(n, -1, 2))
+        path = np.zeros((n, 2, 2))
         go = np.flatnonzero(self.prepared.continues[mat]) if bounce else np.zeros(0, np.int64)
-        lobe, lobe_choice = np.zeros((n, 2)), np.zeros(n)
         if len(go):
-            lobe[go] = sampler.get2d(pixel[go], sample[go], D.lobe(depth))
-            lobe_choice[go] = sampler.get(pixel[go], sample[go], D.lobe_choice(depth))
-        return StepSamples(point, choice, lobe, lobe_choice)
+            sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
+        return StepSamples(light, path)
 
     def _bind_materials(self, surf: SurfaceHits, u: StepSamples, hits):
         """(hits, their samples, shader) per material: a slice of
@@ -333,98 +338,62 @@ class Integrator:
                 yield group.take(sub), u_g.take(sub), shader
 
     # -- next-event estimation ----------------------------------------------------------
-    def _direct(self, shader, hits: SurfaceHits, u: StepSamples, lift, wave: WaveOutput) -> list[ShadowRays]:
-        """Shadow rays (not yet traced) for the hits of one shader, one per light strategy, each
-        batch shown to the wave's ratio estimator when there is one (core.integrator.ratio)."""
-        lights = self.lights
-        out = []
-        time = hits.time if self.timed else None
-        sel_lobes = shader.selection(hits.wo_l[:, 2]) if shader.sampled else None
-        emissive = lights.light_slots if len(lights.emissive) else -1
-        for k in range(lights.strategies):
-            u_pick = u.choice[emissive] if emissive >= 0 else None
-            # the world is sampled around the shading normal, the one the BSDF's cosine follows
-            ls = lights.sample(k, hits.pos, hits.ns, u.point[k], u_pick, u.choice[k] if lights.selecting else None,
-                               time)
-            ok = vec.max3(ls.value) > 0
-            if not ok.any():
-                continue
-            wi_l = hits.frame.to_local(ls.wi)
-            above = wi_l[:, 2] > 0  # the shading hemisphere decides, as in Cycles, not the facet
-            f = shader.evaluate(hits.wo_l, wi_l, above, hits.inside, sel_lobes)
-            f_diff, f_nd = ls.restrict(f.diffuse, f.glossy, above)
-            w_l = power_heuristic(ls.pdf, f.pdf)
-            contrib = hits.throughput * ls.value * (f_diff + f_nd * w_l[:, None])
-            ok &= vec.max3(contrib) > 0
-            sel = np.flatnonzero(ok)
-            if wave.ratio is not None:
-                wave.ratio.shadow_rays(k, shader, hits, sel_lobes, ls.value, f_diff, sel)
-            if len(sel) == 0:
-                continue
-            scale = hits.scale[sel]
-            lift_s = np.zeros((len(sel), 3)) if lift is None else lift[sel]
-            origin = _shadow_origin(hits.pos[sel], hits.ng[sel], ls.wi[sel], wi_l[sel, 2], lift_s, scale)
-            dist = ls.dist[sel]
-            stop = 0.0 if ls.tmax_scale is None else ls.tmax_scale[sel]
-            tmax = np.where(np.isinf(dist), np.inf, dist * (1.0 - 1e-6) - stop - scale)
-            out.append(ShadowRays(path=hits.path[sel], origins=origin, dirs=ls.wi[sel], tmax=np.maximum(tmax, 0.0),
-                                  contrib=contrib[sel]))
-        return out
+    def _sample_lights(self, lit) -> LightSamples:
+        """Every light strategy sampled at the hits of one depth step that have lobes (``lit``:
+        (hits, their samples) per shader), for all shaders at once and in their order; the
+        world around each hit's shading normal (a normal program's where there is one)."""
+        def joined(arrays):
+            return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
 
-    def _resolve_shadows(self, shadows: list[ShadowRays], times, out: WaveOutput):
-        """Trace the shadow rays of a depth step and add the unblocked ones' light."""
-        if not shadows:
-            return
-        rays = ShadowRays.concat(shadows)
-        self._count("shadow", len(rays))
-        blocked = self.geometry.occluded(rays.origins, rays.dirs, rays.tmax, times[rays.path])
-        # area lights are not geometry: a nearer area light does not block (lights cast shadows
-        # of each other's bodies in Cycles only when they are meshes, so it does not here)
-        visible = ~blocked
-        n = len(out.radiance)
-        for c in range(3):
-            out.radiance[:, c] += np.bincount(rays.path[visible], weights=rays.contrib[visible, c], minlength=n)
-        if out.ratio is not None:
-            out.ratio.resolved(rays.path, visible)
+        hits = [group for group, _ in lit]
+        return self.lights.sample_all(joined([h.pos for h in hits]), joined([h.ns for h in hits]),
+                                      joined([u.light for _, u in lit]),
+                                      joined([h.time for h in hits]) if self.timed else None)
+
+    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput):
+        """Direct light at the hits of one shader, every strategy's shadow ray traced in the
+        kernel (core.integrator.direct); what the wave's ratio estimator needs, when there is one,
+        shown to it after (core.integrator.ratio)."""
+        n = len(group)
+        keep = 0 if wave.ratio is None else n
+        f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
+        # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
+        # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
+        lifted = len(self.geometry.tables[3]) > 0 and any(lobe.kind == "diffuse" for lobe in shader.lobes)
+        geo = self.geometry
+        traced = direct_light(
+            shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
+            _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
+            _c(group.path), geo.tables, group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
+            geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
+            visibility)
+        self._count("shadow", traced)
+        if wave.ratio is not None:
+            wave.ratio.direct(shader, group, light.value, f_diff, visibility)
 
     # -- continuation through a non-diffuse lobe ------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
-        """The paths of these hits continued through one sampled lobe (None if none goes on)."""
-        bs = shader.sample(hits.wo_l, u.lobe_choice, u.lobe, hits.inside)
-        new_thr = hits.throughput * bs.weight
-        sel = np.flatnonzero(bs.valid & (vec.max3(new_thr) > 0))
-        wi = hits.frame[sel].to_world(bs.wi_l[sel])
-        # a sampled direction on the wrong side of the geometric surface would leak light
-        transmit = bs.wi_l[sel, 2] < 0
-        geo_ok = (vec.dot(wi, hits.ng[sel]) < 0) == transmit
-        sel, wi, transmit = sel[geo_ok], wi[geo_ok], transmit[geo_ok]
+        """The paths of these hits continued through one sampled lobe (None if none goes on;
+        core.integrator.continuation)."""
+        n = len(hits)
+        go, passthrough, transmit = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
+        origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
+                       _c(hits.frame.m),
+                       _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
+                       _c(hits.pos), _c(hits.ng), _c(hits.scale), go, origin, wi, weight, prev_pdf, passthrough,
+                       transmit)
+        sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
-        passthrough = bs.passthrough[sel]
-        origin = spawn(hits.pos[sel], hits.ng[sel], wi, hits.scale[sel])
+        passthrough, transmit = passthrough[sel], transmit[sel]
         self._count("refraction", (transmit & ~passthrough).sum())
         self._count("reflection", (~transmit).sum())
         self._count("transparent", passthrough.sum())
-        n = len(sel)
-        return PathState(path=hits.path[sel], origins=origin, dirs=wi, tmax=np.full(n, np.inf),
-                         throughput=new_thr[sel], prev_pdf=np.where(bs.delta[sel], np.inf, bs.pdf[sel]),
-                         prev_normal=hits.ng[sel], prev_shading=hits.ns[sel],
-                         straight=hits.straight[sel] & passthrough, time=hits.time[sel])
+        return PathState(path=hits.path[sel], origins=origin[sel], dirs=wi[sel], tmax=np.full(len(sel), np.inf),
+                         throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],
+                         prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel])
 
 
-TERMINATOR_CUTOFF = 0.1
-"""Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
-terminator geometry offset)."""
-
-
-def _shadow_origin(pos, ng, wi, cos_shading, lift, scale):
-    """Shadow-ray origin: on the side of the surface the shading normal puts wi, lifted by
-    ``lift`` toward the smooth surface near the terminator (Cycles' rule, faded in by the
-    cosines) so that light the shading normal sees is not cut off by the flat facet."""
-    cos_geo = vec.dot(ng, wi)
-    c = TERMINATOR_CUTOFF
-    amount = np.where(cos_shading < c, np.clip(2.0 - (cos_geo + cos_shading) / c, 0.0, 1.0),
-                      np.clip(1.0 - cos_geo / c, 0.0, 1.0))
-    amount = np.where(cos_shading > 0, amount, 0.0)
-    side = np.where(cos_shading > 0, 1.0, -1.0)[:, None] * ng
-    return spawn(pos + lift * amount[:, None], ng, side, scale)
+def _c(a):
+    return np.ascontiguousarray(a)

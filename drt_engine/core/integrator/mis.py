@@ -3,16 +3,30 @@ BSDF-sampled ray finds reaches the image, whatever the emitter (lights hit, the 
 emissive triangles), as Mitsuba's path integrator has it."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..base.constants import TINY
+from ..base.jit import kernel
 
 
+@kernel(inline="always")
+def power(a, b):
+    """Power heuristic weight of strategy a against b (densities per solid angle; a = inf: delta)."""
+    if math.isinf(a):
+        return 1.0
+    a2 = a * a
+    return a2 / max(a2 + b * b, TINY)
+
+
+@kernel
 def power_heuristic(a, b):
-    """Power heuristic weight of strategy a against b (densities per solid angle)."""
-    a2 = np.where(np.isinf(a), 1.0, a * a)
-    b2 = np.where(np.isinf(a), 0.0, b * b)
-    return a2 / np.maximum(a2 + b2, TINY)
+    """``power`` over arrays of densities."""
+    out = np.empty(len(a))
+    for i in range(len(a)):
+        out[i] = power(a[i], b[i])
+    return out
 
 
 def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf):

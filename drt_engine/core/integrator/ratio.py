@@ -13,9 +13,9 @@ ratio of two sums is biased, and the bias shrinks as the pixel's samples grow (t
 of means converges to the ratio of expectations). A per-hit ratio over one shadow ray would
 be E_u V, biased at any sample count, hence sums per pixel.
 
-``RatioEstimator`` is the one hook next-event estimation calls: with each batch of shadow rays
-as it is built (D and U of the hits at once, the N each ray would add kept aside) and with the
-visibility of a depth step's rays once they are traced (N of those that got through). It adds
+``RatioEstimator`` is the one hook next-event estimation calls, once per shader's hits after the
+direct-light kernel traced their shadow rays: D and U of the hits, N of the rays that got
+through (the kernel hands it each sample's diffuse part and visibility). It adds
 each sample's N, D and U (summed over these lights) to a wave output ``RATIO`` of NDU_CHANNELS
 columns; its N is also in Combined, as Monte Carlo has it. A render without the estimator has
 no hook and does none of this. The film keeps them as sums (core.film.ratio_sums), over all
@@ -29,10 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..base import vectors as vec
 from ..base.jit import kernel
 from ..film.ratio_sums import NDU_CHANNELS
 from ..lights.collection import closed_forms
 from ..lights.kinds import unoccluded
+from .direct import VISIBLE
 
 
 def delta_light(light) -> bool:
@@ -75,40 +77,32 @@ class RatioEstimator:
     def __init__(self, table, strategies, n):
         self.table, self.strategies = table, strategies
         self.ndu = np.zeros((n, NDU_CHANNELS))
-        self._hits, self._albedo = None, None  # the hits of the shader being lit, and their albedo
-        self._shares = []  # per batch built since the last resolve: the N of each of its rays
 
-    def shadow_rays(self, k, shader, hits, sel_lobes, value, f_diff, sel):
-        """Light strategy k sampled at ``hits`` (light sample values ``value``, the BSDF's diffuse
-        part ``f_diff`` toward them; ``sel_lobes`` the lobe selection ``shader`` evaluated with),
-        shadow rays built from the hits ``sel``: for strategies of the estimator, D and U of every
-        hit now and the share of N each ray adds if unblocked; zero shares for the other lights."""
-        diffuse = None
-        if k in self.strategies:
-            if hits is not self._hits:
-                self._hits, self._albedo = hits, _diffuse_albedo(shader, hits, sel_lobes)
-            if self._albedo is not None:
-                diffuse = hits.throughput * value * f_diff
-                add_unoccluded(self.table, k, hits.pos, hits.ns, hits.path, self._albedo, diffuse, self.ndu)
-        if len(sel):
-            self._shares.append(diffuse[sel] if diffuse is not None else np.zeros((len(sel), 3)))
-
-    def resolved(self, path, visible):
-        """The shadow rays built since the last call, traced (rays of ``path``, in the order they
-        were built, ``visible`` where unblocked): their N to the sums."""
-        share = np.concatenate(self._shares)
-        self._shares = []
-        n = len(self.ndu)
-        for c in range(3):
-            self.ndu[:, c] += np.bincount(path[visible], weights=share[visible, c], minlength=n)
+    def direct(self, shader, hits, value, f_diff, visibility):
+        """Direct light computed at ``hits`` (lit by ``shader``): per strategy, the light samples'
+        values and the BSDF's diffuse part toward them, and what became of their shadow rays
+        (core.integrator.direct). For the estimator's strategies, D and U of every hit and the N of
+        each ray that got through; a strategy whose samples all came back empty adds nothing."""
+        albedo = None
+        for k in self.strategies:
+            if not (vec.max3(value[k]) > 0).any():
+                continue
+            if albedo is None:
+                albedo = _diffuse_albedo(shader, hits)
+                if albedo is None:
+                    return
+            diffuse = hits.throughput * value[k] * f_diff[k]
+            add_unoccluded(self.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, self.ndu)
+            seen = visibility[k] == VISIBLE
+            self.ndu[hits.path[seen], :3] += diffuse[seen]
 
 
-def _diffuse_albedo(shader, hits, sel_lobes):
+def _diffuse_albedo(shader, hits):
     """throughput x the diffuse part's albedo / pi at each hit (None without a diffuse part):
     the diffuse part toward the normal, since it is that times the cosine (the layers above
     attenuate it by factors of wo alone, bsdf.mixture.eval_lobes)."""
     n = len(hits.path)
     normal = np.zeros((n, 3))
     normal[:, 2] = 1.0
-    f_diff = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside, sel_lobes).diffuse
+    f_diff = shader.evaluate(hits.wo_l, normal, np.ones(n, bool), hits.inside).diffuse
     return hits.throughput * f_diff if (f_diff > 0).any() else None

@@ -103,19 +103,3 @@ class SurfaceHits:
         return self.frame.n
 
     take = _take
-
-
-@dataclass
-class ShadowRays:
-    """Shadow rays not yet traced: what each adds to its path's radiance when unblocked."""
-
-    path: np.ndarray
-    origins: np.ndarray
-    dirs: np.ndarray
-    tmax: np.ndarray
-    contrib: np.ndarray
-
-    def __len__(self):
-        return len(self.path)
-
-    concat = staticmethod(_concat)

@@ -9,9 +9,10 @@ lights, emissive triangles and the world can also be hit by continued rays, and 
 The per-ray arithmetic is in kernels: each light kind's in its own module (lights.point,
 lights.sun, lights.area, behind the switch in lights.kinds, over one flat table of lights,
 lights.table), emissive triangles' in lights.triangles, the choice among many lights in
-lights.choice, the environment map's in lights.environment, the world's in lights.world. The methods
-here call one batch loop per wave and strategy (below too, with the table lights' closed-form
-unoccluded light for the ratio estimator); shader programs (textured emission, the
+lights.choice, the environment map's in lights.environment, the world's in lights.world. Every
+strategy is sampled in one kernel call per depth step (lights.strategies); hits and densities
+of rays that found a light are one batch loop per wave (below, with the table lights'
+closed-form unoccluded light for the ratio estimator); shader programs (textured emission, the
 environment's radiance) stay NumPy.
 """
 from __future__ import annotations
@@ -27,12 +28,13 @@ from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
 from ..shading.surface import SurfaceAttributes, SurfaceContext
-from .choice import pick_light, pick_probability
+from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
+from .strategies import MAP_WORLD, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
 from .table import light_row, light_table
-from .triangles import pdf_emissive_batch, sample_emissive_batch
-from .world import pdf_world_batch, sample_map_world_batch, sample_uniform_world_batch, world_shown_batch
+from .triangles import pdf_emissive_batch
+from .world import pdf_world_batch, world_shown_batch
 
 
 class LightSample:
@@ -42,14 +44,6 @@ class LightSample:
         self.wi, self.dist, self.value, self.pdf = wi, dist, value, pdf
         self.tmax_scale = tmax_scale  # distance to stop short of an emitter that is geometry
         self.lobes = None  # (diffuse, glossy, transmission) this light lights, when not all
-
-    def restrict(self, f_diff, f_nd, above):
-        """The BSDF parts this light may light (diffuse, reflection, transmission)."""
-        if self.lobes is None:
-            return f_diff, f_nd
-        diffuse, glossy, transmission = self.lobes
-        keep = np.where(above, glossy, transmission)[:, None]
-        return (f_diff if diffuse else np.zeros_like(f_diff)), np.where(keep, f_nd, 0.0)
 
 
 def validate_light(light: Light):
@@ -109,6 +103,7 @@ class Lights:
             estimate[geometry.material == m] = self._textured_estimate(m)
         power = estimate @ LUMINANCE * geometry.area
         self.emissive = np.flatnonzero(power > 0)
+        self.emissive_cdf, self.emissive_prob = np.zeros(0), np.zeros(0)
         if len(self.emissive):
             cdf = np.cumsum(power[self.emissive])
             self.emissive_cdf = cdf / cdf[-1]
@@ -124,6 +119,7 @@ class Lights:
         self._map_share = MAP_SHARE if env is not None else 0.0
         lit = self.environment.mean_radiance > 0 if self.environment else np.any(world.radiance > 0)
         self.world = world.radiance if lit and world.visible_lighting else None
+        self._world_radiance = np.asarray(world.radiance, np.float64)
         self.world_constant = world.radiance
         self.world_seen = lit and (world.visible_camera or world.visible_lighting)
         partial = world.visible_lighting and not (world.visible_diffuse and world.visible_glossy
@@ -199,23 +195,67 @@ class Lights:
         return self.still, p, d, rotation
 
     # -- next-event estimation ----------------------------------------------------
-    def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray,
-               u_light: np.ndarray | None = None, time: np.ndarray | None = None) -> LightSample:
-        """Strategy k for shading points ``pos``; ``normal`` faces the incoming ray.
+    def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None
+                   ) -> LightSamples:
+        """Every strategy at shading points ``pos`` in one kernel call (lights.strategies);
+        ``normal`` faces the incoming ray (the world is sampled about it); ``u`` (N, S, 2, 2): per
+        strategy the point and the choice. With many lights, strategies below ``light_slots``
+        each pick one light per point by estimated contribution and divide by the chance of that
+        pick. Moving lights are sampled again in their own frames at ``time``; textured emission
+        and the environment's radiance come from their shader programs."""
+        n, strategies = len(pos), self.strategies
+        pos, normal, u = (np.ascontiguousarray(a, np.float64) for a in (pos, normal, u))
+        out = LightSamples.empty(strategies, n)
+        pick, chosen = np.zeros((strategies, n), np.int64), np.ones((strategies, n))
+        bary, lit = np.zeros((n, 3)), np.zeros((strategies, n), np.bool_)
+        g = self.geometry
+        world = NO_WORLD if self.world is None else UNIFORM_WORLD if self.environment is None else MAP_WORLD
+        sample_strategies(self.table, self.light_slots, self.selecting, g.world_vertices, g.triangles, g.world_ng,
+                          g.area, self.emissive, self.emissive_cdf, self.emissive_prob, self.tri_emission, g.tables,
+                          world, self._world_radiance, MAP_SHARE, *self._map, pos, normal, u, out.wi, out.dist,
+                          out.value, out.pdf, out.stop, pick, chosen, bary, lit)
+        if time is not None and self.motions:
+            self._moving_samples(out, pick, chosen, pos, u, time)
+        e = self.light_slots
+        if len(self.emissive) and self.textured:  # emission from the shader program at the sampled points
+            k = np.flatnonzero(self._textured_tri[pick[e]] & lit[e])
+            if len(k):
+                out.value[e, k] = self._emission_at(pick[e, k], bary[k]) / np.maximum(out.pdf[e, k], TINY)[:, None]
+        if self.world is not None:
+            w = strategies - 1
+            k = np.flatnonzero(lit[w])
+            if len(k):  # the map's radiance from the environment's program
+                out.value[w, k] = self.environment.radiance(out.wi[w, k]) / out.pdf[w, k, None]
+            if self.world_lobes is not None:
+                out.restrict[w] = self.world_lobes
+        return out
 
-        With many lights, strategies below ``light_slots`` each pick one light per point
-        by estimated contribution (``u_light``) and divide by the chance of that pick.
-        """
-        if k < self.light_slots:
-            if not self.selecting:
-                return self._sample_light(k, pos, u, time)
-            return self._sample_selected(pos, u, u_light, time)
-        k -= self.light_slots
-        if len(self.emissive) and k == 0:
-            return self._sample_emissive(pos, u, u_pick)
-        sample = self._sample_world(normal, u)
-        sample.lobes = self.world_lobes
+    def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray | None = None,
+               u_light: np.ndarray | None = None, time: np.ndarray | None = None) -> LightSample:
+        """Strategy k alone (``sample_all``'s), with its point ``u``, the emissive triangle's pick
+        ``u_pick`` and the light's pick ``u_light`` among many."""
+        block = np.zeros((len(pos), self.strategies, 2, 2))
+        block[:, k, 0] = u
+        if u_pick is not None and len(self.emissive):
+            block[:, self.light_slots, 1, 0] = u_pick
+        if u_light is not None:
+            block[:, k, 1, 0] = u_light
+        out = self.sample_all(pos, normal, block, time)
+        sample = LightSample(out.wi[k], out.dist[k], out.value[k], out.pdf[k],
+                             out.stop[k] if len(self.emissive) and k == self.light_slots else None)
+        if out.restrict[k, 0] != UNRESTRICTED:
+            sample.lobes = tuple(bool(x) for x in out.restrict[k])
         return sample
+
+    def _moving_samples(self, out: LightSamples, pick, chosen, pos, u, time):
+        """Table strategies whose light moves, sampled again in that light's own frame."""
+        moving = np.array(list(self.motions))
+        for k in range(self.light_slots):
+            rows = np.flatnonzero(np.isin(pick[k], moving))
+            for i in np.unique(pick[k, rows]):
+                idx = rows[pick[k, rows] == i]
+                ls = self._sample_light(i, pos[idx], u[idx, k, 0], time[idx])
+                out.put(k, idx, LightSample(ls.wi, ls.dist, ls.value / chosen[k, idx, None], ls.pdf * chosen[k, idx]))
 
     def _sample_light(self, index: int, pos, u, time=None) -> LightSample:
         table, local, _, rotation = self._frame(index, pos, None, time)
@@ -223,44 +263,6 @@ class Lights:
         if rotation is not None:
             wi = np.einsum("nij,nj->ni", rotation, wi)
         return LightSample(wi, dist, value, pdf)
-
-    def _sample_selected(self, pos, u, u_light, time=None) -> LightSample:
-        """One light per point chosen by contribution; value and pdf are the whole slot's (the
-        light's divided, and multiplied, by the expected number of picks of that light)."""
-        wi, dist, value, pdf, pick, chosen = _sample_chosen_batch(self.table, self.light_slots, pos, u, u_light)
-        if time is not None and self.motions:  # moving lights picked: sampled again in their own frames
-            for i in np.intersect1d(pick, list(self.motions)):
-                idx = np.flatnonzero(pick == i)
-                ls = self._sample_light(i, pos[idx], u[idx], time[idx])
-                wi[idx], dist[idx] = ls.wi, ls.dist
-                value[idx] = ls.value / chosen[idx, None]
-                pdf[idx] = ls.pdf * chosen[idx]
-        return LightSample(wi, dist, value, pdf)
-
-    def _sample_emissive(self, pos, u, u_pick):
-        g = self.geometry
-        wi, dist, value, pdf, pick, bary, q, cos_l = sample_emissive_batch(
-            g.world_vertices, g.triangles, g.world_ng, g.area, self.emissive, self.emissive_cdf,
-            self.emissive_prob, self.tri_emission, pos, u, np.ascontiguousarray(u_pick))
-        if self.textured:  # emission from the shader program at the sampled points
-            k = np.flatnonzero(self._textured_tri[pick] & (cos_l > 0))
-            if len(k):
-                value[k] = self._emission_at(pick[k], bary[k]) / np.maximum(pdf[k], TINY)[:, None]
-        return LightSample(wi, dist, value, pdf, tmax_scale=g.offset_scale(pick, q))
-
-    def _sample_world(self, normal, u):
-        """Cosine-weighted directions for a uniform world; for a textured one, a defensive mixture:
-        the map's luminance density with probability MAP_SHARE, else cosine-weighted (the
-        sample's density is the mixture's, which ``pdf_world`` also gives)."""
-        if self.environment is None:
-            wi, value, pdf = sample_uniform_world_batch(normal, u, np.asarray(self.world, np.float64))
-            return LightSample(wi, np.full(len(u), np.inf), value, pdf)
-        wi, pdf, lit = sample_map_world_batch(normal, u, MAP_SHARE, *self._map)
-        value = np.zeros((len(u), 3))
-        k = np.flatnonzero(lit)
-        if len(k):
-            value[k] = self.environment.radiance(wi[k]) / pdf[k, None]
-        return LightSample(wi, np.full(len(u), np.inf), value, pdf)
 
     # -- lights hit by rays (multiple importance sampling) --------------------------
     def intersect(self, origins, dirs, tmax, time=None):
@@ -343,22 +345,6 @@ def _sample_batch(table, i, pos, u):
         wi[j, 0], wi[j, 1], wi[j, 2], dist[j] = wx, wy, wz, d
         value[j, 0], value[j, 1], value[j, 2], pdf[j] = r, g, b, p
     return wi, dist, value, pdf
-
-
-@kernel
-def _sample_chosen_batch(table, slots, pos, u, u_light):
-    n = len(pos)
-    wi, dist, value, pdf = np.empty((n, 3)), np.empty(n), np.empty((n, 3)), np.empty(n)
-    pick, chosen = np.empty(n, np.int64), np.empty(n)
-    for j in range(n):
-        px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
-        i, prob = pick_light(table, px, py, pz, u_light[j])
-        c = prob * slots
-        wx, wy, wz, d, r, g, b, p = sample_light(table, i, px, py, pz, u[j, 0], u[j, 1])
-        wi[j, 0], wi[j, 1], wi[j, 2], dist[j] = wx, wy, wz, d
-        value[j, 0], value[j, 1], value[j, 2], pdf[j] = r / c, g / c, b / c, p * c
-        pick[j], chosen[j] = i, c
-    return wi, dist, value, pdf, pick, chosen
 
 
 @kernel

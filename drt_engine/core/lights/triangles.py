@@ -46,26 +46,6 @@ def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
 
 
 @kernel
-def sample_emissive_batch(vertices, triangles, ng, area, emissive, cdf, prob, emission, pos, u, u_pick):
-    n = len(pos)
-    wi, dist, value, pdf = np.empty((n, 3)), np.empty(n), np.zeros((n, 3)), np.empty(n)
-    pick, bary, q, cos_out = np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-    for j in range(n):
-        i = pick_triangle(emissive, cdf, u_pick[j])
-        px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
-        wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz,
-                                                          u[j, 0], u[j, 1])
-        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
-        dist[j], pdf[j], pick[j], cos_out[j] = d, p, i, cos_l
-        bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
-        q[j, 0], q[j, 1], q[j, 2] = px + wx * d, py + wy * d, pz + wz * d
-        if cos_l > 0:
-            s = 1.0 / max(p, TINY)
-            value[j, 0], value[j, 1], value[j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
-    return wi, dist, value, pdf, pick, bary, q, cos_out
-
-
-@kernel
 def pdf_emissive_batch(ng, area, prob, prim, dirs, t):
     out = np.empty(len(prim))
     for j in range(len(prim)):

@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 
-from ..base.constants import TINY
 from ..base.jit import kernel
 from ..base.vectors import basis
 from ..base.warps import concentric_disk
@@ -44,35 +43,6 @@ def sample_world_direction(nx, ny, nz, u0, u1, share, row_cdf, col_cdf, cell, ce
         c0 = min(max((u0 - share) / (1.0 - share), 0.0), 1.0 - 1e-12)
         dx, dy, dz, _ = cosine_direction(nx, ny, nz, c0, min(max(u1, 0.0), 1.0 - 1e-12))
     return dx, dy, dz, world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area)
-
-
-@kernel
-def sample_uniform_world_batch(normal, u, radiance):
-    n = len(u)
-    wi, value, pdf = np.empty((n, 3)), np.zeros((n, 3)), np.empty(n)
-    for j in range(n):
-        wx, wy, wz, z = cosine_direction(normal[j, 0], normal[j, 1], normal[j, 2], u[j, 0], u[j, 1])
-        wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
-        pdf[j] = z / math.pi
-        if pdf[j] > 0:
-            s = 1.0 / max(pdf[j], TINY)
-            value[j, 0], value[j, 1], value[j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
-    return wi, value, pdf
-
-
-@kernel
-def sample_map_world_batch(normal, u, share, row_cdf, col_cdf, cell, cell_area):
-    """Directions and densities; ``lit`` marks those above the normal with density > 0 (the
-    caller evaluates the map's radiance there)."""
-    n = len(u)
-    wi, pdf, lit = np.empty((n, 3)), np.empty(n), np.zeros(n, np.bool_)
-    for j in range(n):
-        nx, ny, nz = normal[j, 0], normal[j, 1], normal[j, 2]
-        dx, dy, dz, p = sample_world_direction(nx, ny, nz, u[j, 0], u[j, 1], share, row_cdf, col_cdf, cell,
-                                               cell_area)
-        wi[j, 0], wi[j, 1], wi[j, 2], pdf[j] = dx, dy, dz, p
-        lit[j] = nx * dx + ny * dy + nz * dz > 0 and p > 0
-    return wi, pdf, lit
 
 
 @kernel

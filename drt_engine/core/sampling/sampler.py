@@ -256,6 +256,19 @@ def _fill_2d(pattern, seed, nx, ny, tables, pixel, sample, dim, out):
         out[i, 0], out[i, 1] = sample_2d(pattern, seed, nx, ny, tables, int(pixel[i]), int(sample[i]), dim)
 
 
+@kernel
+def _fill_pairs(pattern, seed, nx, ny, tables, pixel, sample, dims, rows, out):
+    """``out[r, p]`` = dimensions (dims[p], dims[p] + 1) for the rows ``rows`` (empty: every row);
+    pairs with dims[p] < 0 are left as they are."""
+    count = len(rows) if len(rows) else len(pixel)
+    for i in range(count):
+        r = rows[i] if len(rows) else i
+        for p in range(len(dims)):
+            if dims[p] >= 0:
+                out[r, p, 0], out[r, p, 1] = sample_2d(pattern, seed, nx, ny, tables, int(pixel[r]), int(sample[r]),
+                                                       dims[p])
+
+
 class Sampler:
     """Hands out sample values for explicit dimensions.
 
@@ -289,6 +302,18 @@ class Sampler:
         assert dim % 2 == 0, "2D dimensions start at an even index"
         out = np.empty((len(pixel), 2))
         _fill_2d(*self.params, _ints(pixel), _ints(sample), int(dim), out)
+        return out
+
+    def pairs(self, pixel: np.ndarray, sample: np.ndarray, dims: np.ndarray, rows=None, out=None) -> np.ndarray:
+        """(N, P, 2): the 2D dimensions starting at each even ``dims[p]`` (a 1D dimension d, even,
+        is column 0 of the pair at d), drawn in one call, for ``rows`` only if given (the other
+        rows zero); pairs with dims[p] < 0 are skipped (zero)."""
+        dims = np.asarray(dims, np.int64).ravel()
+        assert (dims[dims >= 0] % 2 == 0).all(), "2D dimensions start at an even index"
+        if out is None:
+            out = np.zeros((len(pixel), len(dims), 2))
+        _fill_pairs(*self.params, _ints(pixel), _ints(sample), dims,
+                    np.zeros(0, np.int64) if rows is None else _ints(rows), out)
         return out
 
 

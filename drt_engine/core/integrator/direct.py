@@ -1,0 +1,130 @@
+"""Next-event estimation of one material's hits in one kernel call.
+
+For every hit and every light strategy: the BSDF toward the light sample, the power heuristic
+against BSDF sampling, the shadow ray's origin (Cycles' terminator rule) and the ray itself,
+traced in place through Embree; the light that gets through goes straight into the wave's
+radiance. No shadow-ray records, no per-strategy Python, no gather and scatter between stages.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..base.jit import kernel
+from ..bsdf.mixture import eval_lobes, selection
+from ..geometry import embree
+from ..geometry.accel import blocked, lift, spawn_point
+from ..lights.strategies import UNRESTRICTED
+from .mis import power
+
+TERMINATOR_CUTOFF = 0.1
+"""Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
+terminator geometry offset)."""
+
+NOT_TRACED, BLOCKED, VISIBLE = -1, 0, 1
+"""What became of the shadow ray of a hit and strategy (``visibility``, for the ratio estimator)."""
+
+
+@kernel(inline="always")
+def _positive(r, g, b):
+    """Some channel above zero and none NaN (what ``max3(v) > 0`` says of a row)."""
+    if r != r or g != g or b != b:
+        return False
+    return r > 0 or g > 0 or b > 0
+
+
+@kernel(inline="always")
+def shadow_origin(px, py, pz, gx, gy, gz, wx, wy, wz, cos_shading, lx, ly, lz, scale):
+    """Shadow-ray origin: on the side of the surface the shading normal puts w, lifted by (lx, ly,
+    lz) toward the smooth surface near the terminator (Cycles' rule, faded in by the cosines) so
+    that light the shading normal sees is not cut off by the flat facet."""
+    cos_geo = gx * wx + gy * wy + gz * wz
+    c = TERMINATOR_CUTOFF
+    if cos_shading < c:
+        amount = min(max(2.0 - (cos_geo + cos_shading) / c, 0.0), 1.0)
+    else:
+        amount = min(max(1.0 - cos_geo / c, 0.0), 1.0)
+    if not cos_shading > 0:
+        amount = 0.0
+    side = 1.0 if cos_shading > 0 else -1.0
+    return spawn_point(px + lx * amount, py + ly * amount, pz + lz * amount, gx, gy, gz, side * gx, side * gy,
+                       side * gz, scale)
+
+
+@kernel
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, geo, prim,
+                 u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times, radiance, f_diff,
+                 visibility):
+    """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays traced.
+
+    Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
+    position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
+    normal rows), wo in that frame, inside, offset scale, throughput, path, and the triangle and
+    barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
+    (core.geometry.accel.lift).
+    Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
+    to stop short of an emitter that is geometry, and the BSDF parts each strategy lights
+    (``restrict``). ``times``: each hit's shutter time (empty when nothing moves).
+    ``f_diff`` and ``visibility`` (strategy by hit) are filled when they have rows (the ratio
+    estimator reads them): the diffuse part toward each sample and what became of its ray.
+    """
+    rayhit = embree.new_rayhit()
+    scratch = np.empty((2, 3, 4))
+    sel = np.empty((1, max(n_sampled, 1)))
+    keep = f_diff.shape[1] > 0
+    traced = 0
+    for j in range(len(pos)):
+        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0)
+        time = times[j] if len(times) else 0.5
+        hx = hy = hz = 0.0
+        if lifted:
+            hx, hy, hz = lift(geo, prim[j], u[j], v[j], time, scratch)
+        s0 = s1 = s2 = 0.0
+        for k in range(wi.shape[0]):
+            if keep:
+                visibility[k, j] = NOT_TRACED
+            v0, v1, v2 = value[k, j, 0], value[k, j, 1], value[k, j, 2]
+            if not _positive(v0, v1, v2):
+                continue
+            wx, wy, wz = wi[k, j, 0], wi[k, j, 1], wi[k, j, 2]
+            lx = wx * frame[j, 0, 0] + wy * frame[j, 0, 1] + wz * frame[j, 0, 2]
+            ly = wx * frame[j, 1, 0] + wy * frame[j, 1, 1] + wz * frame[j, 1, 2]
+            lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
+            above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
+            f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
+                           inside[j], sel, 0)
+            d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
+            if restrict[k, 0] != UNRESTRICTED:
+                if restrict[k, 0] == 0:
+                    d0 = d1 = d2 = 0.0
+                if restrict[k, 1 if above else 2] == 0:
+                    n0 = n1 = n2 = 0.0
+            if keep:
+                f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
+            w = power(pdf[k, j], f[6])
+            c0 = throughput[j, 0] * v0 * (d0 + n0 * w)
+            c1 = throughput[j, 1] * v1 * (d1 + n1 * w)
+            c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
+            if not _positive(c0, c1, c2):
+                continue
+            ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, lz, hx, hy,
+                                       hz, scale[j])
+            tmax = math.inf
+            if not math.isinf(dist[k, j]):
+                tmax = max(dist[k, j] * (1.0 - 1e-6) - stop[k, j] - scale[j], 0.0)
+            traced += 1
+            hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time)
+            if keep:
+                visibility[k, j] = BLOCKED if hidden else VISIBLE
+            # area lights are not geometry: a nearer area light does not block (lights cast shadows
+            # of each other's bodies in Cycles only when they are meshes, so it does not here)
+            if not hidden:
+                s0 += c0
+                s1 += c1
+                s2 += c2
+        p = path[j]
+        radiance[p, 0] += s0
+        radiance[p, 1] += s1
+        radiance[p, 2] += s2
+    return traced

@@ -1,0 +1,116 @@
+"""Every next-event strategy sampled at once: one kernel call per depth step fills, strategy by
+hit, the direction, distance, value and density of each strategy's sample (the lights of the
+table, or those picked among many, emissive triangles, the world). What only a shader program
+or a moving frame can give (textured emission, the environment's radiance, moving lights) the
+caller fills in after, from what the kernel leaves (picks, barycentrics, ``lit``)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ..base.constants import TINY
+from ..base.jit import kernel
+from ..geometry.accel import offset_scale
+from .choice import pick_light
+from .kinds import sample_light
+from .triangles import pick_triangle, sample_triangle
+from .world import cosine_direction, sample_world_direction
+
+UNRESTRICTED = -1
+"""A strategy that lights every BSDF part (``LightSamples.restrict[k, 0]``); otherwise the row
+holds whether it lights the diffuse, reflection and transmission parts (the world's ray visibility)."""
+
+NO_WORLD, UNIFORM_WORLD, MAP_WORLD = 0, 1, 2
+
+
+@dataclass
+class LightSamples:
+    """Every light strategy's sample at the hits of one depth step, strategy by hit: direction,
+    distance (inf for distant), value (radiance / pdf; zero where nothing was sampled), pdf, the
+    distance to stop short of an emitter that is geometry, and per strategy the BSDF parts it
+    lights (core.integrator.direct's ``restrict``)."""
+
+    wi: np.ndarray
+    dist: np.ndarray
+    value: np.ndarray
+    pdf: np.ndarray
+    stop: np.ndarray
+    restrict: np.ndarray
+
+    @classmethod
+    def empty(cls, strategies: int, n: int) -> "LightSamples":
+        return cls(np.zeros((strategies, n, 3)), np.zeros((strategies, n)), np.zeros((strategies, n, 3)),
+                   np.zeros((strategies, n)), np.zeros((strategies, n)), np.full((strategies, 3), UNRESTRICTED, np.int8))
+
+    @property
+    def strategies(self) -> int:
+        return len(self.wi)
+
+    def put(self, k: int, rows, sample) -> None:
+        """Strategy k's sample (a core.lights.collection.LightSample) at hits ``rows``."""
+        self.wi[k, rows], self.dist[k, rows], self.value[k, rows], self.pdf[k, rows] = \
+            sample.wi, sample.dist, sample.value, sample.pdf
+
+    def take(self, rows) -> "LightSamples":
+        return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
+                            self.stop[:, rows], self.restrict)
+
+    def arrays(self) -> tuple:
+        """The fields, contiguous, in the order core.integrator.direct's kernel takes them."""
+        return tuple(np.ascontiguousarray(getattr(self, f.name)) for f in fields(self))
+
+
+@kernel
+def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, cdf, prob, emission,
+                      geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, pos, normal, u, wi, dist, value,
+                      pdf, stop, pick, chosen, bary, lit):
+    """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
+    hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
+    expected picks of it), emissive triangles when there are (``emissive``, picked by power),
+    the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``, MAP_WORLD: directions from the
+    map with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
+    the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
+    light or triangle sampled, ``bary`` the triangle's barycentrics, ``lit`` where the caller's
+    value applies (a triangle's front seen, a map direction above the normal)."""
+    for j in range(len(pos)):
+        px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
+        for k in range(slots):
+            i, c = k, 1.0
+            if selecting:
+                i, p_pick = pick_light(table, px, py, pz, u[j, k, 1, 0])
+                c = p_pick * slots
+            wx, wy, wz, d, r, g, b, p = sample_light(table, i, px, py, pz, u[j, k, 0, 0], u[j, k, 0, 1])
+            wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j] = wx, wy, wz, d
+            if selecting:
+                r, g, b, p = r / c, g / c, b / c, p * c
+            value[k, j, 0], value[k, j, 1], value[k, j, 2], pdf[k, j] = r, g, b, p
+            pick[k, j], chosen[k, j] = i, c
+        k = slots
+        if len(emissive):
+            i = pick_triangle(emissive, cdf, u[j, k, 1, 0])
+            wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, prob, i, px, py, pz,
+                                                              u[j, k, 0, 0], u[j, k, 0, 1])
+            wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, d, p
+            pick[k, j], lit[k, j] = i, cos_l > 0
+            bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
+            if cos_l > 0:
+                s = 1.0 / max(p, TINY)
+                value[k, j, 0], value[k, j, 1], value[k, j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
+            stop[k, j] = offset_scale(geo, i, px + wx * d, py + wy * d, pz + wz * d)
+            k += 1
+        if world == NO_WORLD:
+            continue
+        nx, ny, nz = normal[j, 0], normal[j, 1], normal[j, 2]
+        if world == UNIFORM_WORLD:
+            wx, wy, wz, z = cosine_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1])
+            p = z / math.pi
+            if p > 0:
+                s = 1.0 / max(p, TINY)
+                value[k, j, 0], value[k, j, 1], value[k, j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
+        else:
+            wx, wy, wz, p = sample_world_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1], share, row_cdf, col_cdf,
+                                                   cell, cell_area)
+            lit[k, j] = nx * wx + ny * wy + nz * wz > 0 and p > 0
+        wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, math.inf, p
