@@ -49,8 +49,8 @@ STOP_TIMEOUT = 5.0
 
 
 def viewport_settings(settings, preview_samples: int):
-    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, not denoised
-    (``use_denoising`` is for final renders; the viewport's denoising is still to come)."""
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, no final-render
+    denoising (``use_denoising``; the viewport denoises its own images through ViewDenoise)."""
     return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
                                sample_start=0, sample_end=0, use_denoising=False)
@@ -72,15 +72,15 @@ class ViewDenoise:
         """The viewport's settings with the features the denoiser needs traced."""
         return with_features(settings)
 
-    def image(self, passes: dict, samples: int) -> tuple[np.ndarray, bool]:
+    def image(self, passes: dict, samples: int, filters) -> tuple[np.ndarray, bool]:
         """(RGBA image to show, whether it is denoised) of a render's passes with ``samples`` in
-        every pixel."""
+        every pixel, denoised on ``filters`` (the worker's: core.film.denoiser.Filters)."""
         combined = passes["Combined"]
         if samples < self.start_sample:
             return combined, False
         out = combined.copy()
-        out[..., :3] = self.denoiser.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
-                                             prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+        out[..., :3] = filters.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
+                                       prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
         return out, True
 
 
@@ -229,6 +229,7 @@ class ViewportRender:
     def _run(self, scene_data, cameras, settings, stop: threading.Event, denoise=None) -> None:
         from ..core.render.render import Renderer
 
+        filters = None  # the denoiser's filters, kept over this view's refreshes
         try:
             _nicer(WORKER_NICE)
             prepared = self.prepared(scene_data)
@@ -247,9 +248,12 @@ class ViewportRender:
             last = [0.0]
 
             def shown(passes, samples):
+                nonlocal filters
                 if denoise is None:
                     return passes["Combined"], ""
-                image, denoised = denoise.image(passes, samples)
+                if filters is None:
+                    filters = denoise.denoiser.filters()
+                image, denoised = denoise.image(passes, samples, filters)
                 return image, " | Denoised" if denoised else ""
 
             def progress(update) -> bool:
@@ -272,6 +276,9 @@ class ViewportRender:
         except Exception as error:  # a bug of ours: keep the UI alive, details in the console
             print(f"DRT: unexpected error in the viewport render\n{traceback.format_exc()}")
             self._fail(f"DRT internal error: {type(error).__name__}: {error}", stop)
+        finally:
+            if filters is not None:
+                filters.close()
 
     def _fail(self, message: str, stop: threading.Event) -> None:
         with self._lock:

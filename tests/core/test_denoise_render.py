@@ -5,13 +5,16 @@ The scene is the soft-shadow scene (a sphere and a cube under a rectangular area
 pixels): its error sits in the penumbrae, where OIDN has real work to do. The reference is a
 512-sample render of another seed, its own variance taken off the true errors.
 """
+import math
+
 import numpy as np
 import pytest
 
 from drt_engine.core.errors import SettingsError
 from drt_engine.core.film import denoiser
 from drt_engine.core.render.adaptive import true_error
-from drt_engine.core.render.denoise import denoised_error
+from drt_engine.core.render.denoise import DENOISED_SHARE, Schedule, denoised_error
+from drt_engine.core.render.driver import TARGET_MIN_SAMPLES
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import NOISY_IMAGE, RenderSettings
 from tests.support.oidn import require_oidn
@@ -131,13 +134,26 @@ def test_a_farm_part_is_not_denoised(oidn):
     assert any("not denoised" in w for w in part.warnings)
 
 
-def test_the_denoised_estimate_is_logged_at_the_end_or_with_a_target_at_every_step(oidn, pair):
+def test_the_denoised_estimate_is_logged_at_the_end_or_at_the_steps_that_could_meet_the_target(oidn, pair):
     denoised, plain = pair
     assert [("relmse_denoised" in entry) for entry in denoised.log] == [False] * (len(denoised.log) - 1) + [True]
     assert all("relmse_denoised" not in entry for entry in plain.log)
-    targeted = render(oidn, samples=32, use_denoising=True, target_error=1e-9)  # never reached
-    steps = [entry for entry in targeted.log if entry["spp_max"] >= 2]
-    assert len(steps) >= 2 and all(0 < entry["relmse_denoised"] <= entry["relmse"] for entry in steps)
+    unreachable = render(oidn, samples=32, use_denoising=True, target_error=1e-9)
+    assert [("relmse_denoised" in entry) for entry in unreachable.log] == [False] * (len(unreachable.log) - 1) + [True]
+    assert unreachable.stats["stopped_by"] == "samples"
+    loose = render(oidn, samples=32, use_denoising=True, target_error=1.0)  # any denoised image is under it
+    steps = [entry for entry in loose.log if "relmse_denoised" in entry]
+    assert loose.stats["stopped_by"] == "target_error" and steps == [loose.log[-1]]
+    assert loose.log[-1]["spp_max"] == TARGET_MIN_SAMPLES and loose.log[-1]["relmse_denoised"] < 1.0
+
+
+def test_a_step_is_denoised_when_its_noisy_error_times_the_last_ratio_is_under_the_target():
+    schedule = Schedule(1e-3)
+    assert schedule.ratio == DENOISED_SHARE and not schedule.due(0.02) and schedule.due(0.009)
+    schedule.measured(4e-3, 2e-3)  # this scene's denoiser halves the error
+    assert not schedule.due(2.1e-3) and schedule.due(1.9e-3)
+    schedule.measured(math.inf, 1e-3)  # an unknown step changes nothing
+    assert schedule.ratio == 0.5
 
 
 def test_the_target_error_applies_to_the_denoised_image(oidn):
