@@ -243,11 +243,6 @@ def test_denoise_keeps_the_noisy_image_and_reports_both_errors(bl, blend, tmp_pa
     assert abs(denoised.mean() / STRENGTH - 1) < 5e-3
 
 
-@pytest.mark.parametrize("split", [["--workers", "2"], ["--sample-range", "0:1"]])
-def test_denoise_refuses_split_renders(blend, tmp_path, split):
-    assert_one_line_error(run_cli("render", blend, "-o", tmp_path / "x.exr", "--denoise", *split), "--denoise")
-
-
 def test_denoise_without_oidn_is_one_clear_error(blend, tmp_path, monkeypatch):
     """Where Blender ships no OpenImageDenoise (Debian's 4.3.2) the CLI says so instead of rendering."""
     from drt_engine.blender import oidn

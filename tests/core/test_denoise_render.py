@@ -165,3 +165,40 @@ def test_the_target_error_applies_to_the_denoised_image(oidn):
     assert noisy.stats["stopped_by"] == denoised.stats["stopped_by"] == "target_error"
     assert denoised.stats["samples"] < noisy.stats["samples"]
     assert denoised.stats["relmse_denoised"] < target < denoised.stats["relmse"]
+
+
+def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch):
+    """A farm's parts carry the denoiser's features and the replicate halves in their sums; the merge
+    denoises the merged film once (not per part, however often its images are asked for) and gives
+    the whole render's denoised image and estimate."""
+    from drt_engine.core.film import parts
+    from drt_engine.core.film.denoising import PASSES as FEATURE_PASSES
+    from drt_engine.core.render import merge, report
+
+    scene, base = soft_shadow_scene(WIDTH)
+
+    def run(start=0, end=0):
+        settings = RenderSettings(**{**base, "samples": SPP, "seed": 1, "passes": ("Combined",),
+                                     "use_denoising": True, "sample_start": start, "sample_end": end})
+        renderer = Renderer(scene, settings, denoiser=oidn)
+        result = renderer.render()
+        summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(scene))
+        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(scene), "report": summary}
+        return parts.from_film(renderer.film, settings, header), result
+
+    whole = run()[1]
+    pieces = [run(a, b)[0] for a, b in ((3, SPP), (0, 3))]
+    assert all(set(FEATURE_PASSES) <= set(piece.sums) for piece in pieces)
+    calls = []
+    monkeypatch.setattr(merge, "denoise_film", lambda *a, real=merge.denoise_film: calls.append(a) or real(*a))
+    merger = merge.merge_parts(pieces, ["A", "B"])
+    assert not calls and all("relmse_denoised" not in entry for entry in merger.log.entries)
+    images = merger.images(oidn)
+    assert merger.images(oidn)["Combined"] is not images["Combined"] and len(calls) == 1
+    assert set(images) == {"Combined", NOISY_IMAGE}
+    np.testing.assert_allclose(images[NOISY_IMAGE], whole.passes[NOISY_IMAGE], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(images["Combined"], whole.passes["Combined"], rtol=1e-3, atol=1e-4)
+    stats = merger.report(1.0)["stats"]
+    assert stats["relmse_denoised"] == pytest.approx(whole.stats["relmse_denoised"], rel=1e-3)
+    assert ["relmse_denoised" in entry for entry in merger.log.entries] == [False, True]
+    assert set(merger.images(None)) == {"Combined"}  # without a library: the merged image as rendered
