@@ -68,6 +68,8 @@ class Renderer:
         self.denoising = settings.use_denoising and not settings.partial
         self._denoised = None  # (samples in the film, core.render.denoise.Denoised) of the newest denoising
         self._denoise_seconds = 0.0
+        self._filters = None  # core.film.denoiser.Filters while a denoising render runs
+        self._schedule = None  # core.render.denoise.Schedule while one runs under a target error
         if self.denoising and denoiser is None:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
         if settings.use_denoising:  # the features guide the denoiser (a part's, the merge's): traced even
