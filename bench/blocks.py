@@ -20,6 +20,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "bench-adaptive": DOCS / "adaptive-sampling.md",
     "ratio": DOCS / "ratio-estimator.md",
     "viewport-times": DOCS / "viewport.md",
+    "viewport-denoise": DOCS / "viewport.md",
     "denoise": DOCS / "denoising.md",
     "denoise-calibration": DOCS / "denoising.md",
 }

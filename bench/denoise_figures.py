@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import sys
 import time
@@ -30,7 +31,7 @@ MAPS = ROOT / "bench" / "plots" / "denoise_cornell_box.png"
 CALIBRATION = ROOT / "bench" / "denoise_calibration.json"
 RESULTS = ROOT / "bench" / "results"
 
-SCENES = ("cornell_box", "glossy_spheres")
+SCENES = ("cornell_box", "dof_row", "glossy_spheres", "motion_blur")
 WIDTH = 256
 SAMPLES = (16, 32, 64)
 SEEDS = (1, 2)
@@ -94,7 +95,7 @@ def measure() -> dict:
                                   denoiser=oidn).render()
                 seconds = time.perf_counter() - start
                 noisy, denoised = result.passes[NOISY_IMAGE][..., :3], result.passes["Combined"][..., :3]
-                row = {"scene": name, "samples": spp, "seed": seed,
+                row = {"scene": name, "samples": spp, "seed": seed, "load": os.getloadavg()[0],
                        "true_noisy": true_error(noisy, ref, ref_var)[1], "est_noisy": result.stats["relmse"],
                        "true_denoised": true_error(denoised, ref, ref_var)[1],
                        "est_denoised": result.stats["relmse_denoised"],
@@ -112,7 +113,10 @@ def measure() -> dict:
             row = {"scene": name, "use_denoising": use_denoising, "seconds": seconds,
                    "samples": result.stats["samples"], "stopped_by": result.stats["stopped_by"],
                    "estimate": result.stats[key],
-                   "true": true_error(result.passes["Combined"][..., :3], ref, ref_var)[1]}
+                   "true": true_error(result.passes["Combined"][..., :3], ref, ref_var)[1],
+                   "denoise_seconds": result.stats["denoising"]["seconds"] if use_denoising else 0.0,
+                   "denoised_steps": sum("relmse_denoised" in entry for entry in result.log),
+                   "load": os.getloadavg()[0]}
             print(row, flush=True)
             targets.append(row)
     return {"width": WIDTH, "reference_samples": REFERENCE_SAMPLES, "seeds": list(SEEDS),
@@ -125,6 +129,7 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     relative squared error of the denoised image per pixel, and its true one against the
     reference. The error maps are pooled over 9x9 pixels (the estimate per pixel is a difference
     of noisy squares) and drawn on one log scale, 1e-6 black to 1e-2 white."""
+    import bpy
     import numpy as np
     import OpenImageIO as oiio
 
@@ -138,7 +143,8 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     from drt_engine.core.render.render import Renderer
     from drt_engine.core.settings import NOISY_IMAGE
 
-    drt_engine.register()
+    if not hasattr(bpy.types.Scene, "drt"):  # --calibration measured in this process: registered already
+        drt_engine.register()
     oidn = denoiser.load(oidn_library())
     scene, data = bench_scenes.load(name, WIDTH)
 
@@ -208,17 +214,33 @@ def calibration_block(m: dict) -> str:
               f"misses is blurred detail, and OIDN smoothing a noisier half harder than the whole; the "
               f"cross-validation against the noisy halves sees both). Denoising time "
               f"is the finished image's five OIDN runs (albedo and normal prefiltered once, then the whole image "
-              f"and both halves), wall clock on a machine shared with other work (load about twice its 2 cores). "
+              f"and both halves), wall clock on a machine shared with other work ({_loads(m['rows'])}). "
               f"Measurements: `bench/denoise_calibration.json`."]
     if m.get("target_rows"):
         lines += ["", f"Time to a relMSE of {m['target']:g} with Target Error {m['target']:g} (seed 1, no adaptive "
-                  f"sampling; with Denoise on the target applies to the denoised image, and every logged step "
-                  f"denoises to know whether it is there yet, so the OIDN runs repeat at each step):", "",
-                  "| scene | denoise | samples | time | estimated relMSE | true relMSE |", "|---|---|---|---|---|---|"]
-        for row in m["target_rows"]:
-            lines.append(f"| {row['scene']} | {'on' if row['use_denoising'] else 'off'} | {row['samples']} "
-                         f"| {row['seconds']:.1f} s | {row['estimate']:.2e} | {row['true']:.2e} |")
+                  f"sampling; with Denoise on the target applies to the denoised image, and a step is denoised, "
+                  f"five OIDN runs, only when its noisy estimate times the last denoised / noisy ratio is under "
+                  f"the target: `denoise.Schedule`):", "",
+                  "| scene | samples off / on | time off | time on (of it denoising, steps denoised) | off / on "
+                  "| estimated relMSE on | true relMSE on | load |", "|---|---|---|---|---|---|---|---|"]
+        rows = {(r["scene"], r["use_denoising"]): r for r in m["target_rows"]}
+        faster = []
+        for scene in dict.fromkeys(r["scene"] for r in m["target_rows"]):
+            off, on = rows[scene, False], rows[scene, True]
+            faster.append(off["seconds"] / on["seconds"])
+            lines.append(f"| {scene} | {off['samples']} / {on['samples']} | {off['seconds']:.1f} s "
+                         f"| {on['seconds']:.1f} s ({on['denoise_seconds']:.1f} s, {on['denoised_steps']}) "
+                         f"| {faster[-1]:.1f}x | {on['estimate']:.2e} | {on['true']:.2e} "
+                         f"| {off['load']:.1f}, {on['load']:.1f} |")
+        lines += ["", f"Denoising reached the target {', '.join(f'{x:.1f}' for x in faster)} times as fast; load: "
+                  f"the 1-minute load average after each run, on 2 cores."]
     return "\n".join(lines)
+
+
+def _loads(rows) -> str:
+    """The 1-minute load averages the rows were measured under, on the machine's 2 cores."""
+    loads = [r["load"] for r in rows if "load" in r]
+    return f"load average {min(loads):.1f} to {max(loads):.1f} on 2 cores" if loads else "load not recorded"
 
 
 def main() -> None:
