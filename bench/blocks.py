@@ -23,6 +23,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "viewport-denoise": DOCS / "viewport.md",
     "denoise": DOCS / "denoising.md",
     "denoise-calibration": DOCS / "denoising.md",
+    "denoise-feature-noise": DOCS / "denoising.md",
 }
 RESULTS_THROUGHPUT = ("<!-- throughput: begin -->", "<!-- throughput: end -->")
 """bench/throughput.py's section of bench/RESULTS.md, which bench/run.py keeps when it rewrites the file."""

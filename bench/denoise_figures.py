@@ -29,6 +29,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 MEASURED = ROOT / "out" / "ui" / "denoise.json"
 MAPS = ROOT / "bench" / "plots" / "denoise_cornell_box.png"
 CALIBRATION = ROOT / "bench" / "denoise_calibration.json"
+FEATURE_NOISE = ROOT / "bench" / "denoise_feature_noise.json"
 RESULTS = ROOT / "bench" / "results"
 
 SCENES = ("cornell_box", "dof_row", "glossy_spheres", "motion_blur")
@@ -186,6 +187,60 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     print(f"wrote {path.relative_to(ROOT)}: estimated relMSE {estimated.mean():.3g}, true {true.mean():.3g}")
 
 
+def feature_noise(samples=16) -> dict:
+    """What the denoised estimate misses because the three denoisings share the albedo and normal,
+    traced over all the samples (their noise is correlated with both halves'): per scene, the estimate
+    / true error as DRT computes it, and as it comes out when each half is a render of its own (other
+    seeds, half the samples) denoised with its own features, the whole image with their mean."""
+    import bpy
+    import numpy as np
+
+    import drt_engine
+    import scenes as bench_scenes
+    from drt_engine.blender.oidn import oidn_library
+    from drt_engine.core.film import denoiser
+    from drt_engine.core.film.denoising import ALBEDO, NORMAL
+    from drt_engine.core.render.adaptive import true_error
+    from drt_engine.core.render.denoise import denoised_error
+    from drt_engine.core.render.render import Renderer
+
+    if not hasattr(bpy.types.Scene, "drt"):
+        drt_engine.register()
+    oidn = denoiser.load(oidn_library())
+    rows = []
+    for name in SCENES:
+        scene, data = bench_scenes.load(name, WIDTH)
+
+        def settings_for(**kw):
+            return bench_scenes.settings(scene, threads=0, use_adaptive_sampling=False, **kw)
+
+        ref, ref_var = reference(name, data, settings_for)
+        shared = Renderer(data, settings_for(samples=samples, seed=1, use_denoising=True), denoiser=oidn).render()
+        halves = [Renderer(data, settings_for(samples=samples // 2, seed=seed, passes=("Combined", ALBEDO, NORMAL)))
+                  .render().passes for seed in (11, 12)]
+        noisy = [half["Combined"][..., :3].astype(np.float64) for half in halves]
+        whole = oidn.denoise(sum(noisy) / 2, *(sum(half[k] for half in halves) / 2 for k in (ALBEDO, NORMAL)))
+        own = [oidn.denoise(image, half[ALBEDO], half[NORMAL]) for image, half in zip(noisy, halves)]
+        n = np.full(noisy[0].shape[0] * noisy[0].shape[1], float(samples))
+        estimate = denoised_error(whole, *own, *noisy, n, n / 2)
+        row = {"scene": name, "samples": samples,
+               "shared": shared.stats["relmse_denoised"] / true_error(shared.passes["Combined"][..., :3], ref, ref_var)[1],
+               "own": estimate["relmse"] / true_error(whole, ref, ref_var)[1]}
+        print(row, flush=True)
+        rows.append(row)
+    return {"rows": rows, "reference_samples": REFERENCE_SAMPLES, "width": WIDTH}
+
+
+def feature_noise_block(m: dict) -> str:
+    lines = ["| scene | denoised est. / true, features shared (DRT) | halves with features of their own |",
+             "|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['shared']:.2f} | {r['own']:.2f} |" for r in m["rows"]]
+    lines += ["", f"{m['rows'][0]['samples']} samples, {m['width']} px wide, seed 1 (halves: two renders of half "
+              f"the samples, seeds 11 and 12), against {m['reference_samples']}-sample references "
+              f"(`bench/denoise_figures.py --feature-noise`, `bench/denoise_feature_noise.json`)."]
+    return "\n".join(lines)
+
+
 def calibration_block(m: dict) -> str:
     """One line per scene and sample count, the figures averaged over the seeds (est. / true: its range)."""
     lines = ["| scene | spp | noisy relMSE (est. / true) | denoised relMSE | denoised / noisy | "
@@ -253,7 +308,13 @@ def main() -> None:
                         help="only draw bench/plots/denoise_cornell_box.png (noisy, denoised, estimated and true error)")
     parser.add_argument("--publish-only", action="store_true",
                         help="rewrite the calibration block from bench/denoise_calibration.json without rendering")
+    parser.add_argument("--feature-noise", action="store_true",
+                        help="measure what the estimate misses through the features the halves share")
     args = parser.parse_args()
+    if args.feature_noise:
+        FEATURE_NOISE.write_text(json.dumps(feature_noise(), indent=1) + "\n")
+        write_block("denoise-feature-noise", feature_noise_block(json.loads(FEATURE_NOISE.read_text())))
+        return
     if args.maps:
         maps()
         return
