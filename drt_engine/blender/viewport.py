@@ -114,7 +114,7 @@ class ViewportSession:
         self.denoise = None  # ViewDenoise, or None: the viewport is not denoised
         self.key = None  # region size and matrices the running render is for
         self.texture = None
-        weakref.finalize(engine, self.worker.stop)  # Blender frees the engine: stop the worker
+        weakref.finalize(engine, self.worker.close)  # Blender frees the engine: stop the worker
 
     def update(self, engine, depsgraph) -> None:
         """The scene changed (or the viewport opened): export what changed; the next ``draw``
@@ -181,6 +181,8 @@ class ViewportRender:
         self.status = ""
         self._prepared = None  # (SceneData, PreparedScene) of the newest scene prepared
         self._prepare_lock = threading.Lock()
+        self._filters = None  # core.film.denoiser.Filters the views share (set up once per size)
+        self._filters_lock = threading.Lock()
 
     def start(self, scene_data, cameras, settings, denoise: ViewDenoise | None = None) -> None:
         """Stop the running worker (without waiting for it) and render ``scene_data`` seen by
@@ -198,6 +200,25 @@ class ViewportRender:
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout)
+
+    def close(self) -> None:
+        """Stop the worker and release the denoiser's filters (a worker still running then fails
+        with a DenoiserError instead of setting filters up again)."""
+        self.stop()
+        with self._filters_lock:
+            if self._filters is not None:
+                self._filters.close()
+
+    def filters(self, denoiser):
+        """The denoiser's filters, kept from view to view: setting one up for a 1280x720 image took
+        0.2-0.3 s (bench/viewport_times.py's load), which every orbit step would pay again. Workers
+        may overlap; the denoiser's lock serialises their runs."""
+        with self._filters_lock:
+            if self._filters is None or self._filters.denoiser is not denoiser:
+                if self._filters is not None:
+                    self._filters.close()
+                self._filters = denoiser.filters()
+            return self._filters
 
     def latest(self) -> tuple[int, np.ndarray | None]:
         with self._lock:
@@ -229,7 +250,6 @@ class ViewportRender:
     def _run(self, scene_data, cameras, settings, stop: threading.Event, denoise=None) -> None:
         from ..core.render.render import Renderer
 
-        filters = None  # the denoiser's filters, kept over this view's refreshes
         try:
             _nicer(WORKER_NICE)
             prepared = self.prepared(scene_data)
@@ -248,12 +268,9 @@ class ViewportRender:
             last = [0.0]
 
             def shown(passes, samples):
-                nonlocal filters
                 if denoise is None:
                     return passes["Combined"], ""
-                if filters is None:
-                    filters = denoise.denoiser.filters()
-                image, denoised = denoise.image(passes, samples, filters)
+                image, denoised = denoise.image(passes, samples, self.filters(denoise.denoiser))
                 return image, " | Denoised" if denoised else ""
 
             def progress(update) -> bool:
@@ -276,9 +293,6 @@ class ViewportRender:
         except Exception as error:  # a bug of ours: keep the UI alive, details in the console
             print(f"DRT: unexpected error in the viewport render\n{traceback.format_exc()}")
             self._fail(f"DRT internal error: {type(error).__name__}: {error}", stop)
-        finally:
-            if filters is not None:
-                filters.close()
 
     def _fail(self, message: str, stop: threading.Event) -> None:
         with self._lock:

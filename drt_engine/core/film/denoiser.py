@@ -137,11 +137,13 @@ class Filters:
     """RT filters of one device, each made and committed once per set of images, size, flags and
     quality, with its own image buffers shared with OIDN: a call copies its images in and runs the
     filter (OIDN reads shared images at execution, no commit needed). ``close`` releases them (their
-    scratch memory grows with the image). One user at a time: a render, or the viewport's worker."""
+    scratch memory grows with the image); a call after it is a DenoiserError. Calls hold the device's
+    lock, so users that overlap (the viewport's workers) take turns."""
 
     def __init__(self, denoiser: Denoiser):
-        self._denoiser = denoiser
+        self.denoiser = denoiser
         self._kept: dict = {}  # key -> (filter handle, {image name: buffer})
+        self._closed = False
 
     def __enter__(self) -> "Filters":
         return self
@@ -150,11 +152,12 @@ class Filters:
         self.close()
 
     def close(self) -> None:
-        lib = self._denoiser._lib
-        with self._denoiser._lock:
+        lib = self.denoiser._lib
+        with self.denoiser._lock:
             for handle, _ in self._kept.values():
                 lib.oidnReleaseFilter(handle)
             self._kept.clear()
+            self._closed = True
 
     def denoise(self, color, albedo=None, normal=None, prefilter: str = "ACCURATE",
                 quality: str = "HIGH") -> np.ndarray:
@@ -187,8 +190,10 @@ class Filters:
         images = {name: image for name, image in images.items() if image is not None}
         h, w = next(iter(images.values())).shape[:2]
         key = (tuple(images), h, w, tuple(sorted(flags.items())), quality)
-        dn = self._denoiser
+        dn = self.denoiser
         with dn._lock:
+            if self._closed:
+                raise DenoiserError("OpenImageDenoise's filters were used after they were released")
             if key not in self._kept:
                 self._kept[key] = self._new(images, flags, quality, h, w)
             handle, buffers = self._kept[key]
@@ -200,7 +205,7 @@ class Filters:
 
     def _new(self, images: dict, flags: dict, quality: str, h: int, w: int):
         """A committed RT filter over buffers of its own, for ``_run``'s key (the lock held)."""
-        dn, lib = self._denoiser, self._denoiser._lib
+        dn, lib = self.denoiser, self.denoiser._lib
         handle = lib.oidnNewFilter(dn._device, b"RT")
         if not handle:
             dn._check(dn._device, "creating its RT filter")
