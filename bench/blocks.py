@@ -20,8 +20,10 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "bench-adaptive": DOCS / "adaptive-sampling.md",
     "ratio": DOCS / "ratio-estimator.md",
     "viewport-times": DOCS / "viewport.md",
+    "viewport-denoise": DOCS / "viewport.md",
     "denoise": DOCS / "denoising.md",
     "denoise-calibration": DOCS / "denoising.md",
+    "denoise-feature-noise": DOCS / "denoising.md",
 }
 RESULTS_THROUGHPUT = ("<!-- throughput: begin -->", "<!-- throughput: end -->")
 """bench/throughput.py's section of bench/RESULTS.md, which bench/run.py keeps when it rewrites the file."""

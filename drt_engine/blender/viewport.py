@@ -49,8 +49,8 @@ STOP_TIMEOUT = 5.0
 
 
 def viewport_settings(settings, preview_samples: int):
-    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, not denoised
-    (``use_denoising`` is for final renders; the viewport's denoising is still to come)."""
+    """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, no final-render
+    denoising (``use_denoising``; the viewport denoises its own images through ViewDenoise)."""
     return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
                                sample_start=0, sample_end=0, use_denoising=False)
@@ -72,15 +72,15 @@ class ViewDenoise:
         """The viewport's settings with the features the denoiser needs traced."""
         return with_features(settings)
 
-    def image(self, passes: dict, samples: int) -> tuple[np.ndarray, bool]:
+    def image(self, passes: dict, samples: int, filters) -> tuple[np.ndarray, bool]:
         """(RGBA image to show, whether it is denoised) of a render's passes with ``samples`` in
-        every pixel."""
+        every pixel, denoised on ``filters`` (the worker's: core.film.denoiser.Filters)."""
         combined = passes["Combined"]
         if samples < self.start_sample:
             return combined, False
         out = combined.copy()
-        out[..., :3] = self.denoiser.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
-                                             prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+        out[..., :3] = filters.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
+                                       prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
         return out, True
 
 
@@ -114,7 +114,7 @@ class ViewportSession:
         self.denoise = None  # ViewDenoise, or None: the viewport is not denoised
         self.key = None  # region size and matrices the running render is for
         self.texture = None
-        weakref.finalize(engine, self.worker.stop)  # Blender frees the engine: stop the worker
+        weakref.finalize(engine, self.worker.close)  # Blender frees the engine: stop the worker
 
     def update(self, engine, depsgraph) -> None:
         """The scene changed (or the viewport opened): export what changed; the next ``draw``
@@ -181,6 +181,8 @@ class ViewportRender:
         self.status = ""
         self._prepared = None  # (SceneData, PreparedScene) of the newest scene prepared
         self._prepare_lock = threading.Lock()
+        self._filters = None  # core.film.denoiser.Filters the views share (set up once per size)
+        self._filters_lock = threading.Lock()
 
     def start(self, scene_data, cameras, settings, denoise: ViewDenoise | None = None) -> None:
         """Stop the running worker (without waiting for it) and render ``scene_data`` seen by
@@ -198,6 +200,25 @@ class ViewportRender:
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout)
+
+    def close(self) -> None:
+        """Stop the worker and release the denoiser's filters (a worker still running then fails
+        with a DenoiserError instead of setting filters up again)."""
+        self.stop()
+        with self._filters_lock:
+            if self._filters is not None:
+                self._filters.close()
+
+    def filters(self, denoiser):
+        """The denoiser's filters, kept from view to view: setting one up for a 1280x720 image took
+        0.2-0.3 s (bench/viewport_times.py's load), which every orbit step would pay again. Workers
+        may overlap; the denoiser's lock serialises their runs."""
+        with self._filters_lock:
+            if self._filters is None or self._filters.denoiser is not denoiser:
+                if self._filters is not None:
+                    self._filters.close()
+                self._filters = denoiser.filters()
+            return self._filters
 
     def latest(self) -> tuple[int, np.ndarray | None]:
         with self._lock:
@@ -249,7 +270,7 @@ class ViewportRender:
             def shown(passes, samples):
                 if denoise is None:
                     return passes["Combined"], ""
-                image, denoised = denoise.image(passes, samples)
+                image, denoised = denoise.image(passes, samples, self.filters(denoise.denoiser))
                 return image, " | Denoised" if denoised else ""
 
             def progress(update) -> bool:

@@ -106,7 +106,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "analytic light times the pixel's visible fraction (scene.drt.shadow_estimator)")
     render.add_argument("--denoise", action="store_true",
                         help="denoise Combined with the OpenImageDenoise library Blender ships, keeping the image "
-                        "as rendered as the Noisy Image pass (scene.drt.use_denoising); not with split renders")
+                        "as rendered as the Noisy Image pass (scene.drt.use_denoising); a split render is "
+                        "denoised once, after its parts are merged")
     farm = render.add_argument_group(
         "render farm", "Split the render over processes or machines: sample ranges of a frame, frames of an "
         "animation. Parts need a fixed sample count (no adaptive sampling, time limit or target error).")

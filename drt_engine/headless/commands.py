@@ -22,10 +22,6 @@ def render(args) -> str:
     check_paths(blend, output)
     if args.workers is not None and args.cluster is not None:
         raise CLIError("choose --workers (a local cluster) or --cluster (a running one), not both")
-    split = args.workers is not None or args.cluster is not None or args.sample_range is not None
-    if args.denoise and split:
-        raise CLIError("--denoise: a split render's parts are not denoised and the merge does not denoise yet; "
-                       "render it whole, or denoise the merged image in Blender's compositor")
     if args.workers is not None or args.cluster is not None:
         if args.sample_range is not None:
             raise CLIError("--sample-range renders one part here; --workers and --cluster split the render themselves")

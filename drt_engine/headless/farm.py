@@ -89,6 +89,8 @@ def _plan(args, blend: Path) -> tuple[int, list[int], list[str]]:
         threads = max(1, (os.cpu_count() or 1) // args.workers)
     if threads is not None:
         options += ["--engine-threads", str(threads)]
+    if args.denoise:  # the parts carry the denoiser's features; the merge denoises
+        options.append("--denoise")
     return samples, frames, options
 
 

@@ -30,11 +30,32 @@ def write_part(output: Path, part) -> None:
 
 
 def write_output(output: Path, merger) -> None:
+    """The merged image as an EXR: denoised once here when the parts were rendered with denoising."""
+    images = merger.images(merge_denoiser(merger))
     try:
         output.parent.mkdir(parents=True, exist_ok=True)
-        merge.write_exr(output, merger.film, merger.first.header["view_layer"])
+        merge.write_exr(output, images, merger.first.header["view_layer"])
     except OSError as error:
         raise CLIError(f"cannot write {output}: {error.strerror or error}") from None
+
+
+def merge_denoiser(merger):
+    """Blender's OpenImageDenoise for parts rendered with denoising, else None; where this Blender
+    has none, a warning line and the merged image as rendered (as a render in Blender does)."""
+    if not merger.denoising:
+        return None
+    from ..blender import oidn
+    from ..core.errors import DRTError
+    from ..core.film.denoiser import load
+
+    path = oidn.oidn_library()
+    if path is None:
+        print(f"DRT: warning: {oidn.UNAVAILABLE}; the merged image is not denoised", flush=True)
+        return None
+    try:
+        return load(path)
+    except DRTError as error:
+        raise CLIError(str(error)) from None
 
 
 def done_line(output: Path, width: int, height: int, stats: dict, elapsed: float, samples: str | None = None) -> str:

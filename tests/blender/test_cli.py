@@ -243,11 +243,6 @@ def test_denoise_keeps_the_noisy_image_and_reports_both_errors(bl, blend, tmp_pa
     assert abs(denoised.mean() / STRENGTH - 1) < 5e-3
 
 
-@pytest.mark.parametrize("split", [["--workers", "2"], ["--sample-range", "0:1"]])
-def test_denoise_refuses_split_renders(blend, tmp_path, split):
-    assert_one_line_error(run_cli("render", blend, "-o", tmp_path / "x.exr", "--denoise", *split), "--denoise")
-
-
 def test_denoise_without_oidn_is_one_clear_error(blend, tmp_path, monkeypatch):
     """Where Blender ships no OpenImageDenoise (Debian's 4.3.2) the CLI says so instead of rendering."""
     from drt_engine.blender import oidn
@@ -258,3 +253,18 @@ def test_denoise_without_oidn_is_one_clear_error(blend, tmp_path, monkeypatch):
     args = cli.build_parser().parse_args(["render", str(blend), "-o", str(tmp_path / "x.exr"), "--denoise"])
     with pytest.raises(CLIError, match="--denoise: .*OpenImageDenoise"):
         scene.open_scene(args, blend)
+
+
+def test_merging_denoised_parts_where_blender_has_no_oidn_warns_and_keeps_the_image(monkeypatch, capsys):
+    """Parts rendered with denoising, merged where Blender ships no OpenImageDenoise: one warning line,
+    and the merged image as rendered (as a render in such a Blender is)."""
+    from types import SimpleNamespace
+
+    from drt_engine.blender import oidn
+    from drt_engine.headless import outputs
+
+    assert outputs.merge_denoiser(SimpleNamespace(denoising=False)) is None
+    monkeypatch.setattr(oidn, "search", lambda: None)
+    assert outputs.merge_denoiser(SimpleNamespace(denoising=True)) is None
+    printed = capsys.readouterr().out
+    assert printed.count("\n") == 1 and printed.startswith("DRT: warning:") and "not denoised" in printed

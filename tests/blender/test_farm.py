@@ -155,6 +155,28 @@ def test_split_render_with_a_killed_worker_equals_the_single_render(cornell_box,
     tree.assert_all_gone()
 
 
+def test_a_denoised_split_render_is_denoised_once_after_the_merge(cornell_box, tmp_path):
+    """``--denoise --workers 2``: the parts carry the denoiser's features and halves, the merge denoises
+    the merged image once, and it is the single denoised render (the same noisy sums into OIDN; the
+    denoised image within 1e-3, what float64 sums added in another order change in OIDN's output)."""
+    single, split = tmp_path / "single.exr", tmp_path / "split.exr"
+    result = run("render", cornell_box, "-o", single, *OPTIONS, "--denoise")
+    assert result.returncode == 0, result.stderr
+    result = run("render", cornell_box, "-o", split, *OPTIONS, "--denoise", "--workers", 2, timeout=240)
+    assert result.returncode == 0, result.stderr
+    assert "2/2 tasks done" in result.stdout and "(denoised " in result.stdout.splitlines()[-1]
+    a, b = read_channels(split), read_channels(single)
+    assert sorted(a) == sorted(b) and "ViewLayer.Noisy Image.R" in a
+    for name in b:
+        tolerance = 1e-3 if ".Combined." in name and not name.endswith(".A") else RELATIVE
+        assert np.allclose(a[name], b[name], rtol=tolerance, atol=tolerance * np.abs(b[name]).max()), name
+    report, expected = (json.loads(p.with_name(p.stem + ".drt.json").read_text()) for p in (split, single))
+    log = report["log"]  # an entry as the merged samples grow (one or two: parts may arrive out of order)
+    assert ["relmse_denoised" in entry for entry in log] == [False] * (len(log) - 1) + [True]
+    for key in ("relmse", "relmse_denoised"):
+        assert report["stats"][key] == pytest.approx(expected["stats"][key], rel=1e-3), key
+
+
 def test_merged_parts_from_blender_and_the_cli_equal_the_single_render(drt, cornell_box, single, tmp_path):
     """Samples 0:3 from a `blender -b`-style render (scene.drt.sample_offset / count), 3:8 from the CLI."""
     cli_part = tmp_path / "b.exr"

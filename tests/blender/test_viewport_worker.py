@@ -84,3 +84,22 @@ def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_re
         assert statuses[-1].startswith("Done") and statuses[-1].endswith("| Denoised") == note, statuses[-1]
         np.testing.assert_array_equal(image, expected.astype(np.float32))
     assert not np.array_equal(denoised[..., :3], passes["Combined"][..., :3])
+
+
+def test_views_share_the_denoisers_filters_until_the_viewport_closes():
+    """Every view of one viewport denoises on the same filters (set up once per size, not per orbit
+    step); closing the viewport releases them, and a late worker's call is then a DRT error."""
+    import pytest
+
+    from drt_engine.core.errors import DenoiserError
+    from drt_engine.core.film import denoiser
+    from tests.support.oidn import require_oidn
+
+    oidn = denoiser.load(require_oidn())
+    viewport = ViewportRender(lambda: None)
+    filters = viewport.filters(oidn)
+    assert viewport.filters(oidn) is filters
+    filters.denoise(np.ones((8, 8, 3)))
+    viewport.close()
+    with pytest.raises(DenoiserError, match="released"):
+        filters.denoise(np.ones((8, 8, 3)))

@@ -5,13 +5,16 @@ The scene is the soft-shadow scene (a sphere and a cube under a rectangular area
 pixels): its error sits in the penumbrae, where OIDN has real work to do. The reference is a
 512-sample render of another seed, its own variance taken off the true errors.
 """
+import math
+
 import numpy as np
 import pytest
 
 from drt_engine.core.errors import SettingsError
 from drt_engine.core.film import denoiser
 from drt_engine.core.render.adaptive import true_error
-from drt_engine.core.render.denoise import denoised_error
+from drt_engine.core.render.denoise import DENOISED_SHARE, Schedule, denoised_error
+from drt_engine.core.render.driver import TARGET_MIN_SAMPLES
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import NOISY_IMAGE, RenderSettings
 from tests.support.oidn import require_oidn
@@ -131,13 +134,26 @@ def test_a_farm_part_is_not_denoised(oidn):
     assert any("not denoised" in w for w in part.warnings)
 
 
-def test_the_denoised_estimate_is_logged_at_the_end_or_with_a_target_at_every_step(oidn, pair):
+def test_the_denoised_estimate_is_logged_at_the_end_or_at_the_steps_that_could_meet_the_target(oidn, pair):
     denoised, plain = pair
     assert [("relmse_denoised" in entry) for entry in denoised.log] == [False] * (len(denoised.log) - 1) + [True]
     assert all("relmse_denoised" not in entry for entry in plain.log)
-    targeted = render(oidn, samples=32, use_denoising=True, target_error=1e-9)  # never reached
-    steps = [entry for entry in targeted.log if entry["spp_max"] >= 2]
-    assert len(steps) >= 2 and all(0 < entry["relmse_denoised"] <= entry["relmse"] for entry in steps)
+    unreachable = render(oidn, samples=32, use_denoising=True, target_error=1e-9)
+    assert [("relmse_denoised" in entry) for entry in unreachable.log] == [False] * (len(unreachable.log) - 1) + [True]
+    assert unreachable.stats["stopped_by"] == "samples"
+    loose = render(oidn, samples=32, use_denoising=True, target_error=1.0)  # any denoised image is under it
+    steps = [entry for entry in loose.log if "relmse_denoised" in entry]
+    assert loose.stats["stopped_by"] == "target_error" and steps == [loose.log[-1]]
+    assert loose.log[-1]["spp_max"] == TARGET_MIN_SAMPLES and loose.log[-1]["relmse_denoised"] < 1.0
+
+
+def test_a_step_is_denoised_when_its_noisy_error_times_the_last_ratio_is_under_the_target():
+    schedule = Schedule(1e-3)
+    assert schedule.ratio == DENOISED_SHARE and not schedule.due(0.02) and schedule.due(0.009)
+    schedule.measured(4e-3, 2e-3)  # this scene's denoiser halves the error
+    assert not schedule.due(2.1e-3) and schedule.due(1.9e-3)
+    schedule.measured(math.inf, 1e-3)  # an unknown step changes nothing
+    assert schedule.ratio == 0.5
 
 
 def test_the_target_error_applies_to_the_denoised_image(oidn):
@@ -149,3 +165,40 @@ def test_the_target_error_applies_to_the_denoised_image(oidn):
     assert noisy.stats["stopped_by"] == denoised.stats["stopped_by"] == "target_error"
     assert denoised.stats["samples"] < noisy.stats["samples"]
     assert denoised.stats["relmse_denoised"] < target < denoised.stats["relmse"]
+
+
+def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch):
+    """A farm's parts carry the denoiser's features and the replicate halves in their sums; the merge
+    denoises the merged film once (not per part, however often its images are asked for) and gives
+    the whole render's denoised image and estimate."""
+    from drt_engine.core.film import parts
+    from drt_engine.core.film.denoising import PASSES as FEATURE_PASSES
+    from drt_engine.core.render import merge, report
+
+    scene, base = soft_shadow_scene(WIDTH)
+
+    def run(start=0, end=0):
+        settings = RenderSettings(**{**base, "samples": SPP, "seed": 1, "passes": ("Combined",),
+                                     "use_denoising": True, "sample_start": start, "sample_end": end})
+        renderer = Renderer(scene, settings, denoiser=oidn)
+        result = renderer.render()
+        summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(scene))
+        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(scene), "report": summary}
+        return parts.from_film(renderer.film, settings, header), result
+
+    whole = run()[1]
+    pieces = [run(a, b)[0] for a, b in ((3, SPP), (0, 3))]
+    assert all(set(FEATURE_PASSES) <= set(piece.sums) for piece in pieces)
+    calls = []
+    monkeypatch.setattr(merge, "denoise_film", lambda *a, real=merge.denoise_film: calls.append(a) or real(*a))
+    merger = merge.merge_parts(pieces, ["A", "B"])
+    assert not calls and all("relmse_denoised" not in entry for entry in merger.log.entries)
+    images = merger.images(oidn)
+    assert merger.images(oidn)["Combined"] is not images["Combined"] and len(calls) == 1
+    assert set(images) == {"Combined", NOISY_IMAGE}
+    np.testing.assert_allclose(images[NOISY_IMAGE], whole.passes[NOISY_IMAGE], rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(images["Combined"], whole.passes["Combined"], rtol=1e-3, atol=1e-4)
+    stats = merger.report(1.0)["stats"]
+    assert stats["relmse_denoised"] == pytest.approx(whole.stats["relmse_denoised"], rel=1e-3)
+    assert ["relmse_denoised" in entry for entry in merger.log.entries] == [False, True]
+    assert set(merger.images(None)) == {"Combined"}  # without a library: the merged image as rendered

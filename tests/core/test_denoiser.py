@@ -58,6 +58,23 @@ def test_colour_alone_and_rgba_input(oidn):
     assert relmse(oidn.denoise(noisy), clean) < relmse(noisy[..., :3], clean) / 30
 
 
+def test_filters_kept_over_calls_give_what_fresh_filters_give(oidn):
+    """A render's or the viewport's Filters set each filter up once and copy new images into its
+    buffers: every image, of either size, prefiltered or not, comes out as a one-off call makes it."""
+    rng = np.random.default_rng(5)
+    albedo, normal = features()
+    calls = [(gradient() * rng.exponential(1.0, (H, W, 1)), albedo, normal, prefilter, "HIGH")
+             for prefilter in ("ACCURATE", "NONE", "ACCURATE")]
+    calls.append((rng.exponential(1.0, (H // 2, W, 3)), None, None, "NONE", "BALANCED"))
+    calls.append((gradient() * rng.exponential(1.0, (H, W, 1)), albedo, normal, "ACCURATE", "HIGH"))
+    with oidn.filters() as filters:
+        kept = [filters.denoise(*call) for call in calls]
+        assert len(filters._kept) == 4  # albedo, normal, the guided image, the image alone
+    for call, image in zip(calls, kept):
+        assert np.array_equal(image, oidn.denoise(*call))
+    assert not filters._kept  # released on leaving the block
+
+
 def test_quality_values_are_oidns(oidn):
     """OIDN reads back the value each quality name sets (oidn.h: FAST 4, BALANCED 5, HIGH 6)."""
     assert {q: oidn.filter_quality(q) for q in denoiser.QUALITIES} == {"FAST": 4, "BALANCED": 5, "HIGH": 6}

@@ -68,10 +68,10 @@ def load(path) -> "Denoiser":
 
 
 class Denoiser:
-    """One OIDN CPU device of the library at ``path``; ``denoise`` runs its RT filter.
+    """One OIDN CPU device of the library at ``path``; ``denoise`` runs its RT filter, ``filters``
+    keeps filters for repeated calls.
 
-    Calls on one device are serialised by OIDN itself; a lock here keeps a filter's error check
-    with its own calls."""
+    A lock serialises the calls on the device, so a filter's error check stays with its own calls."""
 
     def __init__(self, path):
         path = Path(path)
@@ -103,57 +103,23 @@ class Denoiser:
             text = message.value.decode(errors="replace") if message.value else f"error code {code}"
             raise DenoiserError(f"OpenImageDenoise failed {doing}: {text}")
 
+    def filters(self) -> "Filters":
+        """RT filters on this device kept alive between calls until closed: a render or a viewport
+        denoising image after image of one size sets up each filter once."""
+        return Filters(self)
+
     def denoise(self, color, albedo=None, normal=None, prefilter: str = "ACCURATE",
                 quality: str = "HIGH") -> np.ndarray:
         """The denoised (h, w, 3) float32 image of an HDR ``color`` (h, w, 3), guided by ``albedo``
-        (in [0, 1]) and ``normal`` (in [-1, 1]) when given (a normal needs an albedo, as OIDN asks)."""
-        if prefilter not in PREFILTERS:
-            raise DenoiserError(f"unknown denoising prefilter {prefilter!r} (one of {', '.join(PREFILTERS)})")
-        if quality not in QUALITIES:
-            raise DenoiserError(f"unknown denoising quality {quality!r} (one of {', '.join(QUALITIES)})")
-        color = _image(color)
-        albedo, normal = _features(albedo, normal, color.shape[:2])
-        if prefilter == "ACCURATE":
-            albedo, normal = self.clean_features(albedo, normal, quality)
-        output = np.empty_like(color)
-        with self._lock:
-            self._run({"color": color, "albedo": albedo, "normal": normal, "output": output},
-                      {"hdr": True, "cleanAux": prefilter != "FAST"}, quality)
-        return output
+        (in [0, 1]) and ``normal`` (in [-1, 1]) when given (a normal needs an albedo, as OIDN asks);
+        its filters are released after it."""
+        with self.filters() as filters:
+            return filters.denoise(color, albedo, normal, prefilter, quality)
 
     def clean_features(self, albedo, normal, quality: str = "HIGH"):
-        """(albedo, normal) denoised each by a filter of its own: the ACCURATE prefilter, which
-        ``denoise`` with prefilter NONE then takes as clean (several images guided by the same
-        features need it once)."""
-        if albedo is None:
-            return None, None
-        albedo, normal = _features(albedo, normal, np.shape(albedo)[:2])
-        with self._lock:
-            for name, aux in (("albedo", albedo), ("normal", normal)):
-                if aux is not None:
-                    self._run({name: aux, "output": aux}, {}, quality)
-        return albedo, normal
-
-    def _run(self, images: dict, flags: dict, quality: str) -> None:
-        lib = self._lib
-        flt = lib.oidnNewFilter(self._device, b"RT")
-        if not flt:
-            self._check(self._device, "creating its RT filter")
-            raise DenoiserError("OpenImageDenoise could not create its RT filter")
-        try:
-            for name, image in images.items():
-                if image is not None:
-                    h, w = image.shape[:2]
-                    lib.oidnSetSharedFilterImage(flt, name.encode(), image.ctypes.data, FORMAT_FLOAT3, w, h, 0, 0, 0)
-            for name, value in flags.items():
-                lib.oidnSetFilterBool(flt, name.encode(), value)
-            lib.oidnSetFilterInt(flt, b"quality", QUALITIES[quality])
-            lib.oidnCommitFilter(flt)
-            self._check(self._device, "setting up its filter")
-            lib.oidnExecuteFilter(flt)
-            self._check(self._device, "denoising")
-        finally:
-            lib.oidnReleaseFilter(flt)
+        """``Filters.clean_features`` with filters released after it."""
+        with self.filters() as filters:
+            return filters.clean_features(albedo, normal, quality)
 
     def filter_quality(self, quality: str) -> int:
         """The quality an RT filter reads back after it was set to ``quality`` (checks the enum)."""
@@ -165,6 +131,98 @@ class Denoiser:
             finally:
                 self._lib.oidnReleaseFilter(flt)
 
+
+
+class Filters:
+    """RT filters of one device, each made and committed once per set of images, size, flags and
+    quality, with its own image buffers shared with OIDN: a call copies its images in and runs the
+    filter (OIDN reads shared images at execution, no commit needed). ``close`` releases them (their
+    scratch memory grows with the image); a call after it is a DenoiserError. Calls hold the device's
+    lock, so users that overlap (the viewport's workers) take turns."""
+
+    def __init__(self, denoiser: Denoiser):
+        self.denoiser = denoiser
+        self._kept: dict = {}  # key -> (filter handle, {image name: buffer})
+        self._closed = False
+
+    def __enter__(self) -> "Filters":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        lib = self.denoiser._lib
+        with self.denoiser._lock:
+            for handle, _ in self._kept.values():
+                lib.oidnReleaseFilter(handle)
+            self._kept.clear()
+            self._closed = True
+
+    def denoise(self, color, albedo=None, normal=None, prefilter: str = "ACCURATE",
+                quality: str = "HIGH") -> np.ndarray:
+        """As ``Denoiser.denoise``."""
+        if prefilter not in PREFILTERS:
+            raise DenoiserError(f"unknown denoising prefilter {prefilter!r} (one of {', '.join(PREFILTERS)})")
+        if quality not in QUALITIES:
+            raise DenoiserError(f"unknown denoising quality {quality!r} (one of {', '.join(QUALITIES)})")
+        color = _image(color)
+        albedo, normal = _features(albedo, normal, color.shape[:2])
+        if prefilter == "ACCURATE":
+            albedo, normal = self.clean_features(albedo, normal, quality)
+        images = {"color": color, "albedo": albedo, "normal": normal}
+        return self._run(images, {"hdr": True, "cleanAux": prefilter != "FAST"}, quality)
+
+    def clean_features(self, albedo, normal, quality: str = "HIGH"):
+        """(albedo, normal) denoised each by a filter of its own: the ACCURATE prefilter, which
+        ``denoise`` with prefilter NONE then takes as clean (several images guided by the same
+        features need it once)."""
+        if quality not in QUALITIES:
+            raise DenoiserError(f"unknown denoising quality {quality!r} (one of {', '.join(QUALITIES)})")
+        if albedo is None:
+            return None, None
+        albedo, normal = _features(albedo, normal, np.shape(albedo)[:2])
+        return tuple(None if aux is None else self._run({name: aux}, {}, quality)
+                     for name, aux in (("albedo", albedo), ("normal", normal)))
+
+    def _run(self, images: dict, flags: dict, quality: str) -> np.ndarray:
+        """The filter's output for ``images`` (name -> (h, w, 3) float32, None for absent)."""
+        images = {name: image for name, image in images.items() if image is not None}
+        h, w = next(iter(images.values())).shape[:2]
+        key = (tuple(images), h, w, tuple(sorted(flags.items())), quality)
+        dn = self.denoiser
+        with dn._lock:
+            if self._closed:
+                raise DenoiserError("OpenImageDenoise's filters were used after they were released")
+            if key not in self._kept:
+                self._kept[key] = self._new(images, flags, quality, h, w)
+            handle, buffers = self._kept[key]
+            for name, image in images.items():
+                np.copyto(buffers[name], image)
+            dn._lib.oidnExecuteFilter(handle)
+            dn._check(dn._device, "denoising")
+            return buffers["output"].copy()
+
+    def _new(self, images: dict, flags: dict, quality: str, h: int, w: int):
+        """A committed RT filter over buffers of its own, for ``_run``'s key (the lock held)."""
+        dn, lib = self.denoiser, self.denoiser._lib
+        handle = lib.oidnNewFilter(dn._device, b"RT")
+        if not handle:
+            dn._check(dn._device, "creating its RT filter")
+            raise DenoiserError("OpenImageDenoise could not create its RT filter")
+        buffers = {name: np.zeros((h, w, 3), np.float32) for name in (*images, "output")}
+        try:
+            for name, buffer in buffers.items():
+                lib.oidnSetSharedFilterImage(handle, name.encode(), buffer.ctypes.data, FORMAT_FLOAT3, w, h, 0, 0, 0)
+            for name, value in flags.items():
+                lib.oidnSetFilterBool(handle, name.encode(), value)
+            lib.oidnSetFilterInt(handle, b"quality", QUALITIES[quality])
+            lib.oidnCommitFilter(handle)
+            dn._check(dn._device, "setting up its filter")
+        except BaseException:
+            lib.oidnReleaseFilter(handle)
+            raise
+        return handle, buffers
 
 def _features(albedo, normal, shape):
     """Float32 copies of the features in OIDN's ranges (albedo [0, 1], normal [-1, 1]); no normal

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..film.denoising import ALBEDO, NORMAL
 from ..film.film import Film
+from ..settings import NOISY_IMAGE
 from .adaptive import RELMSE_EPSILON, TRUE_FLOOR
 
 
@@ -45,13 +46,38 @@ class Denoised:
     seconds: float  # the denoisings' time
 
 
+DENOISED_SHARE = 0.1
+"""The denoised / noisy relMSE a render assumes before it has measured its own: below every ratio
+measured on the sample scenes (docs/denoising.md), so ``Schedule`` skips no step that could have
+met the target unless a scene denoises better still."""
+
+
+class Schedule:
+    """Which steps of a render under a target error are denoised (each costs five OIDN runs): those
+    whose noisy estimate times the denoised / noisy ratio of the last step denoised (DENOISED_SHARE
+    before one) is under the target. That ratio grows with the samples (OIDN gains less as the noise
+    falls: docs/denoising.md), so the prediction leans low and a step that could meet the target is
+    not skipped; the stop itself is always on a denoised estimate (core.render.driver)."""
+
+    def __init__(self, target: float):
+        self.target, self.ratio = target, DENOISED_SHARE
+
+    def due(self, relmse_noisy: float) -> bool:
+        return relmse_noisy * self.ratio < self.target
+
+    def measured(self, relmse_noisy: float, relmse_denoised: float) -> None:
+        if 0 < relmse_noisy < math.inf and relmse_denoised < math.inf:
+            self.ratio = relmse_denoised / relmse_noisy
+
+
 ERROR_BLOCK = 1 << 20
 """Pixels whose error terms are computed at a time: float64 temporaries of a whole 8K image are GBs."""
 
 
 def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: str) -> Denoised:
     """The denoised Combined image of ``film`` and its estimated error; ``passes`` are the film's
-    images (Denoising Albedo and Normal among them), ``denoiser`` a core.film.denoiser.Denoiser."""
+    images (Denoising Albedo and Normal among them), ``denoiser`` a core.film.denoiser.Denoiser or,
+    for repeated denoisings, its Filters."""
     start = time.perf_counter()
     shape = (film.height, film.width, 3)
     albedo, normal = passes.get(ALBEDO), passes.get(NORMAL)
@@ -63,6 +89,24 @@ def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: st
                             for image in noisy)
     error = denoised_error(full, half_a, half_b, noisy[1], noisy[2], film.count, film.count_a)
     return Denoised(full, error, time.perf_counter() - start)
+
+
+def figures(denoised: Denoised) -> dict:
+    """The denoised image's estimated error as the log, the stats and the report name it."""
+    e = denoised.error
+    return {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
+            "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
+
+
+def denoised_passes(passes: dict, denoised: Denoised, wanted) -> dict:
+    """The passes of a denoised render: Combined denoised (alpha as rendered), the image as rendered
+    kept as Noisy Image, the features the denoiser read dropped unless ``wanted`` names them."""
+    noisy = passes["Combined"]
+    combined = noisy.copy()
+    combined[..., :3] = denoised.rgb
+    out = {name: image for name, image in passes.items() if name in wanted}
+    out["Combined"], out[NOISY_IMAGE] = combined, noisy
+    return out
 
 
 def noisy_images(film: Film) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

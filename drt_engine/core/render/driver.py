@@ -5,6 +5,7 @@ It knows pixels, sample counts, time and the film's statistics, not rays: it han
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -17,6 +18,7 @@ from .report import ErrorLog
 WAVE = 1 << 16  # camera samples per wave: bounds memory whatever the resolution
 _FIRST_TIMED_WAVE = 1 << 12  # under a time limit, the wave that measures the rate
 _BLOCK = 1 << 20  # pixels of a round gathered at a time (bounds the driver's memory on large images)
+TARGET_MIN_SAMPLES = 4  # samples every pixel has before the target error may stop a render
 
 
 @dataclass
@@ -55,9 +57,10 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None, deno
     the render, adaptive.allocate), sample after sample over the active pixels (so a round cut
     short leaves an even image), in waves of at most WAVE. Each pixel draws sample ids 0, 1,
     2, ... in order, so its sequence stays stratified. ``trace(pixel, sample)`` adds a wave to
-    ``film``; ``rays`` is the ray count by kind the log reports. ``denoised()``, when given (denoising
-    on), returns the denoised image's estimated error (core.render.denoise) for the log entry of each
-    step once every pixel has a sample in both halves; the target error then applies to it.
+    ``film``; ``rays`` is the ray count by kind the log reports. ``denoised(entry)``, when given
+    (denoising under a target error), returns the denoised image's estimated error (core.render.denoise)
+    for a step's log entry once every pixel has a sample in both halves, or nothing for a step it
+    skips; the target error then applies to it.
     """
     start = time.perf_counter()
     log = ErrorLog()
@@ -120,13 +123,13 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None, deno
             allocating = s.adaptive_mode == "NOISE"
         entry = log.record(time.perf_counter() - start, film, rays, unconverged)
         if denoised is not None and film.count.min() >= 2:
-            entry.update(denoised())
-        error = entry.get("relmse_denoised", entry["relmse"])
+            entry.update(denoised(entry))
+        error = entry["relmse"] if denoised is None else entry.get("relmse_denoised", math.inf)
         if film.count.min() >= cap if allocating else target == cap:
             stopped = "samples"
         elif len(active) == 0:
             stopped = "threshold"
-        elif s.target_error > 0 and film.count.min() >= 4 and error < s.target_error:
+        elif s.target_error > 0 and film.count.min() >= TARGET_MIN_SAMPLES and error < s.target_error:
             stopped = "target_error"
         elif s.time_limit > 0 and entry["elapsed"] >= s.time_limit:
             stopped = "time_limit"
@@ -136,9 +139,7 @@ def drive(settings, film: Film, cap: int, trace, rays: dict, progress=None, deno
             entry["stopped"] = stopped
             break
     if stopped in ("time_limit", "cancelled") and (not log.last or "stopped" not in log.last):
-        entry = log.record(time.perf_counter() - start, film, rays, unconverged, stopped)
-        if denoised is not None and stopped == "time_limit" and film.count.min() >= 2:
-            entry.update(denoised())
+        log.record(time.perf_counter() - start, film, rays, unconverged, stopped)
     return DriveOutcome(stopped or "samples", log, threshold, first, time.perf_counter() - start)
 
 

@@ -3,15 +3,19 @@
 Parts are added in the order of their sample ranges, whatever order they arrive in, so the
 same parts always give the same bits. A farm's parts arrive one by one: ``Merger`` adds
 each as soon as every range before it is in, and logs the estimated error of the samples
-merged so far, the way a single render logs its rounds.
+merged so far, the way a single render logs its rounds. Parts rendered with denoising on carry
+the denoiser's features and the two replicate halves, and the merged image is denoised once,
+when it is written (``Merger.images``), never part by part.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..film import parts as parts_mod
+from ..film.denoising import PASSES as FEATURE_PASSES
 from ..film.film import Film
 from ..settings import PASS_CHANNELS
+from .denoise import denoise_film, denoised_passes, figures
 from .report import ErrorLog, report_dict
 
 
@@ -27,6 +31,7 @@ class Merger:
         self.log = ErrorLog()
         self.rays: dict[str, int] = {}
         self.cpu = 0.0
+        self.denoised = None  # core.render.denoise.Denoised of the merged image, once denoised
 
     def add(self, part: parts_mod.Part, elapsed: float, name: str = "a part") -> dict | None:
         """Take a part; returns the log entry when the merged samples grew, else None."""
@@ -59,6 +64,26 @@ class Merger:
     def done(self) -> bool:
         return self.merged == len(self.ranges)
 
+    @property
+    def denoising(self) -> bool:
+        """Whether the parts were rendered to be denoised (``use_denoising``)."""
+        return bool(self.first.header["settings"].get("use_denoising"))
+
+    def images(self, denoiser=None) -> dict:
+        """The merged image's passes, as a whole render returns them: denoised (once, however often
+        this is called) when the parts ask for it and ``denoiser`` (core.film.denoiser.Denoiser) is
+        given, its estimated error then in the last log entry; else the passes asked for as merged."""
+        settings = self.first.settings()
+        passes = self.film.images()
+        if not (self.denoising and denoiser is not None):
+            return {name: image for name, image in passes.items() if name in settings.passes}
+        if self.denoised is None:
+            with denoiser.filters() as filters:
+                self.denoised = denoise_film(self.film, {k: passes[k] for k in FEATURE_PASSES if k in passes},
+                                             filters, settings.denoising_prefilter, settings.denoising_quality)
+            self.log.last.update(figures(self.denoised))
+        return denoised_passes(passes, self.denoised, settings.passes)
+
     def report(self, elapsed: float) -> dict:
         """The merged render's report, as ``report.report_dict`` makes a single render's."""
         first = self.first.header["report"]
@@ -70,6 +95,10 @@ class Merger:
                      samples_mean=float(count.mean()),
                      elapsed=float(elapsed), cpu=self.cpu, rays=dict(self.rays), stopped_by="samples",
                      rmse=last["rmse"], relmse=last["relmse"], parts=len(self.ranges))
+        if self.denoised is not None:
+            stats.update(figures(self.denoised), denoising={"prefilter": settings.denoising_prefilter,
+                                                            "quality": settings.denoising_quality,
+                                                            "seconds": self.denoised.seconds})
         summary = report_dict(settings, stats, self.log.entries, first["scene"])
         summary["view_layer"] = self.first.header["view_layer"]
         return summary
@@ -87,14 +116,14 @@ def merge_parts(parts: list[parts_mod.Part], names: list[str]) -> Merger:
     return merger
 
 
-def write_exr(path, film: Film, view_layer: str) -> None:
-    """Every pass as Blender's multilayer EXR names it (``layer.pass.channel``), float32, top row first."""
+def write_exr(path, images: dict, view_layer: str) -> None:
+    """Every pass of ``images`` ((h, w, channels), rows from the bottom) as Blender's multilayer EXR
+    names it (``layer.pass.channel``), float32, top row first."""
     import OpenImageIO as oiio
 
-    images = film.images()
     names = [f"{view_layer}.{name}.{c}" for name in images for c in PASS_CHANNELS[name]]
     pixels = np.concatenate([image[::-1] for image in images.values()], axis=2)
-    spec = oiio.ImageSpec(film.width, film.height, len(names), oiio.FLOAT)
+    spec = oiio.ImageSpec(pixels.shape[1], pixels.shape[0], len(names), oiio.FLOAT)
     spec.channelnames = tuple(names)
     spec.attribute("compression", "zip")
     out = oiio.ImageOutput.create(str(path))

@@ -22,11 +22,11 @@ from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import NOISY_IMAGE, RenderSettings
+from ..settings import RenderSettings
 from ..validate import validate_camera
 from . import adaptive
-from .denoise import denoise_film
-from .driver import WAVE, ProgressUpdate, drive
+from .denoise import Schedule, denoise_film, denoised_passes, figures
+from .driver import TARGET_MIN_SAMPLES, WAVE, ProgressUpdate, drive
 from .prepared import PreparedScene
 
 __all__ = ["WAVE", "ProgressUpdate", "RenderResult", "Renderer", "PreparedScene"]
@@ -68,10 +68,12 @@ class Renderer:
         self.denoising = settings.use_denoising and not settings.partial
         self._denoised = None  # (samples in the film, core.render.denoise.Denoised) of the newest denoising
         self._denoise_seconds = 0.0
+        self._filters = None  # core.film.denoiser.Filters while a denoising render runs
+        self._schedule = None  # core.render.denoise.Schedule while one runs under a target error
         if self.denoising and denoiser is None:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
-        if self.denoising:  # the features guide the denoiser: traced even when not asked for as passes
-            settings = with_features(settings)
+        if settings.use_denoising:  # the features guide the denoiser (a part's, the merge's): traced even
+            settings = with_features(settings)  # when not asked for as passes
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
@@ -110,18 +112,25 @@ class Renderer:
                     half = samples.take(sel)
                     self._trace(Samples(half.index, half.pixel, half.sample >> 1), sampler, r, pool)
 
+        # with a target error, the steps that could meet it are denoised to know whether the denoised
+        # image is there yet (Schedule); without one, only the finished image is denoised
+        stepwise = self.denoising and s.target_error > 0
+        self._schedule = Schedule(s.target_error) if stepwise else None
+        self._filters = self.denoiser.filters() if self.denoising else None
         try:
-            # with a target error, every step denoises (3 OIDN runs) to know whether the denoised image
-            # is there yet; without one, only the finished image is denoised
-            stepwise = self.denoising and s.target_error > 0
-            outcome = drive(s, self.film, cap, trace, self.rays, progress,
-                            denoised=self._denoised_figures if stepwise else None)
+            try:
+                outcome = drive(s, self.film, cap, trace, self.rays, progress,
+                                denoised=self._step_figures if stepwise else None)
+            finally:
+                if pool is not None:
+                    pool.shutdown(wait=True)
+            if outcome.stopped != "cancelled":
+                jit.mark_compiled()  # also when warm: the stamp's time is the folder's last use
+            return self._result(outcome)
         finally:
-            if pool is not None:
-                pool.shutdown(wait=True)
-        if outcome.stopped != "cancelled":
-            jit.mark_compiled()  # also when warm: the stamp's time is the folder's last use
-        return self._result(outcome)
+            if self._filters is not None:
+                self._filters.close()
+                self._filters = None
 
     def _seed_pixels(self, index):
         """Ids in the whole image of the window's pixels ``index``: they seed the samples, so a
@@ -165,44 +174,42 @@ class Renderer:
                  "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
         passes = film.images()
         warnings = list(self.warnings)
-        if s.use_denoising and s.partial:
-            warnings.append("this render is one range of the samples (a farm part): it is not denoised; "
-                            "denoise the merged image")
+        if s.use_denoising and s.partial:  # the part's film keeps the features for the merge
+            passes = {name: image for name, image in passes.items() if name in s.passes}
+            warnings.append("this render is one range of the samples (a farm part): it is not denoised here; "
+                            "merging the parts denoises the merged image")
         if self.denoising and outcome.stopped != "cancelled":
             passes = self._denoise(passes, stats, outcome.log.last)
         return RenderResult(passes, stats, outcome.stopped == "cancelled", warnings, outcome.log.entries)
 
     def _denoise_film(self):
-        """The film's image denoised (core.render.denoise), once per sample total: the step that ends
-        a render and the result share one denoising."""
+        """The film's image denoised (core.render.denoise) on the render's filters, once per sample
+        total: the step that ends a render and the result share one denoising."""
         s, samples = self.settings, float(self.film.count.sum())
         if self._denoised is None or self._denoised[0] != samples:
             features = self.film.images(FEATURE_PASSES)
-            denoised = denoise_film(self.film, features, self.denoiser, s.denoising_prefilter, s.denoising_quality)
+            denoised = denoise_film(self.film, features, self._filters, s.denoising_prefilter, s.denoising_quality)
             self._denoised = samples, denoised
             self._denoise_seconds += denoised.seconds
         return self._denoised[1]
 
-    def _denoised_figures(self) -> dict:
-        """The denoised image's estimated error as the log and stats name it."""
-        e = self._denoise_film().error
-        return {"rmse_denoised": e["rmse"], "relmse_denoised": e["relmse"],
-                "rmse_denoised_noise": e["rmse_noise"], "relmse_denoised_noise": e["relmse_noise"]}
+    def _step_figures(self, entry: dict) -> dict:
+        """A step's denoised figures under a target error, when the target may stop it and the
+        schedule says the denoised image could be under it; else none."""
+        if self.film.count.min() < TARGET_MIN_SAMPLES or not self._schedule.due(entry["relmse"]):
+            return {}
+        found = figures(self._denoise_film())
+        self._schedule.measured(entry["relmse"], found["relmse_denoised"])
+        return found
 
     def _denoise(self, passes: dict, stats: dict, last: dict | None) -> dict:
-        """Combined denoised (alpha as rendered), the rendered one kept as Noisy Image, features
-        the user did not ask for dropped; the denoised image's estimated error in ``stats`` and
-        the log's last entry, beside the noisy image's (core.render.denoise). With a target error
-        every step of the log has it too (driver.drive), and the target applies to it."""
+        """Combined denoised, the rendered one kept as Noisy Image (core.render.denoise.denoised_passes);
+        the denoised image's estimated error in ``stats`` and the log's last entry, beside the noisy
+        image's. Under a target error the steps that could meet it have it too (driver.drive)."""
         s = self.settings
-        figures = self._denoised_figures()
-        noisy = passes["Combined"]
-        combined = noisy.copy()
-        combined[..., :3] = self._denoised[1].rgb
-        out = {name: image for name, image in passes.items() if name in s.passes}
-        out["Combined"], out[NOISY_IMAGE] = combined, noisy
-        stats.update(figures, denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
-                                         "seconds": self._denoise_seconds})
+        found = figures(self._denoise_film())
+        stats.update(found, denoising={"prefilter": s.denoising_prefilter, "quality": s.denoising_quality,
+                                       "seconds": self._denoise_seconds})
         if last is not None:
-            last.update(figures)
-        return out
+            last.update(found)
+        return denoised_passes(passes, self._denoised[1], s.passes)
