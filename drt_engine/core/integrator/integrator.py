@@ -201,13 +201,9 @@ class Integrator:
         if len(rays) == 0:
             return
 
-        def light_pdf(smooth):
-            pl = np.zeros(len(smooth))
-            for li in np.unique(light_id[smooth]):
-                sel = light_id[smooth] == li
-                k = smooth[sel]
-                pl[sel] = self.lights.pdf(li, rays.origins[k], rays.dirs[k], t[k], rays.time[k])
-            return pl
+        def light_pdf(smooth):  # each ray's own light, in one call
+            return self.lights.pdf(light_id[smooth], rays.origins[smooth], rays.dirs[smooth], t[smooth],
+                                   rays.time[smooth])
 
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
         if self.film_transparent:
