@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..bsdf.microfacet import fresnel_dielectric
+
 BLACKBODY_R = np.array([
     [1.61919106e+03, -2.05010916e-03, 5.02995757e+00],
     [2.48845471e+03, -1.11330907e-03, 3.22621544e+00],
@@ -99,29 +101,16 @@ def wavelength(nm):
     return np.maximum(xyz @ XYZ_TO_REC709.T / 2.52, 0.0)
 
 
-def fresnel_dielectric_cos(cosi, eta):
-    """Unpolarised Fresnel reflectance of a dielectric for |cos| ``cosi`` and relative IOR ``eta``
-    (1 under total internal reflection), Cycles' fresnel_dielectric_cos."""
-    c = np.abs(cosi)
-    g = eta * eta - 1.0 + c * c
-    root = np.sqrt(np.maximum(g, 0.0))
-    with np.errstate(all="ignore"):
-        a = (root - c) / (root + c)
-        b = (c * (root + c) - 1.0) / (c * (root - c) + 1.0)
-        f = 0.5 * a * a * (1.0 + b * b)
-    return np.where(g > 0, f, 1.0)
-
-
 def fresnel(ior, cosi, backfacing):
     """The Fresnel node: its IOR (at least 1e-5) inverted on backfacing hits."""
     eta = np.maximum(ior, 1e-5)
-    return fresnel_dielectric_cos(cosi, np.where(backfacing, 1.0 / eta, eta))
+    return fresnel_dielectric(np.abs(cosi), np.where(backfacing, 1.0 / eta, eta))
 
 
 def layer_weight(blend, cosi, backfacing):
     """(Fresnel, Facing) outputs of the Layer Weight node."""
     eta = np.maximum(1.0 - blend, 1e-5)
-    fres = fresnel_dielectric_cos(cosi, np.where(backfacing, eta, 1.0 / eta))
+    fres = fresnel_dielectric(np.abs(cosi), np.where(backfacing, eta, 1.0 / eta))
     b = np.clip(blend, 0.0, 1.0 - 1e-5)
     exponent = np.where(b < 0.5, 2.0 * b, 0.5 / (1.0 - b))
     c = np.abs(cosi)
