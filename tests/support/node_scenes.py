@@ -614,14 +614,7 @@ def facing_scene(size=32):
             obj = bpy.context.active_object
             if flipped:
                 obj.data.flip_normals()
-            mat = new_material(name)
-            tree = mat.node_tree
-            tree.nodes.clear()
-            bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
-            tree.links.new(build(tree), bsdf.inputs["Color"])
-            out = _node(tree, "ShaderNodeOutputMaterial")
-            tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-            obj.data.materials.append(mat)
+            obj.data.materials.append(_lit_diffuse(name, build)[0])
     return scene
 
 
