@@ -23,6 +23,12 @@ CASES = {
 the sun round (rotation + pi) to 40 degrees."""
 
 
+def offered(sky_type: str) -> bool:
+    """Whether this Blender's Sky Texture has the type (5.0 replaced 4.x's Nishita by the
+    Single and Multiple Scattering models)."""
+    return sky_type in bpy.types.ShaderNodeTexSky.bl_rna.properties["sky_type"].enum_items.keys()
+
+
 def _diffuse(name, color):
     mat = new_material(name)
     tree = mat.node_tree
