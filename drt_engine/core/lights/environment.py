@@ -12,9 +12,9 @@ exact direction, so the table only shapes the density (any table is unbiased).
 
 A Sky Texture's sun disc (half a degree across) would fall between the table's lookup points
 or light only part of a cell: every cell the disc touches takes the world's radiance at the
-disc's centre, and the table's share in those cells goes to a cone sampled uniformly over the
-disc itself (``sun``: direction, cos of its radius, probability), which hits the sun with every
-sample as Cycles' sun guiding does. Cells sampled by the table keep the raised density too.
+disc's centre; that share of the density goes to a cone sampled uniformly over the disc itself
+(``sun``: direction, cos of its radius, probability), which hits the sun with every sample as
+Cycles' sun guiding does, and those cells then take the sky around them in the table.
 """
 from __future__ import annotations
 
@@ -53,13 +53,16 @@ class Environment:
         sun_cells = self._light_sun_cells(lum)
         v = (np.arange(h) + 0.5) / h
         sin_t = np.cos((v - 0.5) * np.pi)[:, None]  # sin of the polar angle at the row centre
-        weight = lum * sin_t
-        total = weight.sum()
         self.mean_radiance = float((lum * sin_t).sum() / max(sin_t.sum() * w, 1e-300))
-        if total <= 0:
-            weight = np.broadcast_to(sin_t, (h, w)).copy()
-            total = weight.sum()
-        cell = (1.0 - UNIFORM_SHARE) * weight / total + UNIFORM_SHARE * sin_t / (sin_t.sum() * w)
+        cell = _cell_probabilities(lum, sin_t)
+        self.sun = np.zeros(5)
+        if sun_cells is not None:  # the disc's share to its cone, the table to the sky around it
+            direction, radius, rows, cols = sun_cells
+            self.sun[:3], self.sun[3], self.sun[4] = direction, math.cos(radius), cell[np.ix_(rows, cols)].sum()
+            around = np.ix_(np.arange(max(rows[0] - 2, 0), min(rows[-1] + 3, h)),
+                            np.mod(np.arange(cols[0] - 2, cols[-1] + 3), w))
+            lum[np.ix_(rows, cols)] = np.median(lum[around])
+            cell = _cell_probabilities(lum, sin_t)
         self.cell = np.ascontiguousarray(cell)  # probability of each cell
         rows = cell.sum(axis=1)
         self.row_cdf = np.concatenate([[0.0], np.cumsum(rows)])
@@ -68,10 +71,6 @@ class Environment:
         self.col_cdf = np.concatenate([np.zeros((h, 1)), np.cumsum(cond, axis=1)], axis=1)
         self.col_cdf = np.ascontiguousarray(self.col_cdf / self.col_cdf[:, -1:])
         self.cell_area = (2 * np.pi / w) * (np.pi / h)  # in (phi, theta)
-        self.sun = np.zeros(5)
-        if sun_cells is not None:
-            direction, radius, cells = sun_cells
-            self.sun[:3], self.sun[3], self.sun[4] = direction, math.cos(radius), cell[cells].sum()
 
     def _cell_luminance(self, w, h, rows_per_chunk=64):
         lum = np.zeros((h, w))
@@ -97,7 +96,7 @@ class Environment:
 
     def _light_sun_cells(self, lum):
         """Raise every cell the disc's (phi, theta) bounding box overlaps to the radiance at its
-        centre; (direction, radius, cells) of the first sun, or None."""
+        centre; (direction, radius, rows, columns) of the first sun, or None."""
         h, w = lum.shape
         first = None
         for direction, radius in self._suns():
@@ -110,8 +109,8 @@ class Environment:
             rows = rows[(rows >= 0) & (rows < h)]
             cols = np.mod(cols, w) if du < 0.5 else np.arange(w)
             lum[np.ix_(rows, cols)] = np.maximum(lum[np.ix_(rows, cols)], centre[0])
-            if first is None and centre[0] > 0:
-                first = direction, radius, np.ix_(rows, cols)
+            if first is None and centre[0] > 0 and len(rows):
+                first = direction, radius, rows, cols
         return first
 
     def radiance(self, dirs: np.ndarray) -> np.ndarray:
@@ -125,6 +124,17 @@ class Environment:
 
     def pdf(self, dirs: np.ndarray) -> np.ndarray:
         return _pdf_batch(self.cell, self.cell_area, self.sun, np.asarray(dirs, np.float64))
+
+
+def _cell_probabilities(lum, sin_t):
+    """Each cell's probability: luminance times sin(theta), with UNIFORM_SHARE spread uniformly
+    (all uniform when the world is black)."""
+    weight = lum * sin_t
+    total = weight.sum()
+    if total <= 0:
+        weight = np.broadcast_to(sin_t, lum.shape).copy()
+        total = weight.sum()
+    return (1.0 - UNIFORM_SHARE) * weight / total + UNIFORM_SHARE * sin_t / (sin_t.sum() * lum.shape[1])
 
 
 @kernel(inline="always")
