@@ -18,8 +18,13 @@ CASES = {
         "sky_type": "MULTIPLE_SCATTERING", "sun_elevation": 2.44, "sun_rotation": -2.5, "sun_size": 0.035,
         "sun_intensity": 0.6, "altitude": 2500.0, "air_density": 2.0, "aerosol_density": 4.0,
         "ozone_density": 5.0},
+    "single scattering, defaults": {"sky_type": "SINGLE_SCATTERING"},
+    "single scattering, every input": {
+        "sky_type": "SINGLE_SCATTERING", "sun_elevation": 0.5, "sun_rotation": 2.0, "sun_size": 0.02,
+        "sun_intensity": 1.5, "altitude": 3000.0, "air_density": 0.5, "aerosol_density": 3.0,
+        "ozone_density": 4.0},
 }
-"""Sky settings per case; the second's elevation (140 degrees) passes the zenith, so Cycles turns
+"""Sky settings per case; the second multiple-scattering case's elevation (140 degrees) passes the zenith, so Cycles turns
 the sun round (rotation + pi) to 40 degrees."""
 
 

@@ -1,4 +1,5 @@
-"""The Sky Texture node as Cycles' svm sky.h evaluates it: a precomputed sky texture looked up
+"""The Sky Texture node as Cycles' svm sky.h evaluates it: a precomputed sky texture (the
+Multiple Scattering model's, sky_scattering, or the Single Scattering one's, sky_single) looked up
 per direction, plus the sun disc with limb darkening, in linear Rec.709.
 
 The node's parameters arrive as Blender shows them (``params``); ``settings`` wraps the sun's
@@ -15,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..scene import TextureImage
-from . import sky_scattering
+from . import sky_scattering, sky_single
 from .colornodes import XYZ_TO_REC709
 from .textures import Texture
 
@@ -23,7 +24,7 @@ TABLE_WIDTH = sky_scattering.TABLE_WIDTH
 """Columns of the precomputed sky; the world's sampling table takes as many."""
 MIN_SUN_SIZE = 0.0005
 """Cycles' clamp of the disc's angular diameter (SkyTextureNode::get_sun_size)."""
-SCATTERING_TYPES = ("MULTIPLE_SCATTERING",)
+SCATTERING_TYPES = ("MULTIPLE_SCATTERING", "SINGLE_SCATTERING")
 """Sky types DRT computes; the others are left out with a warning by the export."""
 
 
@@ -64,13 +65,16 @@ def settings(params: dict) -> Settings:
 @lru_cache(maxsize=8)
 def _texture(s: Settings) -> Texture:
     """The precomputed sky as an image Cycles looks up with Linear interpolation and Extend."""
-    table = sky_scattering.sky_table(s.sun_elevation, s.altitude, s.air, s.aerosol, s.ozone)
+    model = sky_scattering if s.sky_type == "MULTIPLE_SCATTERING" else sky_single
+    table = model.sky_table(s.sun_elevation, s.altitude, s.air, s.aerosol, s.ozone)
     return Texture(TextureImage("sky", pixels=table, colorspace="Non-Color"))
 
 
 @lru_cache(maxsize=8)
 def _sun_pixels(s: Settings) -> tuple[np.ndarray, np.ndarray]:
-    return sky_scattering.sun_pixels(s.sun_elevation, s.sun_size, s.altitude, s.air, s.aerosol, s.ozone)
+    if s.sky_type == "MULTIPLE_SCATTERING":
+        return sky_scattering.sun_pixels(s.sun_elevation, s.sun_size, s.altitude, s.air, s.aerosol, s.ozone)
+    return sky_single.sun_pixels(s.sun_elevation, s.sun_size, s.altitude, s.air, s.aerosol)
 
 
 def _to_rgb(xyz: np.ndarray) -> np.ndarray:
@@ -116,12 +120,19 @@ def sky_sun(params: dict) -> tuple[np.ndarray, float] | None:
 
 def evaluate(params: dict, d: np.ndarray) -> np.ndarray:
     """(N, 3) linear Rec.709 radiance of the sky along the (N, 3) directions d (as given:
-    Cycles does not normalise a mapped vector)."""
+    Cycles does not normalise a mapped vector). Single Scattering has no ground: below the
+    horizon it fades the horizon row's colour to black by 0.4 down, without the sun."""
     s = settings(params)
     elevation = math.pi / 2 - np.arccos(np.clip(d[:, 2], -1.0, 1.0))
     phi = np.arctan2(d[:, 1], d[:, 0])
-    sun = _sun_disc(s, d, elevation) * s.sun_intensity if s.sun_disc else 0.0
+    sun = _sun_disc(s, d, elevation) * s.sun_intensity if s.sun_disc else np.zeros((len(d), 3))
     x = np.mod((-phi - math.pi / 2 + s.sun_rotation) / (2 * math.pi), 1.0)
     y = np.sqrt(np.abs(elevation) / (math.pi / 2)) * np.where(elevation < 0, -1.0, 1.0) * 0.5 + 0.5
+    fade = np.ones(len(d))
+    if s.sky_type == "SINGLE_SCATTERING":
+        below = d[:, 2] < 0.0
+        sun[below] = 0.0
+        y = np.where(below, 0.508, y)
+        fade = np.where(below, np.where(d[:, 2] < -0.4, 0.0, (1.0 + 2.5 * d[:, 2]) ** 3), 1.0)
     xyz = _texture(s).lookup(np.stack([x, y], axis=1), None, "EXTEND", "Linear")[:, :3]
-    return sun + _to_rgb(xyz)
+    return sun + _to_rgb(xyz) * fade[:, None]
