@@ -148,7 +148,7 @@ def test_sky_texture_lighting_a_scene_matches_cycles(drt, tmp_path, name):
     _matches_cycles(sky_scenes.sky_scene(sky_scenes.CASES[name]), tmp_path, "sky", f"Sky Texture, {name}")
 
 
-@pytest.mark.parametrize("sky_type", ["PREETHAM", "HOSEK_WILKIE", "NISHITA"])
+@pytest.mark.parametrize("sky_type", ["HOSEK_WILKIE", "NISHITA"])
 def test_a_sky_type_left_out_is_named_in_the_warning(drt, sky_type):
     if not sky_scenes.offered(sky_type):
         pytest.skip("this Blender has no such sky type")

@@ -409,7 +409,7 @@ class Compiler:
         return i, 0 if output.identifier == "Color" else 1
 
     def _node_ShaderNodeTexSky(self, node, output):
-        if node.sky_type not in sky.SCATTERING_TYPES:
+        if node.sky_type not in sky.SKY_TYPES:
             return self._unsupported(node, f"Sky Texture {node.sky_type.replace('_', ' ').title()}")
         vector = self._vector_or(node, "generated")
         return self.program.add("sky", [vector], sky_type=node.sky_type, sun_disc=bool(node.sun_disc),
@@ -417,7 +417,8 @@ class Compiler:
                                 sun_elevation=float(node.sun_elevation), sun_rotation=float(node.sun_rotation),
                                 altitude=float(node.altitude), air_density=float(node.air_density),
                                 aerosol_density=float(node.aerosol_density),
-                                ozone_density=float(node.ozone_density)), 0
+                                ozone_density=float(node.ozone_density), sun_direction=tuple(node.sun_direction),
+                                turbidity=float(node.turbidity)), 0
 
     def _node_ShaderNodeMapping(self, node, output):
         v = self._in(node, "Vector", "vector")

@@ -16,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..scene import TextureImage
-from . import sky_scattering, sky_single
+from . import sky_preetham, sky_scattering, sky_single
 from .colornodes import XYZ_TO_REC709
 from .textures import Texture
 
@@ -25,6 +25,7 @@ TABLE_WIDTH = sky_scattering.TABLE_WIDTH
 MIN_SUN_SIZE = 0.0005
 """Cycles' clamp of the disc's angular diameter (SkyTextureNode::get_sun_size)."""
 SCATTERING_TYPES = ("MULTIPLE_SCATTERING", "SINGLE_SCATTERING")
+SKY_TYPES = SCATTERING_TYPES + ("PREETHAM",)
 """Sky types DRT computes; the others are left out with a warning by the export."""
 
 
@@ -112,6 +113,8 @@ def _sun_disc(s: Settings, d: np.ndarray, elevation: np.ndarray) -> np.ndarray:
 def sky_sun(params: dict) -> tuple[np.ndarray, float] | None:
     """(direction, angular radius) of the disc the node shows along unmapped directions, or None
     without a disc: what the world's sampling table must not miss."""
+    if params["sky_type"] not in SCATTERING_TYPES:
+        return None
     s = settings(params)
     if not s.sun_disc:
         return None
@@ -122,6 +125,8 @@ def evaluate(params: dict, d: np.ndarray) -> np.ndarray:
     """(N, 3) linear Rec.709 radiance of the sky along the (N, 3) directions d (as given:
     Cycles does not normalise a mapped vector). Single Scattering has no ground: below the
     horizon it fades the horizon row's colour to black by 0.4 down, without the sun."""
+    if params["sky_type"] == "PREETHAM":
+        return _to_rgb(sky_preetham.xyz(params, d))
     s = settings(params)
     elevation = math.pi / 2 - np.arccos(np.clip(d[:, 2], -1.0, 1.0))
     phi = np.arctan2(d[:, 1], d[:, 0])
