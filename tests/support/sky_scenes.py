@@ -24,11 +24,11 @@ CASES = {
         "sun_intensity": 1.5, "altitude": 3000.0, "air_density": 0.5, "aerosol_density": 3.0,
         "ozone_density": 4.0},
     "Preetham, defaults": {"sky_type": "PREETHAM"},
-    "Preetham, low sun, hazy": {"sky_type": "PREETHAM", "sun_direction": (0.3, 0.8, 0.35),  # not unit length
-                                "turbidity": 6.0},
+    "Preetham, low sun, hazy": {"sky_type": "PREETHAM", "turbidity": 6.0,
+                                "sun_direction": (0.3, 0.8, 0.35)},  # of length 0.92
 }
-"""Sky settings per case; the second multiple-scattering case's elevation (140 degrees) passes the zenith, so Cycles turns
-the sun round (rotation + pi) to 40 degrees."""
+"""Sky settings per case; the second multiple-scattering case's elevation (140 degrees) passes
+the zenith, so Cycles turns the sun round (rotation + pi) to 40 degrees."""
 
 
 def offered(sky_type: str) -> bool:
