@@ -1,7 +1,8 @@
 """Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
 and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
 Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
-Info, a Wireframe in pixels and the material's Displacement (as bump) in scenes of their own.
+Info, a Wireframe in pixels, the material's Displacement (as bump) and a Sky Texture world
+lighting a sphere on the ground in scenes of their own.
 The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
 1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
@@ -18,6 +19,7 @@ import pytest
 from tests.support import node_scenes as ns
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
+from tests.support import sky_scenes
 from tests.support.datablocks import new_material
 from tests.support.export_helpers import render_export
 
@@ -135,6 +137,24 @@ def test_object_instancer_and_view_layer_attributes_match_cycles(drt, tmp_path):
 
 def test_mirror_ball_environment_matches_cycles(drt, tmp_path):
     _matches_cycles(ns.mirror_ball_scene(), tmp_path, "mirror-ball", "Environment Texture, Mirror Ball")
+
+
+@pytest.mark.parametrize("name", list(sky_scenes.CASES))
+def test_sky_texture_lighting_a_scene_matches_cycles(drt, tmp_path, name):
+    """The sky seen above the horizon and the ground below it, and the light of sky and sun
+    disc on a diffuse sphere and ground (the sphere's shadow is the disc's penumbra)."""
+    if not sky_scenes.offered(sky_scenes.CASES[name]["sky_type"]):
+        pytest.skip("this Blender has no such sky type")
+    _matches_cycles(sky_scenes.sky_scene(sky_scenes.CASES[name]), tmp_path, "sky", f"Sky Texture, {name}")
+
+
+@pytest.mark.parametrize("sky_type", ["HOSEK_WILKIE", "NISHITA"])
+def test_a_sky_type_left_out_is_named_in_the_warning(drt, sky_type):
+    if not sky_scenes.offered(sky_type):
+        pytest.skip("this Blender has no such sky type")
+    scene = sky_scenes.sky_scene({"sky_type": sky_type})
+    warnings = _cannot(render_export(scene))
+    assert len(warnings) == 1 and "Sky Texture" in warnings[0], warnings
 
 
 def test_box_projection_of_a_udim_image_reads_tile_1001(drt):

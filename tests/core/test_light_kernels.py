@@ -97,7 +97,7 @@ def test_environment_samples_follow_the_density_map_pdf_states():
                       [Texture(TextureImage("random", pixels=pixels, colorspace="Non-Color"))])
     n = 400_000
     dirs, pdf = env.sample(RNG.random((n, 2)))
-    assert np.allclose(pdf, [map_pdf(env.cell, env.cell_area, *d) for d in dirs[:200]] + list(pdf[200:]))
+    assert np.allclose(pdf, [map_pdf(env.cell, env.cell_area, env.sun, *d) for d in dirs[:200]] + list(pdf[200:]))
     # cell counts against the cells' probabilities: chi-square over the 64 x 32 table
     u = -np.arctan2(dirs[:, 1], dirs[:, 0]) / (2 * np.pi) + 0.5
     v = np.arctan2(dirs[:, 2], np.hypot(dirs[:, 0], dirs[:, 1])) / np.pi + 0.5

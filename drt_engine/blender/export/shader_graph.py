@@ -14,7 +14,7 @@ import numpy as np
 from ...core.base.colour import LUMINANCE
 from ...core.scene import Program, TextureImage
 from ...core.shading import nodes as sn
-from ...core.shading import proctex
+from ...core.shading import proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
@@ -407,6 +407,18 @@ class Compiler:
         i = self.program.add("environment", [vector], image=self.images.index(node.image),
                              interpolation=node.interpolation, projection=node.projection)
         return i, 0 if output.identifier == "Color" else 1
+
+    def _node_ShaderNodeTexSky(self, node, output):
+        if node.sky_type not in sky.SKY_TYPES:
+            return self._unsupported(node, f"Sky Texture {node.sky_type.replace('_', ' ').title()}")
+        vector = self._vector_or(node, "generated")
+        return self.program.add("sky", [vector], sky_type=node.sky_type, sun_disc=bool(node.sun_disc),
+                                sun_size=float(node.sun_size), sun_intensity=float(node.sun_intensity),
+                                sun_elevation=float(node.sun_elevation), sun_rotation=float(node.sun_rotation),
+                                altitude=float(node.altitude), air_density=float(node.air_density),
+                                aerosol_density=float(node.aerosol_density),
+                                ozone_density=float(node.ozone_density), sun_direction=tuple(node.sun_direction),
+                                turbidity=float(node.turbidity)), 0
 
     def _node_ShaderNodeMapping(self, node, output):
         v = self._in(node, "Vector", "vector")

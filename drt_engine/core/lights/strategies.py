@@ -64,13 +64,13 @@ class LightSamples:
 
 @kernel
 def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, cdf, prob, emission,
-                      geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, pos, normal, u, wi, dist, value,
-                      pdf, stop, pick, chosen, bary, lit):
+                      geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, sun, pos, normal, u, wi, dist,
+                      value, pdf, stop, pick, chosen, bary, lit):
     """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
     hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
     expected picks of it), emissive triangles when there are (``emissive``, picked by power),
     the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``, MAP_WORLD: directions from the
-    map with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
+    map (and its sun cone, ``sun``) with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
     the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
     light or triangle sampled, ``bary`` the triangle's barycentrics, ``lit`` where the caller's
     value applies (a triangle's front seen, a map direction above the normal)."""
@@ -111,6 +111,6 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
                 value[k, j, 0], value[k, j, 1], value[k, j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
         else:
             wx, wy, wz, p = sample_world_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1], share, row_cdf, col_cdf,
-                                                   cell, cell_area)
+                                                   cell, cell_area, sun)
             lit[k, j] = nx * wx + ny * wy + nz * wz > 0 and p > 0
         wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, math.inf, p

@@ -1,5 +1,5 @@
 """The world as a light: directions cosine-weighted about the shading normal, or from the
-environment map's table (lights.environment) with probability ``share``; the density of either,
+environment map (lights.environment: its table and sun cone) with probability ``share``; the density of either,
 and whether the world is seen along a ray, as its ray visibility says. Kernels per ray and their
 batch loops, which lights.collection calls once per wave."""
 from __future__ import annotations
@@ -24,33 +24,33 @@ def cosine_direction(nx, ny, nz, u0, u1):
 
 
 @kernel(inline="always")
-def world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area):
-    """Density of world sampling: the map's share of its table density, the rest cosine."""
+def world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area, sun):
+    """Density of world sampling: the map's share of its density, the rest cosine."""
     cosine = max(nx * dx + ny * dy + nz * dz, 0.0) / math.pi
     if share <= 0:
         return cosine
-    return share * map_pdf(cell, cell_area, dx, dy, dz) + (1.0 - share) * cosine
+    return share * map_pdf(cell, cell_area, sun, dx, dy, dz) + (1.0 - share) * cosine
 
 
 @kernel(inline="always")
-def sample_world_direction(nx, ny, nz, u0, u1, share, row_cdf, col_cdf, cell, cell_area):
+def sample_world_direction(nx, ny, nz, u0, u1, share, row_cdf, col_cdf, cell, cell_area, sun):
     """(dx, dy, dz, pdf): from the map with probability ``share`` (the first sample coordinate
     split), else cosine-weighted about n."""
     if u0 < share:
-        dx, dy, dz = map_direction(row_cdf, col_cdf, min(max(u0 / share, 0.0), 1.0 - 1e-12),
+        dx, dy, dz = map_direction(row_cdf, col_cdf, sun, min(max(u0 / share, 0.0), 1.0 - 1e-12),
                                    min(max(u1, 0.0), 1.0 - 1e-12))
     else:
         c0 = min(max((u0 - share) / (1.0 - share), 0.0), 1.0 - 1e-12)
         dx, dy, dz, _ = cosine_direction(nx, ny, nz, c0, min(max(u1, 0.0), 1.0 - 1e-12))
-    return dx, dy, dz, world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area)
+    return dx, dy, dz, world_pdf(nx, ny, nz, dx, dy, dz, share, cell, cell_area, sun)
 
 
 @kernel
-def pdf_world_batch(normal, dirs, share, cell, cell_area):
+def pdf_world_batch(normal, dirs, share, cell, cell_area, sun):
     out = np.empty(len(dirs))
     for j in range(len(dirs)):
         out[j] = world_pdf(normal[j, 0], normal[j, 1], normal[j, 2], dirs[j, 0], dirs[j, 1], dirs[j, 2], share,
-                           cell, cell_area)
+                           cell, cell_area, sun)
     return out
 
 
