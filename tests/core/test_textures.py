@@ -138,7 +138,7 @@ def normal_program(kind):
     else:
         height = prog.add("const", value=0.3)
         one = prog.add("const", value=1.0)
-        out = prog.add("bump", [(one, 0), (one, 0), (height, 0), None])
+        out = prog.add("bump", [(one, 0), (one, 0), (height, 0), None, (one, 0)])
     return prog, (out, 0)
 
 
@@ -162,7 +162,7 @@ def test_bump_slope_tilts_the_normal_by_its_gradient():
     zero = prog.add("const", value=0.0)
     height = prog.add("math", [(x, 0), (slope, 0), (zero, 0)], operation="MULTIPLY")
     one = prog.add("const", value=1.0)
-    bump = prog.add("bump", [(one, 0), (one, 0), (height, 0), None])
+    bump = prog.add("bump", [(one, 0), (one, 0), (height, 0), None, (one, 0)])
     mat = Material("slope", [Closure("DIFFUSE", color=(1, 1, 1), roughness=0.0, inputs={"normal": (bump, 0)})],
                    prog)
     scene = SceneData(camera=ortho_top(8, half=0.5), meshes=[uv_plane()], instances=[Instance(0, np.eye(4))],

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import bpy
 import numpy as np
 
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
 from .nodes import Issues, find_input, flatten, rgb
-from .shader_graph import Compiler, ImageTable, is_ref
+from .shader_graph import DISPLACEMENT_MATCHED_FROM, Compiler, ImageTable, is_ref
 
 
 def uses_nodes(idblock) -> bool:
@@ -198,6 +199,9 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
             issues.message(f"Material '{material.name}'"))
 
 
+VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
+
+
 def _displacement(material, output, compiler, issues):
     """The output's Displacement as Cycles renders it with the material's method "Bump Only" (the
     default): a bump of the shading normal. Moving the surface itself ("Displacement Only", "Both")
@@ -208,6 +212,8 @@ def _displacement(material, output, compiler, issues):
     method = getattr(material, "displacement_method", "BUMP")
     if method != "BUMP":
         issues.add(f"displacement method {method.replace('_', ' ').title()} (rendered as Bump Only)")
+    if bpy.app.version < DISPLACEMENT_MATCHED_FROM:
+        issues.add(VERSION_BUMP)
     return compiler.displacement(socket)
 
 

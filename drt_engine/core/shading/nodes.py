@@ -621,12 +621,12 @@ class Evaluator:
         return np.where((vec.norm(out) == 0)[:, None], n, out)
 
     def _bump(self, p, refs):
-        strength_ref, distance_ref, height_ref, normal_ref = refs
+        strength_ref, distance_ref, height_ref, normal_ref, width_ref = refs
         strength = np.clip(self(strength_ref), 0, 1)[:, None]
         dist = self(distance_ref) * (-1.0 if p.get("invert") else 1.0)
         n = self(normal_ref) if normal_ref is not None else self.ctx.normal
         t, b = orthonormal_basis(n)
-        eps = self.ctx.bump_step()
+        eps = self.ctx.bump_step(np.maximum(self(width_ref), 0.0))
         h = self(height_ref)
         hx = self._shifted(t * eps[:, None])(height_ref)
         hy = self._shifted(b * eps[:, None])(height_ref)
@@ -741,5 +741,5 @@ class DirectionContext:
         t, _ = orthonormal_basis(self.dirs)
         return t, np.ones(self.n)
 
-    def bump_step(self):
+    def bump_step(self, filter_width):
         return np.full(self.n, 1e-4)

@@ -184,9 +184,11 @@ class SurfaceContext:
     def tangent(self, uv_map):
         return self.attrs.tangent(self.prim, self.normal, uv_map, self.bary)
 
-    def bump_step(self):
+    def bump_step(self, filter_width):
+        """The bump's finite-difference step: ``filter_width`` of the pixel footprint (Cycles' Filter
+        Width), at least a few ulps of the position."""
         w = self.width if self.width is not None else np.zeros(self.n)
-        return np.maximum(0.1 * w, 1e-6 * (1.0 + np.abs(self.pos).max(axis=1)))
+        return np.maximum(filter_width * w, 1e-6 * (1.0 + np.abs(self.pos).max(axis=1)))
 
 
 class SurfaceAttributes:
