@@ -425,7 +425,7 @@ class Compiler:
                                 sun_size=float(node.sun_size), sun_intensity=float(node.sun_intensity),
                                 sun_elevation=float(node.sun_elevation), sun_rotation=float(node.sun_rotation),
                                 altitude=float(node.altitude), air_density=float(node.air_density),
-                                aerosol_density=float(node.aerosol_density),
+                                aerosol_density=float(_aerosol_density(node)),
                                 ozone_density=float(node.ozone_density), sun_direction=tuple(node.sun_direction),
                                 turbidity=float(node.turbidity)), 0
 
@@ -755,3 +755,8 @@ class Compiler:
 
     def _node_ShaderNodeCombineHSV(self, node, output):
         return self._combine(node, "HSV")
+
+
+def _aerosol_density(node) -> float:
+    """The Sky Texture's aerosol density (Blender 4.x calls it dust density)."""
+    return node.aerosol_density if hasattr(node, "aerosol_density") else node.dust_density
