@@ -8,6 +8,8 @@
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
 #                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
+#   make bench-instances  a floor of 1,000 and 10,000 pebble instances, DRT vs Cycles time and memory
+#                    (bench/instances.py: docs/performance.md)
 #   make bench-ratio the ratio estimator against Monte Carlo: efficiency, bias, where the error is
 #                    (bench/ratio_estimator.py: docs/ratio-estimator.md, bench/ratio_estimator.json); about 30 minutes
 #   make bench-denoise built-in denoising: denoised vs noisy relMSE and the denoised error estimate against
@@ -50,7 +52,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-ratio bench-denoise bench-farm texture-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-instances bench-ratio bench-denoise bench-farm texture-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -116,10 +118,14 @@ scenes: $(STAMP)
 bench: $(STAMP)
 	$(PY) bench/run.py --publish
 	$(PY) bench/throughput.py
+	$(PY) bench/instances.py
 	$(PY) bench/ratio_estimator.py --publish
 
 bench-throughput: $(STAMP)
 	$(PY) bench/throughput.py
+
+bench-instances: $(STAMP)
+	$(PY) bench/instances.py
 
 bench-ratio: $(STAMP)
 	$(PY) bench/ratio_estimator.py --publish

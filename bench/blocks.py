@@ -15,6 +15,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "zip-sizes": DOCS / "install.md",
     "throughput": DOCS / "performance.md",
     "preview-times": DOCS / "performance.md",
+    "instances": DOCS / "performance.md",
     "adaptive-calibration": DOCS / "adaptive-sampling.md",
     "adaptive-gain": DOCS / "adaptive-sampling.md",
     "bench-adaptive": DOCS / "adaptive-sampling.md",

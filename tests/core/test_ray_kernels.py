@@ -112,7 +112,7 @@ def test_an_instanced_mesh_is_one_embree_scene_and_each_instance_numbers_its_own
     assert geo.triangle_count == 3 * t + len(floor.triangles)
     origins = np.array([[-1.0, 0, 5], [0.0, 0, 5], [1.0, 0, 5], [3.0, 0, 5]])
     hits = geo.intersect(origins, np.tile([0.0, 0, -1], (4, 1)), np.full(4, np.inf))
-    np.testing.assert_array_equal(geo.source[hits.prim, 0], [0, 1, 2, 3])  # which object each ray hit
+    np.testing.assert_array_equal(geo.source_of(hits.prim)[:, 0], [0, 1, 2, 3])  # which object each ray hit
     np.testing.assert_array_equal(hits.prim[:3] // t, [0, 1, 2])
     np.testing.assert_allclose(hits.t, [4.6, 4.6, 4.6, 6.0], atol=2e-2)
 

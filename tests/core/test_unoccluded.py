@@ -475,7 +475,7 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
     rng, means = np.random.default_rng(9), []
     for _ in range(32):
         u = stratified(64, rng)
-        wi, value = _emissive_samples(verts, tris, ng, area, ids, np.cumsum(prob), prob, emission,
+        wi, value = _emissive_samples(verts, tris, ng, area, np.cumsum(prob), prob, emission,
                                       np.asarray(p, float), u, rng.random(len(u)))
         means.append((value * np.maximum(wi @ unit(n), 0.0)[:, None]).mean(axis=0))
     means = np.array(means)
@@ -484,12 +484,12 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
 
 
 @numba.njit
-def _emissive_samples(verts, tris, ng, area, ids, cdf, prob, emission, p, u, u_pick):
+def _emissive_samples(verts, tris, ng, area, cdf, prob, emission, p, u, u_pick):
     """Directions and values (emission / pdf where the triangle faces p) of the emissive strategy's
     samples at p, as lights.strategies draws them."""
     wi, value = np.zeros((len(u), 3)), np.zeros((len(u), 3))
     for j in range(len(u)):
-        i = pick_triangle(ids, cdf, u_pick[j])
+        i = pick_triangle(cdf, u_pick[j])
         wx, wy, wz, _, pdf, _, _, cos_l = sample_triangle(verts, tris, ng, area, prob, i, p[0], p[1], p[2], u[j, 0],
                                                           u[j, 1])
         wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz

@@ -16,8 +16,8 @@ vertex steps at each ray's own time. Float32 precision stays ours to manage:
 - new rays leave a surface offset along the geometric normal by a bound on the float32 error
   of the hit.
 
-Triangles keep one global numbering (an instance's first id plus Embree's primID), so
-materials, lights and attributes index the same arrays whatever object a hit came from. The
+Triangles keep one global numbering (an instance's first id plus Embree's primID), which
+materials, lights and attributes resolve through the instance to its mesh's tables. The
 per-ray work (queries, hit reconstruction, the terminator lift, offsets) is in scalar kernels
 over ``Geometry.tables``, flat arrays a fused stage kernel can read too.
 """
@@ -136,11 +136,11 @@ def _build(ms: _MeshScene, pivot: np.ndarray) -> _MeshScene:
 class Geometry:
     """All instanced triangles and the Embree scenes that answer ray queries.
 
-    Per mesh (``tables``): object-space vertices (every time step), triangles, normals. Per
-    instance: its mesh, its first global triangle id, its transform (or steps). Per global
-    triangle, for materials, lights and attributes: ``material``, ``source`` (instance,
-    triangle in its mesh), ``triangles`` into ``world_vertices`` with ``world_ng`` and
-    ``area`` at mid-shutter, and ``tri_scale`` for offsets.
+    Per mesh (``tables``): object-space vertices (every time step), triangles, normals, and the
+    triangles' materials and mid-shutter vertices. Per instance: its mesh, its first global
+    triangle id, its transform (or steps). A global id's material, source, world corners and
+    normal are resolved through its instance (``material_of``, ``source_of``, ``world_corners``,
+    ``world_normals``): memory grows with the instances' count, not their triangles.
 
     ``previous``: a Geometry of an earlier version of the scene (a viewport edit): meshes it
     holds as the same objects keep their Embree scenes (unless the camera's nearness moves a
@@ -174,7 +174,7 @@ class Geometry:
         self._motion_steps(kept)
         self._mesh_scenes(kept, analysed, known)
         self._instances(kept)
-        self._world(kept)
+        self._triangle_tables(kept)
         self.tables = self._tables()
 
     # -- construction helpers ------------------------------------------------------
@@ -233,52 +233,37 @@ class Geometry:
         if self._top is not None:
             self._top.commit()
 
-    def _world(self, kept):
-        """Per global triangle: material, source, mid-shutter world triangles, normals, areas."""
-        world, tris, mats, sources, flips = [], [], [], [], []
-        offset = 0
-        for j, (k, _, _) in enumerate(kept):
-            ms = self._mesh_list[self._inst_mesh[j]]
-            m = self._frames[j]
-            world.append(ms.mid @ m[:, :3].T + m[:, 3])
-            tris.append(ms.mesh.triangles[ms.kept] + offset)
-            offset += len(ms.mid)
-            mats.append(ms.mesh.material_indices[ms.kept])
-            sources.append(np.stack([np.full(len(ms.kept), k), ms.kept], axis=1))
-            flips.append(np.full(len(ms.kept), np.linalg.det(m[:, :3]) < 0))
-        self.world_vertices = np.concatenate(world) if world else np.zeros((0, 3))
-        self.triangles = np.concatenate(tris) if tris else np.zeros((0, 3), np.int32)
-        self.material = np.concatenate(mats) if mats else np.zeros(0, np.int32)
-        self.source = np.concatenate(sources) if sources else np.zeros((0, 2), np.int64)
-        """Per triangle: (instance index in the scene, triangle index in its mesh), for attributes."""
-        flip = np.concatenate(flips) if flips else np.zeros(0, bool)
-        p = self.world_vertices[self.triangles]
-        n_world, world_len = _cross_normals(p)
-        self.area = 0.5 * world_len
-        # world triangles wind backwards under mirroring: keep the normals outward
-        self.world_ng = n_world / np.maximum(world_len, 1e-300)[:, None] * np.where(flip, -1.0, 1.0)[:, None]
-        rel = p - self.center
-        # the offset also clears the float64 rounding of world positions far from the origin
-        world_scale = np.abs(p).max(axis=(1, 2)) * _EPS_ABS if len(rel) else 0.0
-        self.tri_scale = np.maximum(np.abs(rel).max(axis=(1, 2)), world_scale) if len(rel) else np.zeros(0)
+    def _triangle_tables(self, kept):
+        """Per mesh row, what materials, lights and attributes ask of a triangle (its material, its
+        index in the mesh, its mid-shutter vertices); per instance its index in the scene and
+        whether it mirrors. Nothing here grows with the instances' triangles: a global id is
+        resolved through its instance (``locate``)."""
+        rows = self._mesh_list
+        self._tri_first = np.cumsum([0] + [len(ms.kept) for ms in rows], dtype=np.int64)
+        self._mid_first = np.cumsum([0] + [len(ms.mid) for ms in rows], dtype=np.int64)
+        self._tri_material = (np.concatenate([ms.mesh.material_indices[ms.kept] for ms in rows]) if rows
+                              else np.zeros(0, np.int32))
+        self._tri_source = np.concatenate([ms.kept for ms in rows]) if rows else np.zeros(0, np.int64)
+        self._mid = np.concatenate([ms.mid for ms in rows]) if rows else np.zeros((0, 3))
+        self._scene_index = np.array([k for k, _, _ in kept], np.int64)
+        self._flip = np.linalg.det(self._frames[:, :, :3]) < 0
 
     def _tables(self):
         """Everything the hit kernels read, as one tuple of flat arrays (see ``hit_surface``).
 
-        Per mesh row: first vertex row, time steps, vertex count, first triangle row. Per
-        instance: mesh row, first global id (and the total after the last), still frame and
-        inverse, rows of its motion steps."""
-        verts, tris, ng, ns, info = [], [], [], [], np.zeros((max(len(self._mesh_list), 1), 4), np.int64)
-        rows = tri_rows = 0
+        Per mesh row: first vertex row, time steps, vertex count, first triangle row, first row of
+        its mid-shutter vertices. Per instance: mesh row, first global id (and the total after the
+        last), still frame (mid-shutter for a moving one) and inverse, rows of its motion steps."""
+        verts, tris, ng, ns, info = [], [], [], [], np.zeros((max(len(self._mesh_list), 1), 5), np.int64)
+        rows = 0
         smooth = any(ms.mesh.corner_normals is not None for ms in self._mesh_list)
         for r, ms in enumerate(self._mesh_list):
             s, v = ms.steps.shape[:2]
-            info[r] = rows, s, v, tri_rows
+            info[r] = rows, s, v, self._tri_first[r], self._mid_first[r]
             verts.append(ms.steps.reshape(-1, 3))
             tris.append(ms.mesh.triangles[ms.kept])
             ng.append(ms.ng)
             rows += s * v
-            tri_rows += len(ms.kept)
             if smooth:
                 ns.append(_corner_normals(ms))
         return (np.concatenate(verts) if verts else np.zeros((0, 3)),
@@ -286,12 +271,53 @@ class Geometry:
                 np.concatenate(ng) if ng else np.zeros((0, 3)),
                 np.concatenate(ns) if ns else np.zeros((0, 3, 3)),
                 info, self._inst_mesh, self._base, self._frames, self._inverses, self._steps,
-                self._motion[0], self._motion[1], self._motion[2], self.center, self.tri_scale)
+                self._motion[0], self._motion[1], self._motion[2], self.center, self._mid)
+
+    # -- triangles by global id --------------------------------------------------------
+    def locate(self, prim: np.ndarray):
+        """(instance row, row in the mesh triangle tables) of global triangles ``prim``."""
+        j = np.searchsorted(self._base, prim, side="right") - 1
+        return j, self._tri_first[self._inst_mesh[j]] + prim - self._base[j]
+
+    def material_of(self, prim: np.ndarray) -> np.ndarray:
+        return self._tri_material[self.locate(prim)[1]]
+
+    def materials_used(self) -> np.ndarray:
+        """The materials of the triangles rays can hit, each once."""
+        return np.unique(self._tri_material)
+
+    def source_of(self, prim: np.ndarray) -> np.ndarray:
+        """(N, 2): per triangle its instance's index in the scene and its index in the mesh."""
+        j, row = self.locate(prim)
+        return np.stack([self._scene_index[j], self._tri_source[row]], axis=1)
+
+    def world_corners(self, prim: np.ndarray) -> np.ndarray:
+        """(N, 3, 3) float64 world corners of triangles ``prim`` at mid-shutter."""
+        j, row = self.locate(prim)
+        p = self._mid[self.tables[1][row] + self._mid_first[self._inst_mesh[j]][:, None]]
+        f = self._frames[j]
+        return np.einsum("nkj,nij->nki", p, f[:, :, :3]) + f[:, None, :, 3]
+
+    def world_normals(self, prim: np.ndarray, corners: np.ndarray | None = None):
+        """(unit world normals outward under mirroring too, areas) of triangles ``prim`` at
+        mid-shutter (from their ``corners`` when the caller has them)."""
+        p = self.world_corners(prim) if corners is None else corners
+        n, length = _cross_normals(p)
+        side = np.where(self._flip[self.locate(prim)[0]], -1.0, 1.0)
+        return n / np.maximum(length, 1e-300)[:, None] * side[:, None], 0.5 * length
+
+    def triangles_with(self, materials) -> np.ndarray:
+        """Global ids, ascending, of every triangle whose material is one of ``materials``."""
+        sel = np.isin(self._tri_material, np.asarray(materials, np.int64))
+        local = [np.flatnonzero(sel[a:b]) for a, b in zip(self._tri_first[:-1], self._tri_first[1:])]
+        shown = np.flatnonzero([len(local[r]) > 0 for r in self._inst_mesh]) if len(self._inst_mesh) else []
+        parts = [self._base[j] + local[self._inst_mesh[j]] for j in shown]
+        return np.concatenate(parts) if parts else np.zeros(0, np.int64)
 
     # -- queries ---------------------------------------------------------------------
     @property
     def triangle_count(self) -> int:
-        return len(self.triangles)
+        return int(self._base[-1])
 
     @property
     def moving(self) -> bool:
@@ -522,9 +548,27 @@ def lift(geo, prim, u, v, time, scratch):
 def offset_scale(geo, prim, px, py, pz):
     """Distance that safely clears the surface of triangle ``prim`` at (px, py, pz): a bound
     on the float32 error of the hit, from the triangle's and the point's distance to the centre."""
-    center, tri_scale = geo[13], geo[14]
+    center = geo[13]
     local = max(abs(px - center[0]), abs(py - center[1]), abs(pz - center[2]))
-    return _EPS_REL * max(tri_scale[prim], local) + 1e-30
+    return _EPS_REL * max(_triangle_scale(geo, prim), local) + 1e-30
+
+
+@kernel(inline="always")  # see instance_of
+def _triangle_scale(geo, prim):
+    """The larger of triangle ``prim``'s corners' distance from the centre and the float64 rounding
+    of their world coordinates (the hit is rebuilt in them), at mid-shutter."""
+    info, mid, center = geo[4], geo[14], geo[13]
+    i = instance_of(geo, prim)
+    f = geo[7][i]
+    r = geo[5][i]
+    row = info[r, 3] + prim - geo[6][i]
+    near = far = 0.0
+    for k in range(3):
+        w = info[r, 4] + geo[1][row, k]
+        for a in range(3):
+            p = f[a, 0] * mid[w, 0] + f[a, 1] * mid[w, 1] + f[a, 2] * mid[w, 2] + f[a, 3]
+            near, far = max(near, abs(p - center[a])), max(far, abs(p))
+    return max(near, far * _EPS_ABS)
 
 
 @kernel

@@ -148,7 +148,7 @@ class Integrator:
             if len(self.prepared.shaders) > 1:
                 # hits ordered by material (stably): each material's hits are one slice, so its
                 # arrays are views, and per path nothing changes (groups keep their order)
-                rows = rows[np.argsort(self.geometry.material[hits.prim[rows]], kind="stable")]
+                rows = rows[np.argsort(self.geometry.material_of(hits.prim[rows]), kind="stable")]
             surf = self._surface(state, hits, rows, ray_times)
             self._emission_seen(surf, state, hits, out)
             if depth == 0:
@@ -242,15 +242,15 @@ class Integrator:
         surface_hits(self.geometry.tables, hits.prim, hits.u, hits.v, self.geometry.time_values(ray_times),
                      rows, state.dirs, pos, ng, frame, wo_l, inside, scale, normal)
         prim = hits.prim[rows]
-        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material[prim], pos=pos,
+        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material_of(prim), pos=pos,
                            ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
                            wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
                            straight=state.straight[rows], time=state.time[rows], normal=normal)
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
-        glows = self.prepared.glows
-        glowing = np.flatnonzero(glows[surf.prim]) if len(glows) else np.zeros(0, np.int64)
+        glows = self.lights.glows
+        glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]

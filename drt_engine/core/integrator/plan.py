@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.motion import Motion, deforms
+from ..geometry.motion import Motion, deforms, moves
 from .ratio import delta_light, ratio_strategies
 
 RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent")
@@ -55,14 +55,14 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     camera = scene.camera
     lens = camera.aperture_radius > 0
     moving = [inst.name or f"instance {i}" for i, inst in enumerate(scene.instances)
-              if Motion(inst.matrices).moving or deforms(scene.meshes[inst.mesh])]
+              if moves(inst.matrices) or deforms(scene.meshes[inst.mesh])]
     moving += [f"light {light.name or i}" for i, light in enumerate(lights.lights) if i in lights.motions]
     camera_moves = Motion(camera.matrices).moving
     if camera_moves:
         moving.append("camera")
     time = geometry.moving or lights.moving or camera_moves
 
-    used = {int(m) for m in np.unique(geometry.material)}
+    used = {int(m) for m in geometry.materials_used()}
     kinds = {lobe.kind for m in used for lobe in shaders[m].lobes}
     bounces = settings.max_depth > 0
     rays = {"camera": True,

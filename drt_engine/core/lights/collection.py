@@ -92,24 +92,14 @@ class Lights:
         """One row per light (lights.table's columns): what every light kernel reads."""
         self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
         self.geometry = geometry
-        emission = np.array([s.emission for s in shaders]) if shaders else np.zeros((0, 3))
-        tri_emission = emission[geometry.material] if len(geometry.material) else np.zeros((0, 3))
         self.shaders = shaders
-        self.tri_emission = np.ascontiguousarray(tri_emission, np.float64)
+        self.emission = np.array([s.emission for s in shaders], np.float64).reshape(-1, 3)
+        """Per material: its constant emission (a textured one's from its shader program instead)."""
         self.textured = [m for m, s in enumerate(shaders) if getattr(s, "varying_emission", False)]
+        self.glows = (self.emission.max(axis=1) > 0) | np.isin(np.arange(len(shaders)), self.textured)
+        """Per material: whether its surface emits where a ray hits it."""
         self.attributes = SurfaceAttributes(scene, geometry) if self.textured else None
-        estimate = tri_emission.copy()
-        for m in self.textured:
-            estimate[geometry.material == m] = self._textured_estimate(m)
-        power = estimate @ LUMINANCE * geometry.area
-        self.emissive = np.flatnonzero(power > 0)
-        self.emissive_cdf, self.emissive_prob = np.zeros(0), np.zeros(0)
-        if len(self.emissive):
-            cdf = np.cumsum(power[self.emissive])
-            self.emissive_cdf = cdf / cdf[-1]
-            self.emissive_prob = np.zeros(len(power))
-            self.emissive_prob[self.emissive] = power[self.emissive] / cdf[-1]
-            self._textured_tri = np.isin(geometry.material, self.textured)
+        self._emitters(geometry)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
@@ -144,6 +134,27 @@ class Lights:
         self._moving_hittable = [i for i in hittable if i in self.motions]
         self._moving_suns = [i for i in suns if i in self.motions]
 
+    def _emitters(self, geometry) -> None:
+        """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
+        each picked by its power (``emissive_cdf``, ``emissive_prob``), with its world corners,
+        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order)."""
+        tris = geometry.triangles_with(np.flatnonzero(self.glows))
+        corners = geometry.world_corners(tris)
+        ng, area = geometry.world_normals(tris, corners)
+        mats = geometry.material_of(tris)
+        estimate = self.emission[mats]
+        for m in self.textured:
+            estimate[mats == m] = self._textured_estimate(tris[mats == m], corners[mats == m], ng[mats == m])
+        power = estimate @ LUMINANCE * area
+        keep = np.flatnonzero(power > 0)
+        self.emissive = tris[keep]
+        cdf = np.cumsum(power[keep])
+        self.emissive_cdf = cdf / cdf[-1] if len(keep) else cdf
+        self.emissive_prob = power[keep] / cdf[-1] if len(keep) else cdf
+        self.emitters = (np.ascontiguousarray(corners[keep].reshape(-1, 3)),
+                         np.arange(3 * len(keep), dtype=np.int64).reshape(-1, 3), np.ascontiguousarray(ng[keep]),
+                         area[keep], np.ascontiguousarray(self.emission[mats[keep]]))
+
     @property
     def moving(self) -> bool:
         return bool(self.motions)
@@ -151,36 +162,36 @@ class Lights:
     # -- emission that varies over a surface ----------------------------------------
     _ESTIMATE_POINTS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1 / 3, 1 / 3, 1 / 3]], float)
 
-    def _textured_estimate(self, m):
-        """Per-triangle emission for choosing triangles: the largest of the corners' and centre's
-        (any choice with power wherever the texture emits keeps light sampling unbiased)."""
-        tris = np.flatnonzero(self.geometry.material == m)
+    def _textured_estimate(self, tris, corners, ng):
+        """Per-triangle emission for choosing triangles of one textured material: the largest of
+        the corners' and centre's (any choice with power wherever the texture emits keeps light
+        sampling unbiased)."""
         best = np.zeros((len(tris), 3))
         for bary in self._ESTIMATE_POINTS:
-            best = np.maximum(best, self._emission_at(tris, np.tile(bary, (len(tris), 1))))
+            weights = np.tile(bary, (len(tris), 1))
+            best = np.maximum(best, self._emission_at(tris, weights, ng, corners))
         return best
 
-    def _emission_at(self, prim, bary, normal=None):
+    def _emission_at(self, prim, bary, normal=None, corners=None):
         """Emission of triangles ``prim`` at ``bary``, its texture seeing ``normal`` (the hits'
         shading normals), or the triangles' geometric normals at light-sampled points."""
         g = self.geometry
-        out = self.tri_emission[prim].copy()
+        mats = g.material_of(prim)
+        out = self.emission[mats]
         for m in self.textured:
-            sel = np.flatnonzero(g.material[prim] == m)
+            sel = np.flatnonzero(mats == m)
             if len(sel):
-                p = g.world_vertices[g.triangles[prim[sel]]]
+                p = g.world_corners(prim[sel]) if corners is None else corners[sel]
                 pos = np.einsum("ni,nij->nj", bary[sel], p)
-                n = g.world_ng[prim[sel]] if normal is None else normal[sel]
+                n = g.world_normals(prim[sel], p)[0] if normal is None else normal[sel]
                 ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n)
                 out[sel] = self.shaders[m].emission_at(ctx)
         return out
 
     def emission_seen(self, prim, u, v, normal=None):
         """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``)."""
-        if not len(self.tri_emission):
-            return np.zeros((len(prim), 3))
         if not self.textured:
-            return self.tri_emission[prim]
+            return self.emission[self.geometry.material_of(prim)]
         return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal)
 
     def _frame(self, i, points, dirs, time):
@@ -210,15 +221,16 @@ class Lights:
         bary, lit = np.zeros((n, 3)), np.zeros((strategies, n), np.bool_)
         g = self.geometry
         world = NO_WORLD if self.world is None else UNIFORM_WORLD if self.environment is None else MAP_WORLD
-        sample_strategies(self.table, self.light_slots, self.selecting, g.world_vertices, g.triangles, g.world_ng,
-                          g.area, self.emissive, self.emissive_cdf, self.emissive_prob, self.tri_emission, g.tables,
+        vertices, triangles, ng, area, emission = self.emitters
+        sample_strategies(self.table, self.light_slots, self.selecting, vertices, triangles, ng, area, self.emissive,
+                          self.emissive_cdf, self.emissive_prob, emission, g.tables,
                           world, self._world_radiance, MAP_SHARE, *self._map, pos, normal, u, out.wi, out.dist,
                           out.value, out.pdf, out.stop, pick, chosen, bary, lit)
         if time is not None and self.motions:
             self._moving_samples(out, pick, chosen, pos, u, time)
         e = self.light_slots
         if len(self.emissive) and self.textured:  # emission from the shader program at the sampled points
-            k = np.flatnonzero(self._textured_tri[pick[e]] & lit[e])
+            k = np.flatnonzero(np.isin(g.material_of(pick[e]), self.textured) & lit[e])
             if len(k):
                 out.value[e, k] = self._emission_at(pick[e, k], bary[k]) / np.maximum(out.pdf[e, k], TINY)[:, None]
         if self.world is not None:
@@ -311,8 +323,17 @@ class Lights:
         return radiance, pdf
 
     def pdf_emissive(self, prim, dirs, t):
-        g = self.geometry
-        return pdf_emissive_batch(g.world_ng, g.area, self.emissive_prob, prim, dirs, np.asarray(t, np.float64))
+        """Light sampling's density (solid angle) of directions ``dirs`` that hit triangles ``prim``
+        at distances ``t``: zero on triangles it never picks."""
+        out = np.zeros(len(prim))
+        e = np.searchsorted(self.emissive, prim)
+        found = np.flatnonzero(e < len(self.emissive))
+        found = found[self.emissive[e[found]] == prim[found]]
+        if len(found):
+            _, _, ng, area, _ = self.emitters
+            out[found] = pdf_emissive_batch(ng, area, self.emissive_prob, e[found], dirs[found],
+                                            np.asarray(t, np.float64)[found])
+        return out
 
     def pdf_world(self, prev_normal, dirs):
         return pdf_world_batch(prev_normal, dirs, self._map_share, *self._map[2:])

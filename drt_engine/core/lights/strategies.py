@@ -68,7 +68,8 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
                       value, pdf, stop, pick, chosen, bary, lit):
     """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
     hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
-    expected picks of it), emissive triangles when there are (``emissive``, picked by power),
+    expected picks of it), emissive triangles when there are (``emissive``: their global ids,
+    picked by power; ``vertices`` to ``emission`` and ``prob`` are per emissive triangle),
     the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``, MAP_WORLD: directions from the
     map (and its sun cone, ``sun``) with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
     the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
@@ -89,16 +90,16 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
             pick[k, j], chosen[k, j] = i, c
         k = slots
         if len(emissive):
-            i = pick_triangle(emissive, cdf, u[j, k, 1, 0])
+            i = pick_triangle(cdf, u[j, k, 1, 0])
             wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, prob, i, px, py, pz,
                                                               u[j, k, 0, 0], u[j, k, 0, 1])
             wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, d, p
-            pick[k, j], lit[k, j] = i, cos_l > 0
+            pick[k, j], lit[k, j] = emissive[i], cos_l > 0
             bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
             if cos_l > 0:
                 s = 1.0 / max(p, TINY)
                 value[k, j, 0], value[k, j, 1], value[k, j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
-            stop[k, j] = offset_scale(geo, i, px + wx * d, py + wy * d, pz + wz * d)
+            stop[k, j] = offset_scale(geo, emissive[i], px + wx * d, py + wy * d, pz + wz * d)
             k += 1
         if world == NO_WORLD:
             continue

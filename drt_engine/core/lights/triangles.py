@@ -20,9 +20,9 @@ from .solid_angle import polygon4
 
 # -- sampling --------------------------------------------------------------------------------------
 @kernel(inline="always")
-def pick_triangle(emissive, cdf, u):
-    """An emissive triangle chosen by power (``cdf`` over the ``emissive`` triangles)."""
-    return emissive[min(np.searchsorted(cdf, u, side="right"), len(emissive) - 1)]
+def pick_triangle(cdf, u):
+    """The index of an emissive triangle chosen by power (``cdf`` over the emissive triangles)."""
+    return min(np.searchsorted(cdf, u, side="right"), len(cdf) - 1)
 
 
 @kernel(inline="always")

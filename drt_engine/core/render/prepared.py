@@ -25,7 +25,6 @@ from dataclasses import fields, is_dataclass, replace
 
 import numpy as np
 
-from ..base import vectors as vec
 from ..errors import SceneError
 from ..geometry.accel import Geometry
 from ..lights.collection import Lights
@@ -140,8 +139,6 @@ class PreparedScene:
 
     def _lights_done(self) -> None:
         self.lights = Lights(self.scene, self.geometry, self.shading, self.textures)
-        # per triangle: emission seen when hit (constant, or from a texture)
-        self.glows = (vec.max3(self.lights.tri_emission) > 0) | np.isin(self.geometry.material, self.lights.textured)
 
     @property
     def warnings(self) -> list[str]:

@@ -75,7 +75,7 @@ class SurfaceContext:
         if name == "normal":
             return a.object_normal(self.prim, self.normal)
         if name == "true_normal":  # the triangle's normal, turned to face the ray as Cycles' Ng
-            ng = a.geometry.world_ng[self.prim]
+            ng = a.geometry.world_normals(self.prim)[0]
             return np.where(self.backfacing()[:, None], -ng, ng)
         if name == "reflection":  # the incoming direction mirrored about the shading normal
             wi = self.coord("incoming")
@@ -155,7 +155,7 @@ class SurfaceContext:
         against the triangle's world normal at mid-shutter."""
         if self.direction is None:
             return np.zeros(self.n, bool)
-        return np.einsum("ij,ij->i", self.direction, self.attrs.geometry.world_ng[self.prim]) > 0
+        return np.einsum("ij,ij->i", self.direction, self.attrs.geometry.world_normals(self.prim)[0]) > 0
 
     def object_matrix(self):
         """(N, 4, 4) object-to-world transforms of the hits' objects."""
@@ -192,20 +192,20 @@ class SurfaceContext:
 
 
 class SurfaceAttributes:
-    """Per-triangle access to the meshes' corner data through ``Geometry.source``."""
+    """Per-triangle access to the meshes' corner data through ``Geometry.source_of``."""
 
     def __init__(self, scene: SceneData, geometry):
         self.scene = scene
         self.geometry = geometry
-        self.source = geometry.source
         self._mesh_of = np.array([instance.mesh for instance in scene.instances], np.int64)
         self._texspaces = {}  # id(mesh) -> (corner, size); the scene outlives this object
 
     def _groups(self, prim):
-        inst = self.source[prim, 0]
+        source = self.geometry.source_of(prim)
+        inst = source[:, 0]
         for i in np.unique(inst):
             sel = np.flatnonzero(inst == i)
-            yield sel, self.scene.instances[i], self.scene.meshes[self._mesh_of[i]], self.source[prim[sel], 1]
+            yield sel, self.scene.instances[i], self.scene.meshes[self._mesh_of[i]], source[sel, 1]
 
     def corner(self, prim, bary, key):
         kind, name = key
@@ -280,7 +280,7 @@ class SurfaceAttributes:
 
     def world_corners(self, prim):
         """(N, 3, 3) world-space corners (mid-shutter) of triangles ``prim``."""
-        return self.geometry.world_vertices[self.geometry.triangles[prim]].astype(np.float64)
+        return self.geometry.world_corners(prim)
 
     def _edges(self, prim):
         """World-space edges (mid-shutter) of triangles ``prim`` from their first corner."""
