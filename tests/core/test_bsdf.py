@@ -130,8 +130,11 @@ def test_sampled_directions_follow_the_evaluated_density(closure, inside):
 @pytest.mark.parametrize("closure", [
     Closure("GLOSSY", color=(0.9, 0.6, 0.3), roughness=0.4, multiscatter=False),
     Closure("PRINCIPLED", color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.6, multiscatter=False),
-], ids=["glossy", "metal"])
+    Closure("DIFFUSE", color=(0.9, 0.6, 0.3), diffuse_roughness=1.0),
+], ids=["glossy", "metal", "oren-nayar"])
 def test_single_scatter_reflection_is_reciprocal(closure):
+    """f(a, b) = f(b, a), the diffuse and non-diffuse parts together (Oren-Nayar's multiple
+    scattering term too: a product of the two directions' albedo deficits)."""
     shader = MaterialShader(Material("m", [closure]))
     n = 1000
     a = RNG.normal(size=(n, 3))
@@ -140,8 +143,8 @@ def test_single_scatter_reflection_is_reciprocal(closure):
     a /= np.linalg.norm(a, axis=1, keepdims=True)
     b /= np.linalg.norm(b, axis=1, keepdims=True)
     up, out = np.ones(n, bool), np.zeros(n, bool)
-    _, f_ab, _ = shader.evaluate(a, b, up, out)
-    _, f_ba, _ = shader.evaluate(b, a, up, out)
+    f_ab = sum(shader.evaluate(a, b, up, out)[:2])
+    f_ba = sum(shader.evaluate(b, a, up, out)[:2])
     assert np.allclose(f_ab / b[:, 2:], f_ba / a[:, 2:], rtol=1e-9, atol=1e-12)
 
 
@@ -232,22 +235,13 @@ def test_oren_nayar_albedo_is_fujiis_plus_the_multiple_scattering(sigma, mu):
     assert np.allclose(albedo, expected, rtol=2e-4)
 
 
-def test_oren_nayar_is_reciprocal_and_brighter_toward_the_light():
-    """f(a, b) = f(b, a); seen from the light's side at grazing, a rough surface is brighter than
-    Lambert (the backscatter Oren-Nayar is for), and the darker seen across it."""
+def test_oren_nayar_is_brighter_toward_the_light():
+    """Seen from the light's side at grazing, a rough surface is brighter than Lambert (the
+    backscatter Oren-Nayar is for), and darker seen across it."""
     shader = MaterialShader(Material("m", [Closure("DIFFUSE", color=(0.8, 0.8, 0.8), diffuse_roughness=1.0)]))
-    n = 1000
-    a = RNG.normal(size=(n, 3))
-    b = RNG.normal(size=(n, 3))
-    a[:, 2], b[:, 2] = np.abs(a[:, 2]), np.abs(b[:, 2])
-    a /= np.linalg.norm(a, axis=1, keepdims=True)
-    b /= np.linalg.norm(b, axis=1, keepdims=True)
-    up, out = np.ones(n, bool), np.zeros(n, bool)
-    f_ab = shader.evaluate(a, b, up, out).diffuse
-    f_ba = shader.evaluate(b, a, up, out).diffuse
-    assert np.allclose(f_ab / b[:, 2:], f_ba / a[:, 2:], rtol=1e-9, atol=1e-12)
+    up, out = np.ones(1, bool), np.zeros(1, bool)
     light = np.array([[0.8, 0.0, 0.6]])
-    back = shader.evaluate(light, light, up[:1], out[:1]).diffuse / 0.6
-    across = shader.evaluate(light * [-1, 1, 1], light, up[:1], out[:1]).diffuse / 0.6
+    back = shader.evaluate(light, light, up, out).diffuse / 0.6
+    across = shader.evaluate(light * [-1, 1, 1], light, up, out).diffuse / 0.6
     assert back[0, 0] > 0.8 / np.pi > across[0, 0]
     assert not shader.lambertian and not shader.can_continue
