@@ -40,6 +40,8 @@ class Closure:
     coat_roughness: float = 0.03
     coat_ior: float = 1.5
     coat_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    diffuse_roughness: float = 0.0
+    """DIFFUSE's and Principled's diffuse: Lambert, or from 1e-5 up Oren-Nayar of this sigma (Cycles')."""
     emission: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
     multiscatter: bool = True
@@ -58,7 +60,8 @@ class Closure:
 
 CLOSURE_KINDS = (
     "PRINCIPLED",  # full Principled BSDF
-    "DIFFUSE",  # Lambert, colour = albedo
+    "DIFFUSE",  # Lambert (Oren-Nayar with ``diffuse_roughness``), colour = albedo
+    "TRANSLUCENT",  # Lambert on the side opposite the normal, colour = albedo
     "GLOSSY",  # GGX reflection tinted by colour, no Fresnel (Blender's Glossy BSDF)
     "GLASS",  # smooth or rough dielectric, reflection + refraction tinted by colour
     "REFRACTION",  # refraction only, tinted by colour

@@ -326,6 +326,46 @@ def test_mix_and_add_shaders_flatten_into_weighted_closures():
     assert data.warnings == []
 
 
+def test_translucent_and_rough_diffuse_export_as_their_closures():
+    """Translucent BSDF in a Mix Shader, a Diffuse BSDF's Roughness (constant, and from a texture,
+    then varying per hit) and a Principled BSDF's Diffuse Roughness (Blender 4.3+) become closures
+    without a warning where this Blender's Cycles computes Oren-Nayar as DRT does."""
+    from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM, VERSION_OREN_NAYAR
+    empty_scene()
+    material, tree, output = _new_node_material("Leaf")
+    translucent = tree.nodes.new("ShaderNodeBsdfTranslucent")
+    translucent.inputs["Color"].default_value = (0.2, 0.9, 0.3, 1.0)
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Roughness"].default_value = 0.7
+    rough = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    tree.links.new(tree.nodes.new("ShaderNodeTexNoise").outputs["Fac"], rough.inputs["Roughness"])
+    principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    if "Diffuse Roughness" in principled.inputs:
+        principled.inputs["Diffuse Roughness"].default_value = 0.4
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs[0].default_value = 0.25
+    add, add2 = tree.nodes.new("ShaderNodeAddShader"), tree.nodes.new("ShaderNodeAddShader")
+    tree.links.new(diffuse.outputs[0], mix.inputs[1])
+    tree.links.new(translucent.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], add.inputs[0])
+    tree.links.new(rough.outputs[0], add.inputs[1])
+    tree.links.new(add.outputs[0], add2.inputs[0])
+    tree.links.new(principled.outputs[0], add2.inputs[1])
+    tree.links.new(add2.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    diffuse_c, translucent_c, rough_c, principled_c = _closures(data, "Leaf")
+    assert (diffuse_c.kind, translucent_c.kind, rough_c.kind) == ("DIFFUSE", "TRANSLUCENT", "DIFFUSE")
+    assert [diffuse_c.weight[0], translucent_c.weight[0]] == pytest.approx([0.75, 0.25])
+    np.testing.assert_allclose(translucent_c.color, (0.2, 0.9, 0.3), rtol=1e-6)
+    assert diffuse_c.diffuse_roughness == pytest.approx(0.7)
+    assert "diffuse_roughness" in rough_c.inputs and "roughness" not in rough_c.inputs
+    assert principled_c.diffuse_roughness == pytest.approx(0.4 if "Diffuse Roughness" in principled.inputs else 0.0)
+    if bpy.app.version < OREN_NAYAR_MATCHED_FROM:
+        assert len(data.warnings) == 1 and VERSION_OREN_NAYAR in data.warnings[0], data.warnings
+    else:
+        assert data.warnings == []
+
+
 def test_muted_mix_shader_passes_its_first_shader_through():
     empty_scene()
     material, tree, output = _new_node_material("Muted")

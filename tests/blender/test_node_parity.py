@@ -1,8 +1,9 @@
 """Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
 and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
 Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
-Info, a Wireframe in pixels, the material's Displacement (as bump) and a Sky Texture world
-lighting a sphere on the ground in scenes of their own.
+Info, a Wireframe in pixels, the material's Displacement (as bump), a Sky Texture world
+lighting a sphere on the ground, and closures (Oren-Nayar, Translucent) under suns in scenes of
+their own.
 The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
 1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
@@ -21,7 +22,7 @@ from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support import sky_scenes
 from tests.support.datablocks import new_material
-from drt_engine.blender.export.materials import VERSION_BUMP
+from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM, VERSION_BUMP, VERSION_OREN_NAYAR
 from drt_engine.blender.export.shader_graph import DISPLACEMENT_MATCHED_FROM
 from tests.support.export_helpers import render_export
 
@@ -263,3 +264,34 @@ def test_tangents_asked_of_a_mesh_without_uv_map_are_named(drt):
     scene = ns.grid_scene([replace(case, name="No UV map", build=ns._vector_displacement("TANGENT"))])
     warnings = [w for w in render_export(scene).warnings if "no UV map" in w]
     assert len(warnings) == 1 and "No UV map" in warnings[0], warnings
+
+
+CLOSURE_CASES = [c for c in ns.CLOSURES if bpy.app.version >= c.since]
+
+
+@pytest.fixture(scope="module")
+def closures(drt, tmp_path_factory):
+    """DRT seed 0, Cycles seeds 0 and 1 of the closure scene, and the export's warnings."""
+    scene = ns.closure_scene(CLOSURE_CASES)
+    warnings = _cannot(render_export(scene))
+    renders = ps.parity_renders(scene, tmp_path_factory.mktemp("closures"), "closures")
+    rh.save_side_by_side("closures", renders[0].rgb, renders[1].rgb)
+    return warnings, renders
+
+
+@pytest.mark.parametrize("case", CLOSURE_CASES, ids=[c.name for c in CLOSURE_CASES])
+def test_closure_matches_cycles(closures, case):
+    """Each closure's square of the scene, without its edge pixels (the pixel filter's reach into the
+    next square): DRT against Cycles by the parity rule, exported without a warning. A Blender whose
+    Cycles computes Oren-Nayar otherwise (4.2's) names it in the material's warning instead."""
+    warnings, renders = closures
+    named = [w for w in warnings if f"Material '{case.name}'" in w]
+    if case.oren_nayar and bpy.app.version < OREN_NAYAR_MATCHED_FROM:
+        assert len(named) == 1 and VERSION_OREN_NAYAR in named[0], warnings
+        return
+    assert not named, warnings
+    i, size, m = CLOSURE_CASES.index(case), renders[0].rgb.shape[0], ps.MARGIN
+    part = (slice(m, size - m), slice(i * size + m, (i + 1) * size - m))
+    figures = ps.parity(*(r.rgb[part] for r in renders))
+    print(f"{case.name}: {figures}")
+    assert figures["ok"], ps.message(case.name, figures)

@@ -31,7 +31,7 @@ def _rays(n):
     return wo, wi
 
 
-@pytest.mark.parametrize("kind", ["metal", "glossy", "plastic", "glass"])
+@pytest.mark.parametrize("kind", ["metal", "glossy", "plastic", "glass", "oren-nayar", "translucent"])
 def test_bound_rows_equal_shaders_built_with_their_colour(kind):
     """A shader bound to per-hit colours and weights (one parameter row per hit) evaluates and
     samples each hit as a shader built with that hit's colour and weight does. (A per-hit metal
@@ -45,6 +45,10 @@ def test_bound_rows_equal_shaders_built_with_their_colour(kind):
             return Closure("GLOSSY", color=color, weight=weight, roughness=0.3)
         if kind == "glass":
             return Closure("PRINCIPLED", color=color, weight=weight, roughness=0.3, transmission=1.0)
+        if kind == "oren-nayar":  # its multiple scattering is not linear in the colour
+            return Closure("PRINCIPLED", color=color, weight=weight, roughness=0.5, diffuse_roughness=0.8)
+        if kind == "translucent":
+            return Closure("TRANSLUCENT", color=color, weight=weight)
         return Closure("PRINCIPLED", color=color, weight=weight, roughness=0.5, coat_weight=0.5)
 
     n = 3000

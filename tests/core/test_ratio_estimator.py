@@ -64,6 +64,22 @@ def test_a_wholly_lit_patch_is_exact():
         assert (diff < 1e-3) == holds, (estimator, diff)
 
 
+def test_a_diffuse_part_other_than_lambert_stays_monte_carlo():
+    """The closed form U is Lambert's: an Oren-Nayar floor's direct light is left to Monte Carlo
+    (no N, D, U of its samples), so its patch renders as with the Monte Carlo estimator, bit for bit."""
+    from drt_engine.core.scene import Closure, Material
+    scene, base = soft_shadow_scene(64)
+    scene.materials[0] = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.6, 0.6), diffuse_roughness=1.0)])
+    patch = (slice(2, 10), slice(20, 44))
+    images = {}
+    for estimator in ("RATIO", "MONTE_CARLO"):
+        renderer, result = render(scene, 4, 1, estimator, **base)
+        images[estimator] = result.passes["Combined"][..., :3][patch]
+        if estimator == "RATIO":
+            assert not renderer.film.sums[RATIO].reshape(48, 64, -1)[patch].any()
+    assert np.array_equal(images["RATIO"], images["MONTE_CARLO"])
+
+
 def test_no_bias_against_monte_carlo(soft):
     """Mean of BIAS_SEEDS renders at BIAS_SAMPLES spp against the reference: image mean within
     0.3%, every 4x4 block within 5 standard errors and their mean squared z-score near 1 (the

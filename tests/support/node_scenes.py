@@ -880,3 +880,88 @@ def displacement_scene(size=32):
     square("Straight", 0.0, -1.1, straight, normal_colour)
     square("Normal linked", 2.2, -1.1, tilted_normal)
     return scene
+
+
+
+def _rough_diffuse(tree, roughness):
+    return _link(tree, _node(tree, "ShaderNodeBsdfDiffuse"), Color=(0.8, 0.55, 0.3, 1.0), Roughness=roughness)
+
+
+def _principled_rough(tree):
+    return _link(tree, _node(tree, "ShaderNodeBsdfPrincipled"), Roughness=0.4,
+                 **{"Base Color": (0.3, 0.6, 0.8, 1.0), "Diffuse Roughness": 1.0})
+
+
+def _translucent(tree, colour=(0.3, 0.9, 0.4, 1.0)):
+    return _link(tree, _node(tree, "ShaderNodeBsdfTranslucent"), Color=colour)
+
+
+def _translucent_over_diffuse(tree):
+    """0.6 translucent, coloured from yellow at the square's bottom to cyan at its top (Generated y:
+    its upright side), and 0.4 diffuse: lit through from behind and in front."""
+    y = _scaled(tree, _component(tree, _node(tree, "ShaderNodeTexCoord").outputs["Generated"], "Y"), 1.0, 0.0)
+    combine = _node(tree, "ShaderNodeCombineColor")
+    tree.links.new(_scaled(tree, y, -0.8, 0.9), combine.inputs[0])
+    combine.inputs[1].default_value = 0.8
+    tree.links.new(_scaled(tree, y, 0.8, 0.1), combine.inputs[2])
+    translucent = _translucent(tree)
+    tree.links.new(combine.outputs[0], translucent.inputs["Color"])
+    mix = _link(tree, _node(tree, "ShaderNodeMixShader"), Fac=0.6)
+    tree.links.new(_link(tree, _node(tree, "ShaderNodeBsdfDiffuse"), Color=(0.9, 0.9, 0.9, 1.0)).outputs[0],
+                   mix.inputs[1])
+    tree.links.new(translucent.outputs[0], mix.inputs[2])
+    return mix
+
+
+@dataclass(frozen=True)
+class ClosureCase:
+    name: str
+    shape: str  # "sphere" | "square"
+    build: Callable  # tree -> the shader node shown
+    oren_nayar: bool = False
+    since: tuple = (0, 0)  # the first Blender with the node inputs it sets
+
+
+CLOSURES = (
+    ClosureCase("Oren-Nayar, roughness 1", "sphere", lambda tree: _rough_diffuse(tree, 1.0), True),
+    ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
+                lambda tree: _rough_diffuse(tree, _generated_z(tree, 1.0, 0.0)), True),
+    ClosureCase("Principled BSDF, Diffuse Roughness 1", "sphere", _principled_rough, True, (4, 3)),
+    ClosureCase("Translucent", "square", _translucent),
+    ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
+)
+"""Closures under two suns, each in its own square of ``closure_scene``: rough diffuse spheres
+(Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
+textured, and a Principled BSDF's Diffuse Roughness) and upright squares lit through from behind
+(Translucent, alone and mixed with a Diffuse lit in front)."""
+
+
+def closure_scene(cases, size=32):
+    """The ``cases`` side by side, ``size`` pixels apart, seen level along +y by an orthographic
+    camera under a black world: one sun from the camera's side, a little above and to the left,
+    one from behind, above and to the right (through the squares, on the spheres' limbs)."""
+    scene = ps._scene(size * len(cases), size)
+    scene.camera.data.type = "ORTHO"
+    scene.camera.data.ortho_scale = 2.1 * len(cases)
+    scene.camera.location = (0.0, -8.0, 0.0)
+    scene.camera.rotation_euler = (np.pi / 2, 0.0, 0.0)
+    ps.black_world(scene)
+    for name, energy, direction in (("Front", 2.0, (-0.35, -1.0, 0.45)), ("Back", 3.0, (0.4, 1.0, 0.6))):
+        sun = bpy.data.objects.new(name, bpy.data.lights.new(name, "SUN"))
+        sun.data.energy = energy
+        sun.rotation_euler = mathutils.Vector(direction).to_track_quat("Z", "Y").to_euler()
+        scene.collection.objects.link(sun)
+    for i, case in enumerate(cases):
+        x = 2.1 * (i - (len(cases) - 1) / 2)
+        if case.shape == "sphere":
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.95, location=(x, 0.0, 0.0), segments=64, ring_count=32)
+            bpy.ops.object.shade_smooth()
+        else:
+            bpy.ops.mesh.primitive_plane_add(size=1.8, location=(x, 0.0, 0.0), rotation=(np.pi / 2, 0.0, 0.0))
+        mat = new_material(case.name)
+        tree = mat.node_tree
+        tree.nodes.clear()
+        out = _node(tree, "ShaderNodeOutputMaterial")
+        tree.links.new(case.build(tree).outputs[0], out.inputs["Surface"])
+        bpy.context.active_object.data.materials.append(mat)
+    return scene

@@ -38,7 +38,8 @@ def _multiscatter(node, issues) -> bool:
 
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
-           "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint", "normal")
+           "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
+           "diffuse_roughness", "normal")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -106,8 +107,10 @@ def _principled(node, weight, issues, compiler):
         coat_roughness=value(0.03, "Coat Roughness", field="coat_roughness", kind="float"),
         coat_ior=value(1.5, "Coat IOR", field="coat_ior", kind="float"),
         coat_tint=rgb(value(1.0, "Coat Tint", field="coat_tint", kind="color")),
+        diffuse_roughness=value(0.0, "Diffuse Roughness", field="diffuse_roughness", kind="float"),
         multiscatter=_multiscatter(node, issues),
     )
+    _oren_nayar_version(node, principled, value, issues)
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
     value.normal()
     if is_ref(alpha):
@@ -126,15 +129,15 @@ def _bsdf(kind):
     def make(node, weight, issues, compiler):
         value = _Inputs(node, compiler, issues)
         closure = Closure(kind, color=rgb(value(0.8, "Color", field="color", kind="color")))
-        if kind != "TRANSPARENT":
+        if kind == "DIFFUSE":
+            closure.diffuse_roughness = value(0.0, "Roughness", field="diffuse_roughness", kind="float")
+            _oren_nayar_version(node, closure, value, issues)
+        elif kind not in ("TRANSPARENT", "TRANSLUCENT"):
             closure.roughness = value(0.5, "Roughness", field="roughness", kind="float")
         if kind in ("GLOSSY", "GLASS", "REFRACTION"):
             closure.multiscatter = _multiscatter(node, issues)
         if kind in ("GLASS", "REFRACTION"):
             closure.ior = value(1.5, "IOR", field="ior", kind="float")
-        if kind == "DIFFUSE" and (closure.roughness > 0.0 or "roughness" in value.varying):
-            issues.add(f"'{node.name}' Oren-Nayar roughness")
-            value.varying.pop("roughness", None)
         if kind == "GLOSSY" and value(0.0, "Anisotropy") > 0.0:
             issues.add(f"'{node.name}' anisotropy")
         if kind != "TRANSPARENT":
@@ -142,6 +145,22 @@ def _bsdf(kind):
         return [_weighted(closure, weight, value.varying)]
 
     return make
+
+
+OREN_NAYAR_MATCHED_FROM = (4, 3)
+"""The first Blender taken to have the Oren-Nayar DRT computes (Fujii's with a multiple-scattering
+term, kernel/closure/bsdf_oren_nayar.h), the version that added the Principled BSDF's Diffuse
+Roughness; matched against 5.0's Cycles. 4.2's is the older model (measured: a white plane seen
+head-on under a sun 69 degrees off, roughness 1, 0.0896 against this model's 0.1021); 4.3 and 4.4
+were not measured. Before this version a rough diffuse is named in the material's warning."""
+VERSION_OREN_NAYAR = "this Blender's Oren-Nayar: rendered as Cycles 4.3+ computes it"
+
+
+def _oren_nayar_version(node, closure, value, issues):
+    """Name a rough diffuse on a Blender whose Cycles computes Oren-Nayar otherwise."""
+    rough = closure.diffuse_roughness > 0.0 or "diffuse_roughness" in value.varying
+    if rough and bpy.app.version < OREN_NAYAR_MATCHED_FROM:
+        issues.add(f"'{node.name}' roughness ({VERSION_OREN_NAYAR})")
 
 
 def _emission_input(closure, value, compiler, default_strength, color_names, strength_names):
@@ -173,6 +192,7 @@ CLOSURE_NODES = {
     "ShaderNodeBsdfRefraction": _bsdf("REFRACTION"),
     "ShaderNodeEmission": _emission,
     "ShaderNodeBsdfTransparent": _bsdf("TRANSPARENT"),
+    "ShaderNodeBsdfTranslucent": _bsdf("TRANSLUCENT"),
 }
 
 

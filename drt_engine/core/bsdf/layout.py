@@ -8,7 +8,7 @@
   ``hp[prow[i]]`` (``hp`` and the row ``r`` in the scalar functions).
 """
 # lobe kinds and Fresnel kinds
-DIFFUSE, REFLECT, GLASS, TRANSPARENT = 0, 1, 2, 3
+DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR = 0, 1, 2, 3, 4, 5
 F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
 
 # lp: constants per lobe
@@ -30,7 +30,8 @@ P_SAMPLED = 21  # index among the lobes a ray continues through, -1 for diffuse
 P_WEIGHT = 22  # (3) constant weight
 P_A_AVG = 25  # (3) cosine averages of A and B (affine multiscatter)
 P_B_AVG = 28
-P = 31
+P_SIGMA = 31  # Oren-Nayar roughness sigma
+P = 32
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice

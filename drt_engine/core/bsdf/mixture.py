@@ -21,9 +21,12 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from .diffuse import diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import DIFFUSE, P_DELTA, P_KIND, P_SAMPLED, REFLECT, TRANSPARENT
+from .layout import DIFFUSE, P_DELTA, P_KIND, P_SAMPLED, REFLECT, TRANSLUCENT, TRANSPARENT
+from .oren_nayar import oren_nayar_eval
+from .passes import diffuse_kind
 from .reflection import reflect_eval, reflect_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
+from .translucent import translucent_eval
 from .transparent import transparent_sample
 
 
@@ -53,7 +56,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
 
     ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
     back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo. Returns
-    (diffuse part RGB, non-diffuse part RGB, density of continuing toward wi through the
+    (diffuse part RGB (Lambert, Oren-Nayar and translucent lobes), non-diffuse part RGB, density of continuing toward wi through the
     non-diffuse lobes).
     """
     j, t = locate(mu, woz)
@@ -64,12 +67,20 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
         if lp[l, P_DELTA] != 0.0:
             continue
         kind = int(lp[l, P_KIND])
-        if kind == DIFFUSE:
-            if refl:
+        if diffuse_kind(kind):
+            if kind == TRANSLUCENT:
+                if not trans:
+                    continue
+                d0, d1, d2 = translucent_eval(lp, lt, hp, r, j, t, l, wiz)
+            elif not refl:
+                continue
+            elif kind == DIFFUSE:
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
-                fd0 += d0
-                fd1 += d1
-                fd2 += d2
+            else:
+                d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
+            fd0 += d0
+            fd1 += d1
+            fd2 += d2
             continue
         if kind == REFLECT:
             if not refl:

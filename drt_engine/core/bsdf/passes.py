@@ -3,8 +3,16 @@ from __future__ import annotations
 
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import DIFFUSE, GLASS, H_TINT_R, H_TINT_T, P_ALPHA, P_ETA, P_KIND, P_REFRACT_ONLY, REFLECT, TRANSPARENT
+from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND, P_REFRACT_ONLY, REFLECT,
+                     TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
+
+
+@kernel(inline="always")
+def diffuse_kind(kind):
+    """Lambert, Oren-Nayar or translucent: Cycles' diffuse closures (CLOSURE_IS_BSDF_DIFFUSE), which
+    its DiffCol pass and the diffuse side of its denoising albedo take."""
+    return kind == DIFFUSE or kind == OREN_NAYAR or kind == TRANSLUCENT
 
 
 @kernel(inline="always")
@@ -14,7 +22,7 @@ def colours(lp, lt, hp, r, mu, mu_o):
     d0 = d1 = d2 = g0 = g1 = g2 = 0.0
     for l in range(lp.shape[0]):
         kind = int(lp[l, P_KIND])
-        if kind == DIFFUSE:
+        if diffuse_kind(kind):
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
             d0 += a0
             d1 += a1
@@ -67,7 +75,7 @@ def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         weight = (a0 + a1 + a2) / 3.0
         total += weight
-        if kind == DIFFUSE or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
+        if diffuse_kind(kind) or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
             d0 += a0
             d1 += a1
             d2 += a2

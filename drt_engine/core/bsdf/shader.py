@@ -1,4 +1,5 @@
-"""Materials as sums of lobes: Lambert, GGX reflection, dielectric (glass), transparent.
+"""Materials as sums of lobes: Lambert, Oren-Nayar, translucent, GGX reflection, dielectric (glass),
+transparent.
 
 A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
 with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
@@ -7,8 +8,8 @@ the layer below weighted by one minus the albedo of the layer above. Energy term
 
 Directions are in the local shading frame with ``wo`` always in the upper hemisphere
 (the caller flips the frame to the side the ray arrived from; glass inverts its IOR).
-The diffuse lobe is evaluated for light sampling only: as in Cook's distribution ray
-tracing (and Cycles with diffuse bounces 0) no rays continue from it.
+The diffuse lobes (Lambert, Oren-Nayar, translucent) are evaluated for light sampling only: as
+in Cook's distribution ray tracing (and Cycles with diffuse bounces 0) no rays continue from them.
 
 Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
 sampling, pdf, lobe choice, pass colours) is compiled (one module per lobe kind, ``mixture``
@@ -35,11 +36,12 @@ from .rows import colours_rows, denoising_rows, evaluate_rows, sample_rows, sele
 class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
     arrays of ``layout``."""
-    kind: str  # "diffuse" | "reflect" | "glass" | "transparent"
+    kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
     alpha: float = 0.0
+    sigma: float = 0.0  # Oren-Nayar roughness
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
     fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
@@ -53,7 +55,7 @@ class Lobe:
     ms: tuple | None = None  # (mu, factor, E_avg): multiple-scattering compensation of f
     f82: np.ndarray | None = None  # metal: F82 tint
     source: int = 0  # index of the closure the lobe comes from
-    role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent"
+    role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent" | "translucent"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
 
     @property
@@ -71,9 +73,17 @@ class Lobe:
         return self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA
 
     @property
+    def diffuse(self) -> bool:
+        """One of the diffuse lobes, which no ray continues through."""
+        return self.kind in DIFFUSE_KINDS
+
+    @property
     def alpha_t(self) -> float:
         """Spread of the refracted directions of a glass lobe (alpha scaled by the bend)."""
         return self.alpha * min(1.0, abs(self.eta - 1.0))
+
+
+DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent")
 
 
 def _alpha(roughness: float) -> float:
@@ -305,8 +315,20 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
             spec.role = "spec"
             lobes.append(spec)
             diffuse_layers.append(_layer_under(spec))
-        lobes.append(Lobe("diffuse", w * opaque, layers=diffuse_layers, albedo=base, role="diffuse"))
+        lobes.append(_diffuse_lobe(w * opaque, base, c.diffuse_roughness, diffuse_layers))
     return lobes
+
+
+OREN_NAYAR_FROM = 1e-5
+"""Roughness from which Cycles' diffuse is Oren-Nayar rather than Lambert
+(``diffuse_roughness_is_almost_zero`` in kernel/closure/bsdf_oren_nayar.h)."""
+
+
+def _diffuse_lobe(weight, albedo, roughness, layers=()) -> Lobe:
+    """Lambert, or Oren-Nayar of sigma ``roughness`` from OREN_NAYAR_FROM up."""
+    rough = float(roughness) >= OREN_NAYAR_FROM
+    return Lobe("oren_nayar" if rough else "diffuse", np.asarray(weight, float), layers=list(layers), albedo=albedo,
+                sigma=float(roughness) if rough else 0.0, role="diffuse")
 
 
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
@@ -317,7 +339,9 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
         if c.kind == "PRINCIPLED":
             new = _principled_lobes(c, tables)
         elif c.kind == "DIFFUSE":
-            new = [Lobe("diffuse", c.weight, albedo=np.clip(c.color, 0, 1), role="diffuse")]
+            new = [_diffuse_lobe(c.weight, np.clip(c.color, 0, 1), c.diffuse_roughness)]
+        elif c.kind == "TRANSLUCENT":
+            new = [Lobe("translucent", c.weight, albedo=np.clip(c.color, 0, 1), role="translucent")]
         elif c.kind == "GLOSSY":
             tint = np.clip(c.color, 0, 1)
             new = [_reflect_lobe(c.weight, _alpha(c.roughness), lambda x: np.ones((len(x), 3)),
@@ -338,7 +362,7 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
 
 
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
-          "transparent": layout.TRANSPARENT}
+          "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -354,6 +378,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_DELTA] = lobe.delta
         row[layout.P_ALPHA], row[layout.P_ALPHA_T], row[layout.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
         row[layout.P_REFRACT_ONLY] = lobe.refract_only
+        row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_FRESNEL], row[layout.P_ETA_F] = lobe.fresnel_kind, lobe.fresnel_eta
         row[layout.P_F82:layout.P_F82 + 3] = 1.0 if lobe.f82 is None else lobe.f82
         row[layout.P_LAYERS] = len(lobe.layers)
@@ -408,7 +433,7 @@ class MaterialShader:
         self.material = material
         self.lobes = lobes_of(material, tables)
         self.emission = material.emission
-        self.sampled = [lobe for lobe in self.lobes if lobe.kind != "diffuse"]
+        self.sampled = [lobe for lobe in self.lobes if not lobe.diffuse]
         self.has_glass = any(lobe.kind == "glass" for lobe in self.lobes)
         for lobe in self.lobes:
             names = (varying or {}).get(lobe.source, ())
@@ -426,6 +451,11 @@ class MaterialShader:
     def can_continue(self) -> bool:
         return bool(self.sampled)
 
+    @property
+    def lambertian(self) -> bool:
+        """Its diffuse part is Lambert about the shading normal (no Oren-Nayar, no translucent lobe)."""
+        return all(lobe.kind == "diffuse" for lobe in self.lobes if lobe.diffuse)
+
     def bind(self, values: dict) -> "MaterialShader":
         """A copy whose lobes take per-hit values: ``values[closure index]`` maps "weight" and
         "color" to (N, 3) arrays (the shader was built with those set to one)."""
@@ -439,7 +469,7 @@ class MaterialShader:
             if color is None:
                 continue
             base = np.clip(color, 0.0, 1.0)
-            if lobe.role in ("diffuse", "transparent"):
+            if lobe.role in ("diffuse", "transparent", "translucent"):
                 hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = base
             elif lobe.role == "glass":
                 hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = np.sqrt(base)

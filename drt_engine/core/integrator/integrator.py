@@ -355,7 +355,7 @@ class Integrator:
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
         # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
         # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
-        lifted = len(self.geometry.tables[3]) > 0 and any(lobe.kind == "diffuse" for lobe in shader.lobes)
+        lifted = len(self.geometry.tables[3]) > 0 and any(lobe.diffuse for lobe in shader.lobes)
         geo = self.geometry
         traced = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),

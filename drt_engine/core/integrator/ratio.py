@@ -83,6 +83,8 @@ class RatioEstimator:
         values and the BSDF's diffuse part toward them, and what became of their shadow rays
         (core.integrator.direct). For the estimator's strategies, D and U of every hit and the N of
         each ray that got through; a strategy whose samples all came back empty adds nothing."""
+        if not shader.lambertian:  # the closed form E_u is of Lambert's cosine about the normal
+            return
         albedo = None
         for k in self.strategies:
             if not (vec.max3(value[k]) > 0).any():
