@@ -156,11 +156,10 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     renderer = Renderer(data, settings_for(samples=samples, seed=seed, use_denoising=True), denoiser=oidn)
     result = renderer.render()
     film, (h, w) = renderer.film, ref.shape[:2]
-    features = film.images(PASSES)
-    albedo, normal = oidn.clean_features(features[ALBEDO], features[NORMAL])
     full, half_a, half_b = noisy_images(film)
     denoised = result.passes["Combined"][..., :3]
-    da, db = (oidn.denoise(x.reshape(h, w, 3), albedo, normal, prefilter="NONE") for x in (half_a, half_b))
+    da, db = (oidn.denoise(x.reshape(h, w, 3), guide[ALBEDO], guide[NORMAL])
+              for x, guide in zip((half_a, half_b), film.half_images(PASSES)))
     _, error, weight = error_terms(denoised, da, db, half_a, half_b, film.count, film.count_a)
     estimated = (error * weight).mean(axis=1)
     true = (((denoised - ref) ** 2 - ref_var) / (ref ** 2 + RELMSE_EPSILON)).reshape(-1, 3).mean(axis=1)

@@ -63,8 +63,14 @@ def test_noisy_image_is_the_render_without_denoising(pair):
 
 
 def test_features_are_traced_for_the_denoiser_but_written_only_when_asked(oidn, pair):
+    """Traced over all samples and per half (Film's ``halved``) when denoising; neither without it."""
     denoised, _ = pair
     assert set(denoised.passes) == {"Combined", "Noise", NOISY_IMAGE}
+    scene, base = soft_shadow_scene(8)
+    for use_denoising, halved in ((True, {"Denoising Albedo", "Denoising Normal"}), (False, set())):
+        settings = RenderSettings(**base, samples=2, use_denoising=use_denoising)
+        film = Renderer(scene, settings, denoiser=oidn).film
+        assert set(film.sums_a) == halved and halved <= set(film.sums)
     asked = render(oidn, samples=2, use_denoising=True,
                    passes=("Combined", "Denoising Albedo", "Denoising Normal"))
     assert set(asked.passes) == {"Combined", "Denoising Albedo", "Denoising Normal", NOISY_IMAGE}
@@ -167,10 +173,10 @@ def test_the_target_error_applies_to_the_denoised_image(oidn):
     assert denoised.stats["relmse_denoised"] < target < denoised.stats["relmse"]
 
 
-def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch):
-    """A farm's parts carry the denoiser's features and the replicate halves in their sums; the merge
-    denoises the merged film once (not per part, however often its images are asked for) and gives
-    the whole render's denoised image and estimate."""
+def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch, tmp_path):
+    """A farm's parts carry the denoiser's features, over all samples and per half, and the replicate
+    halves in their sums, through their files; the merge denoises the merged film once (not per part,
+    however often its images are asked for) and gives the whole render's denoised image and estimate."""
     from drt_engine.core.film import parts
     from drt_engine.core.film.denoising import PASSES as FEATURE_PASSES
     from drt_engine.core.render import merge, report
@@ -188,7 +194,11 @@ def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch
 
     whole = run()[1]
     pieces = [run(a, b)[0] for a, b in ((3, SPP), (0, 3))]
-    assert all(set(FEATURE_PASSES) <= set(piece.sums) for piece in pieces)
+    assert all(set(FEATURE_PASSES) <= set(piece.sums) and set(FEATURE_PASSES) == set(piece.sums_a)
+               for piece in pieces)
+    for i, piece in enumerate(pieces):
+        parts.write(tmp_path / f"{i}.exr", piece)
+    pieces = [parts.read(tmp_path / f"{i}.exr") for i in range(len(pieces))]
     calls = []
     monkeypatch.setattr(merge, "denoise_film", lambda *a, real=merge.denoise_film: calls.append(a) or real(*a))
     merger = merge.merge_parts(pieces, ["A", "B"])
