@@ -13,7 +13,7 @@ follow the same feature noise, it cancels in D_A - D_B, and on dof_row the estim
   falls as 1 / samples, as a linear smoother's does (the same form as the noisy image's estimate,
   adaptive.image_error). It cannot see blur of real detail: a texture smoothed flat or a thin
   shadow softened the same way in both halves cancels in D_A - D_B. On the sample scenes it read
-  0.4 to 0.6 of the true error (docs/denoising.md);
+  0.4 to 0.8 of the true error (docs/denoising.md);
 - **the error of a half's denoised image, blur included**, by cross-validation against the other
   half's noisy image, which is unbiased and independent of it:
   E[(D_A - N_B)^2] = MSE(D_A) + Var(N_B), with Var(N_B) = (N_A - N_B)^2 n_A / n in expectation, so
