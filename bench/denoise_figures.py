@@ -30,6 +30,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 MEASURED = ROOT / "out" / "ui" / "denoise.json"
 MAPS = ROOT / "bench" / "plots" / "denoise_cornell_box.png"
 CALIBRATION = ROOT / "bench" / "denoise_calibration.json"
+NOISE_SCALING = ROOT / "bench" / "denoise_noise_scaling.json"
 RESULTS = ROOT / "bench" / "results"
 
 SCENES = ("cornell_box", "dof_row", "glossy_spheres", "motion_blur")
@@ -229,6 +230,51 @@ def feature_noise_block(m: dict) -> str:
     return "\n".join(lines)
 
 
+def noise_scaling(samples=16, seeds=range(1, 7), width=64) -> dict:
+    """Whether the noise OIDN leaves falls as 1 / samples, as the halves' difference assumes
+    (core.render.denoise): per test scene, the variance of the denoised image across seeds at
+    ``samples`` and at half as many (the size of a half), relMSE-weighted against a 512-sample
+    render, and the estimate's noise part beside the first."""
+    import numpy as np
+
+    from drt_engine.core.film import denoiser
+    from drt_engine.core.render.adaptive import RELMSE_EPSILON
+    from drt_engine.core.render.render import Renderer
+    from drt_engine.core.settings import RenderSettings
+    from tests.support.oidn import require_oidn
+    from tests.support.scenes import defocused_checker_scene, soft_shadow_scene
+
+    oidn = denoiser.load(require_oidn())
+    rows = []
+    for name, make in (("defocused_checker", defocused_checker_scene), ("soft_shadow", soft_shadow_scene)):
+        scene, base = make(width)
+        ref = Renderer(scene, RenderSettings(**{**base, "samples": 512, "seed": 99})).render().passes["Combined"]
+        weight = 1.0 / (ref[..., :3].astype(float) ** 2 + RELMSE_EPSILON)
+        row = {"scene": name, "samples": samples, "seeds": len(seeds), "load": os.getloadavg()[0]}
+        for n, key in ((samples, "full"), (samples // 2, "half")):
+            results = [Renderer(scene, RenderSettings(**{**base, "samples": n, "seed": seed, "use_denoising": True}),
+                                denoiser=oidn).render() for seed in seeds]
+            images = np.array([r.passes["Combined"][..., :3].astype(float) for r in results])
+            row[f"variance_{key}"] = float((images.var(axis=0, ddof=1) * weight).mean())
+            if key == "full":
+                row["estimated_noise"] = float(np.mean([r.stats["relmse_denoised_noise"] for r in results]))
+        print(row, flush=True)
+        rows.append(row)
+    return {"rows": rows, "width": width}
+
+
+def noise_scaling_block(m: dict) -> str:
+    lines = ["| scene | variance at half the samples / at all (1 / samples: 2) | estimated noise part / variance |",
+             "|---|---|---|"]
+    lines += [f"| {r['scene']} | {r['variance_half'] / r['variance_full']:.2f} "
+              f"| {r['estimated_noise'] / r['variance_full']:.2f} |" for r in m["rows"]]
+    r = m["rows"][0]
+    lines += ["", f"Denoised renders of tests/support/scenes.py at {m['width']} px wide, {r['samples']} and "
+              f"{r['samples'] // 2} samples, {r['seeds']} seeds each; variance across the seeds, relMSE-weighted "
+              f"({_loads(m['rows'])}; `bench/denoise_figures.py --noise-scaling`, `bench/denoise_noise_scaling.json`)."]
+    return "\n".join(lines)
+
+
 def calibration_block(m: dict) -> str:
     """One line per scene and sample count, the figures averaged over the seeds (est. / true: its range)."""
     lines = ["| scene | spp | noisy relMSE (est. / true) | denoised relMSE | denoised / noisy | "
@@ -298,7 +344,13 @@ def main() -> None:
                         help="only draw bench/plots/denoise_cornell_box.png (noisy, denoised, estimated and true error)")
     parser.add_argument("--publish-only", action="store_true",
                         help="rewrite the calibration block from bench/denoise_calibration.json without rendering")
+    parser.add_argument("--noise-scaling", action="store_true",
+                        help="measure how the noise OIDN leaves falls with the samples")
     args = parser.parse_args()
+    if args.noise_scaling:
+        NOISE_SCALING.write_text(json.dumps(noise_scaling(), indent=1) + "\n")
+        write_block("denoise-noise-scaling", noise_scaling_block(json.loads(NOISE_SCALING.read_text())))
+        return
     if args.maps:
         maps()
         return
