@@ -25,6 +25,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "denoise": DOCS / "denoising.md",
     "denoise-calibration": DOCS / "denoising.md",
     "denoise-feature-noise": DOCS / "denoising.md",
+    "denoise-noise-scaling": DOCS / "denoising.md",
 }
 RESULTS_THROUGHPUT = ("<!-- throughput: begin -->", "<!-- throughput: end -->")
 """bench/throughput.py's section of bench/RESULTS.md, which bench/run.py keeps when it rewrites the file."""

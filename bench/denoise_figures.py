@@ -8,8 +8,9 @@ measured (out/ui/denoise.json):
 ``bench:denoise-calibration`` (``--calibration``, ``make bench-denoise``): DRT's built-in denoising
 (``use_denoising``, core.render.denoise) on sample scenes at a few sample counts and seeds. For each
 render: the true relMSE of the noisy and of the denoised image against a high-sample reference (less
-the reference's own estimated variance), and DRT's estimates of both. The denoised estimate sees
-only the noise the denoiser leaves, never blurred detail: est. / true below 1 is that unseen part.
+the reference's own estimated variance), and DRT's estimates of both; beside them, from the same
+film, the estimate as it was before each half was denoised with its own half's features (the three
+denoisings guided by the features of all the samples) and the time that took.
 References are cached in bench/results/ (denoise_reference_<scene>_<w>x<h>_<spp>.npz); the
 measurements go to bench/denoise_calibration.json (committed) and the block.
 """
@@ -29,7 +30,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 MEASURED = ROOT / "out" / "ui" / "denoise.json"
 MAPS = ROOT / "bench" / "plots" / "denoise_cornell_box.png"
 CALIBRATION = ROOT / "bench" / "denoise_calibration.json"
-FEATURE_NOISE = ROOT / "bench" / "denoise_feature_noise.json"
+NOISE_SCALING = ROOT / "bench" / "denoise_noise_scaling.json"
 RESULTS = ROOT / "bench" / "results"
 
 SCENES = ("cornell_box", "dof_row", "glossy_spheres", "motion_blur")
@@ -92,16 +93,19 @@ def measure() -> dict:
         for spp in SAMPLES:
             for seed in SEEDS:
                 start = time.perf_counter()
-                result = Renderer(data, settings_for(samples=spp, seed=seed, use_denoising=True),
-                                  denoiser=oidn).render()
+                renderer = Renderer(data, settings_for(samples=spp, seed=seed, use_denoising=True), denoiser=oidn)
+                result = renderer.render()
                 seconds = time.perf_counter() - start
                 noisy, denoised = result.passes[NOISY_IMAGE][..., :3], result.passes["Combined"][..., :3]
+                shared, shared_seconds = shared_features(renderer.film, oidn)
                 row = {"scene": name, "samples": spp, "seed": seed, "load": os.getloadavg()[0],
                        "true_noisy": true_error(noisy, ref, ref_var)[1], "est_noisy": result.stats["relmse"],
                        "true_denoised": true_error(denoised, ref, ref_var)[1],
                        "est_denoised": result.stats["relmse_denoised"],
                        "est_denoised_noise": result.stats["relmse_denoised_noise"],
-                       "render_seconds": seconds, "denoise_seconds": result.stats["denoising"]["seconds"]}
+                       "est_shared": shared["relmse"], "est_shared_noise": shared["relmse_noise"],
+                       "render_seconds": seconds, "denoise_seconds": result.stats["denoising"]["seconds"],
+                       "shared_seconds": shared_seconds}
                 print(row, flush=True)
                 rows.append(row)
         for use_denoising in (False, True):
@@ -156,11 +160,10 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     renderer = Renderer(data, settings_for(samples=samples, seed=seed, use_denoising=True), denoiser=oidn)
     result = renderer.render()
     film, (h, w) = renderer.film, ref.shape[:2]
-    features = film.images(PASSES)
-    albedo, normal = oidn.clean_features(features[ALBEDO], features[NORMAL])
     full, half_a, half_b = noisy_images(film)
     denoised = result.passes["Combined"][..., :3]
-    da, db = (oidn.denoise(x.reshape(h, w, 3), albedo, normal, prefilter="NONE") for x in (half_a, half_b))
+    da, db = (oidn.denoise(x.reshape(h, w, 3), guide[ALBEDO], guide[NORMAL])
+              for x, guide in zip((half_a, half_b), film.half_images(PASSES)))
     _, error, weight = error_terms(denoised, da, db, half_a, half_b, film.count, film.count_a)
     estimated = (error * weight).mean(axis=1)
     true = (((denoised - ref) ** 2 - ref_var) / (ref ** 2 + RELMSE_EPSILON)).reshape(-1, 3).mean(axis=1)
@@ -187,57 +190,88 @@ def maps(name="cornell_box", samples=16, seed=1, path=MAPS) -> None:
     print(f"wrote {path.relative_to(ROOT)}: estimated relMSE {estimated.mean():.3g}, true {true.mean():.3g}")
 
 
-def feature_noise(samples=16) -> dict:
-    """What the denoised estimate misses because the three denoisings share the albedo and normal,
-    traced over all the samples (their noise is correlated with both halves'): per scene, the estimate
-    / true error as DRT computes it, and as it comes out when each half is a render of its own (other
-    seeds, half the samples) denoised with its own features, the whole image with their mean."""
-    import bpy
-    import numpy as np
+def shared_features(film, oidn) -> tuple[dict, float]:
+    """The denoising and estimate as DRT made them before each half had its own features: the
+    albedo and normal of all the samples prefiltered once (Accurate) and guiding the whole image and
+    both halves, five OIDN runs: (the estimate as ``denoised_error`` gives it, wall-clock seconds).
+    The whole image's denoising is the same either way; only the halves' differ."""
+    from drt_engine.core.film.denoising import ALBEDO, NORMAL, PASSES
+    from drt_engine.core.render.denoise import denoised_error, noisy_images
 
-    import drt_engine
-    import scenes as bench_scenes
-    from drt_engine.blender.oidn import oidn_library
-    from drt_engine.core.film import denoiser
-    from drt_engine.core.film.denoising import ALBEDO, NORMAL
-    from drt_engine.core.render.adaptive import true_error
-    from drt_engine.core.render.denoise import denoised_error
-    from drt_engine.core.render.render import Renderer
-
-    if not hasattr(bpy.types.Scene, "drt"):
-        drt_engine.register()
-    oidn = denoiser.load(oidn_library())
-    rows = []
-    for name in SCENES:
-        scene, data = bench_scenes.load(name, WIDTH)
-
-        def settings_for(**kw):
-            return bench_scenes.settings(scene, threads=0, use_adaptive_sampling=False, **kw)
-
-        ref, ref_var = reference(name, data, settings_for)
-        shared = Renderer(data, settings_for(samples=samples, seed=1, use_denoising=True), denoiser=oidn).render()
-        halves = [Renderer(data, settings_for(samples=samples // 2, seed=seed, passes=("Combined", ALBEDO, NORMAL)))
-                  .render().passes for seed in (11, 12)]
-        noisy = [half["Combined"][..., :3].astype(np.float64) for half in halves]
-        whole = oidn.denoise(sum(noisy) / 2, *(sum(half[k] for half in halves) / 2 for k in (ALBEDO, NORMAL)))
-        own = [oidn.denoise(image, half[ALBEDO], half[NORMAL]) for image, half in zip(noisy, halves)]
-        n = np.full(noisy[0].shape[0] * noisy[0].shape[1], float(samples))
-        estimate = denoised_error(whole, *own, *noisy, n, n / 2)
-        row = {"scene": name, "samples": samples,
-               "shared": shared.stats["relmse_denoised"] / true_error(shared.passes["Combined"][..., :3], ref, ref_var)[1],
-               "own": estimate["relmse"] / true_error(whole, ref, ref_var)[1]}
-        print(row, flush=True)
-        rows.append(row)
-    return {"rows": rows, "reference_samples": REFERENCE_SAMPLES, "width": WIDTH}
+    start = time.perf_counter()
+    shape = (film.height, film.width, 3)
+    with oidn.filters() as filters:
+        features = film.images(PASSES)
+        albedo, normal = filters.clean_features(features[ALBEDO], features[NORMAL])
+        noisy = [image.reshape(shape) for image in noisy_images(film)]
+        full, half_a, half_b = (filters.denoise(image, albedo, normal, prefilter="NONE") for image in noisy)
+    estimate = denoised_error(full, half_a, half_b, noisy[1], noisy[2], film.count, film.count_a)
+    return estimate, time.perf_counter() - start
 
 
 def feature_noise_block(m: dict) -> str:
-    lines = ["| scene | denoised est. / true, features shared (DRT) | halves with features of their own |",
+    """Per scene and sample count, the estimate / true with the halves' own features (DRT) and with
+    the features of all the samples shared by the three denoisings (before), from the same renders."""
+    lines = ["| scene | spp | est. / true, each half its own features (DRT) | features shared (before) "
+             "| its noise part, own / shared | denoising time, own / shared |", "|---|---|---|---|---|---|"]
+    groups: dict = {}
+    for row in m["rows"]:
+        groups.setdefault((row["scene"], row["samples"]), []).append(row)
+    for (scene, spp), rows in groups.items():
+        own = ", ".join(f"{r['est_denoised'] / r['true_denoised']:.2f}" for r in rows)
+        shared = ", ".join(f"{r['est_shared'] / r['true_denoised']:.2f}" for r in rows)
+        noise = ", ".join(f"{r['est_denoised_noise'] / r['true_denoised']:.2f} / "
+                          f"{r['est_shared_noise'] / r['true_denoised']:.2f}" for r in rows)
+        own_s = sum(r["denoise_seconds"] for r in rows) / len(rows)
+        shared_s = sum(r["shared_seconds"] for r in rows) / len(rows)
+        lines.append(f"| {scene} | {spp} | {own} | {shared} | {noise} | {own_s:.2f} s / {shared_s:.2f} s |")
+    lines += ["", f"The same renders as above (seeds {', '.join(map(str, m['seeds']))}), each denoised both ways; "
+              f"denoising time is wall clock of nine OIDN runs (own) and five (shared), {_loads(m['rows'])}."]
+    return "\n".join(lines)
+
+
+def noise_scaling(samples=16, seeds=range(1, 7), width=64) -> dict:
+    """Whether the noise OIDN leaves falls as 1 / samples, as the halves' difference assumes
+    (core.render.denoise): per test scene, the variance of the denoised image across seeds at
+    ``samples`` and at half as many (the size of a half), relMSE-weighted against a 512-sample
+    render, and the estimate's noise part beside the first."""
+    import numpy as np
+
+    from drt_engine.core.film import denoiser
+    from drt_engine.core.render.adaptive import RELMSE_EPSILON
+    from drt_engine.core.render.render import Renderer
+    from drt_engine.core.settings import RenderSettings
+    from tests.support.oidn import require_oidn
+    from tests.support.scenes import defocused_checker_scene, soft_shadow_scene
+
+    oidn = denoiser.load(require_oidn())
+    rows = []
+    for name, make in (("defocused_checker", defocused_checker_scene), ("soft_shadow", soft_shadow_scene)):
+        scene, base = make(width)
+        ref = Renderer(scene, RenderSettings(**{**base, "samples": 512, "seed": 99})).render().passes["Combined"]
+        weight = 1.0 / (ref[..., :3].astype(float) ** 2 + RELMSE_EPSILON)
+        row = {"scene": name, "samples": samples, "seeds": len(seeds), "load": os.getloadavg()[0]}
+        for n, key in ((samples, "full"), (samples // 2, "half")):
+            results = [Renderer(scene, RenderSettings(**{**base, "samples": n, "seed": seed, "use_denoising": True}),
+                                denoiser=oidn).render() for seed in seeds]
+            images = np.array([r.passes["Combined"][..., :3].astype(float) for r in results])
+            row[f"variance_{key}"] = float((images.var(axis=0, ddof=1) * weight).mean())
+            if key == "full":
+                row["estimated_noise"] = float(np.mean([r.stats["relmse_denoised_noise"] for r in results]))
+        print(row, flush=True)
+        rows.append(row)
+    return {"rows": rows, "width": width}
+
+
+def noise_scaling_block(m: dict) -> str:
+    lines = ["| scene | variance at half the samples / at all (1 / samples: 2) | estimated noise part / variance |",
              "|---|---|---|"]
-    lines += [f"| {r['scene']} | {r['shared']:.2f} | {r['own']:.2f} |" for r in m["rows"]]
-    lines += ["", f"{m['rows'][0]['samples']} samples, {m['width']} px wide, seed 1 (halves: two renders of half "
-              f"the samples, seeds 11 and 12), against {m['reference_samples']}-sample references "
-              f"(`bench/denoise_figures.py --feature-noise`, `bench/denoise_feature_noise.json`)."]
+    lines += [f"| {r['scene']} | {r['variance_half'] / r['variance_full']:.2f} "
+              f"| {r['estimated_noise'] / r['variance_full']:.2f} |" for r in m["rows"]]
+    r = m["rows"][0]
+    lines += ["", f"Denoised renders of tests/support/scenes.py at {m['width']} px wide, {r['samples']} and "
+              f"{r['samples'] // 2} samples, {r['seeds']} seeds each; variance across the seeds, relMSE-weighted "
+              f"({_loads(m['rows'])}; `bench/denoise_figures.py --noise-scaling`, `bench/denoise_noise_scaling.json`)."]
     return "\n".join(lines)
 
 
@@ -265,16 +299,14 @@ def calibration_block(m: dict) -> str:
               f"against {m['reference_samples']}-sample references; prefilter {m['prefilter'].title()}, quality "
               f"{m['quality'].title()}, Blender {m['blender']}'s OpenImageDenoise on the CPU. The denoised estimate "
               f"read {min(ratios):.2f} to {max(ratios):.2f} of the true error (1 is exact); its noise part alone, "
-              f"the halves' denoised difference, {min(noise_ratios):.2f} to {max(noise_ratios):.2f} (what it "
-              f"misses is mostly the noise of the albedo and normal, which the three denoisings share and which is "
-              f"correlated with both halves: see the next table). Denoising time "
-              f"is the finished image's five OIDN runs (albedo and normal prefiltered once, then the whole image "
-              f"and both halves), wall clock on a machine shared with other work ({_loads(m['rows'])}). "
+              f"the halves' denoised difference, {min(noise_ratios):.2f} to {max(noise_ratios):.2f}. Denoising time "
+              f"is the finished image's nine OIDN runs (the whole image and each half, each after its own albedo "
+              f"and normal are prefiltered), wall clock on a machine shared with other work ({_loads(m['rows'])}). "
               f"Measurements: `bench/denoise_calibration.json`."]
     if m.get("target_rows"):
         lines += ["", f"Time to a relMSE of {m['target']:g} with Target Error {m['target']:g} (seed 1, no adaptive "
                   f"sampling; with Denoise on the target applies to the denoised image, and a step is denoised, "
-                  f"five OIDN runs, only when its noisy estimate times the last denoised / noisy ratio is under "
+                  f"nine OIDN runs, only when its noisy estimate times the last denoised / noisy ratio is under "
                   f"the target: `denoise.Schedule`):", "",
                   "| scene | samples off / on | time off | time on (of it denoising, steps denoised) | off / on "
                   "| estimated relMSE on | true relMSE on | load |", "|---|---|---|---|---|---|---|---|"]
@@ -312,12 +344,12 @@ def main() -> None:
                         help="only draw bench/plots/denoise_cornell_box.png (noisy, denoised, estimated and true error)")
     parser.add_argument("--publish-only", action="store_true",
                         help="rewrite the calibration block from bench/denoise_calibration.json without rendering")
-    parser.add_argument("--feature-noise", action="store_true",
-                        help="measure what the estimate misses through the features the halves share")
+    parser.add_argument("--noise-scaling", action="store_true",
+                        help="measure how the noise OIDN leaves falls with the samples")
     args = parser.parse_args()
-    if args.feature_noise:
-        FEATURE_NOISE.write_text(json.dumps(feature_noise(), indent=1) + "\n")
-        write_block("denoise-feature-noise", feature_noise_block(json.loads(FEATURE_NOISE.read_text())))
+    if args.noise_scaling:
+        NOISE_SCALING.write_text(json.dumps(noise_scaling(), indent=1) + "\n")
+        write_block("denoise-noise-scaling", noise_scaling_block(json.loads(NOISE_SCALING.read_text())))
         return
     if args.maps:
         maps()
@@ -326,7 +358,9 @@ def main() -> None:
         if not args.publish_only:
             CALIBRATION.write_text(json.dumps(measure(), indent=1) + "\n")
             maps()
-        write_block("denoise-calibration", calibration_block(json.loads(CALIBRATION.read_text())))
+        measured = json.loads(CALIBRATION.read_text())
+        write_block("denoise-calibration", calibration_block(measured))
+        write_block("denoise-feature-noise", feature_noise_block(measured))
         return
     write_block("denoise", block(json.loads(MEASURED.read_text())))
 

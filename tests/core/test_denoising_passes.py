@@ -92,3 +92,28 @@ def test_no_work_when_the_passes_are_off(monkeypatch, name):
     scene = floor_scene(Material("paint", [Closure("DIFFUSE", color=COLOUR)]))
     assert name not in render(scene, passes=("Combined", "Depth")).passes and calls == []
     assert name in render(scene, passes=("Combined", name)).passes and sum(calls) == 8 * 8 * 4
+
+
+def test_the_film_sums_the_halved_features_per_replicate_half():
+    """A denoiser guides each half with its own half's features (core.render.denoise): the film's
+    class A sums of a halved pass give each replicate's mean; passes not halved cost nothing."""
+    from drt_engine.core.film.film import Film
+
+    rng = np.random.default_rng(3)
+    film = Film(4, 2, ("Combined", "Denoising Albedo", "Denoising Normal"), halved=("Denoising Albedo",))
+    assert set(film.sums_a) == {"Denoising Albedo"}
+    waves = []
+    for replicate in (0, 1, 1, 0):
+        pixel = rng.integers(0, 8, 64)
+        pixel[:8] = np.arange(8)  # every pixel has samples in both halves
+        values = {"Combined": rng.random((64, 4)), "Denoising Albedo": rng.random((64, 3)),
+                  "Denoising Normal": rng.random((64, 3))}
+        film.add(pixel, values, np.arange(64), replicate=replicate)
+        waves.append((replicate, pixel, values["Denoising Albedo"]))
+    half_a, half_b = film.half_images(["Denoising Albedo"])
+    for replicate, half in ((1, half_a), (0, half_b)):
+        pixel = np.concatenate([p for r, p, _ in waves if r == replicate])
+        albedo = np.concatenate([v for r, _, v in waves if r == replicate])
+        mean = np.stack([albedo[pixel == i].mean(axis=0) for i in range(8)]).reshape(2, 4, 3)
+        np.testing.assert_allclose(half["Denoising Albedo"], mean, rtol=1e-6)
+    assert Film(4, 2, DENOISING).sums_a == {}

@@ -85,3 +85,28 @@ def soft_shadow_scene(width=160):
     scene = SceneData(camera, meshes, [Instance(i, np.eye(4)) for i in range(len(meshes))], mats, [light])
     scene.world.radiance = np.full(3, 0.02)
     return scene, dict(max_depth=8, filter_type="BLACKMAN_HARRIS", filter_size=1.5, threads=0)
+
+
+def defocused_checker_scene(width=64):
+    """A checkerboard floor of light and dark diffuse tiles under a white world, seen far out of focus
+    (thin lens: the plane in focus 2 m away, the floor about 5 m) at ``width`` x 3/4 width pixels, and
+    the settings it renders with. Every pixel averages tiles of both shades through the lens, so its
+    Denoising Albedo is as noisy as its colour and correlated with it: the depth-of-field case (the
+    sample scene dof_row) where an estimate of the denoised error from halves that share their
+    features reads far too low (core.render.denoise)."""
+    tile, size = 0.25, 8.0
+    k = int(round(size / tile))
+    corners = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float) * tile
+    origins = [np.array([-size / 2 + i * tile, -size / 2 + j * tile, 0.0]) for i in range(k) for j in range(k)]
+    vertices = np.concatenate([corners + o for o in origins])
+    tris = [t for q in range(k * k) for t in ([4 * q, 4 * q + 1, 4 * q + 2], [4 * q, 4 * q + 2, 4 * q + 3])]
+    shades = [(i + j) % 2 for i in range(k) for j in range(k) for _ in range(2)]
+    mats = [Material("light", [Closure("DIFFUSE", color=(0.8, 0.8, 0.8))]),
+            Material("dark", [Closure("DIFFUSE", color=(0.2, 0.2, 0.2))])]
+    height, half = width * 3 // 4, 0.45
+    camera = Camera(look_at((0.0, -4.0, 3.0), (0.0, 0.0, 0.0))[None], (-half, half, -half * height / width,
+                                                                       half * height / width), (width, height),
+                    aperture_radius=0.15, focus_distance=2.0)
+    scene = SceneData(camera, [Mesh("checker", vertices, tris, shades)], [Instance(0, np.eye(4))], mats, [])
+    scene.world.radiance = np.full(3, 1.0)
+    return scene, dict(max_depth=4, filter_type="BLACKMAN_HARRIS", filter_size=1.5, threads=0)

@@ -116,11 +116,6 @@ class Denoiser:
         with self.filters() as filters:
             return filters.denoise(color, albedo, normal, prefilter, quality)
 
-    def clean_features(self, albedo, normal, quality: str = "HIGH"):
-        """``Filters.clean_features`` with filters released after it."""
-        with self.filters() as filters:
-            return filters.clean_features(albedo, normal, quality)
-
     def filter_quality(self, quality: str) -> int:
         """The quality an RT filter reads back after it was set to ``quality`` (checks the enum)."""
         with self._lock:
@@ -174,9 +169,8 @@ class Filters:
         return self._run(images, {"hdr": True, "cleanAux": prefilter != "FAST"}, quality)
 
     def clean_features(self, albedo, normal, quality: str = "HIGH"):
-        """(albedo, normal) denoised each by a filter of its own: the ACCURATE prefilter, which
-        ``denoise`` with prefilter NONE then takes as clean (several images guided by the same
-        features need it once)."""
+        """(albedo, normal) denoised each by a filter of its own: the ACCURATE prefilter, after which
+        ``denoise`` takes them as clean."""
         if quality not in QUALITIES:
             raise DenoiserError(f"unknown denoising quality {quality!r} (one of {', '.join(QUALITIES)})")
         if albedo is None:

@@ -150,6 +150,15 @@ def _splat_ratio(pixel, sample, ndu, replicate, total):
 
 
 @kernel
+def _splat_class_a(pixel, sample, values, replicate, total):
+    """Add the values of class A's samples (chosen as ``_splat_counts`` chooses) to their pixels' sums."""
+    for i in range(len(pixel)):
+        if sample_is_class_a(int(sample[i])) if replicate < 0 else replicate == 1:
+            for c in range(values.shape[1]):
+                total[pixel[i], c] += values[i, c]
+
+
+@kernel
 def _extend_range(pixel, combined, lo, hi):
     for i in range(len(pixel)):
         for c in range(3):
@@ -163,11 +172,12 @@ class Film:
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
     (core.integrator.ratio), and Combined is read resolved: its diffuse direct part of the lights
-    with a closed form is U N / D.
+    with a closed form is U N / D. The passes ``halved`` are also summed over class A (``sums_a``):
+    a denoiser guided by them denoises each half with its own half's features (core.render.denoise).
     """
 
     def __init__(self, width: int, height: int, passes: tuple[str, ...], track_range: bool = False,
-                 ratio: bool = False):
+                 ratio: bool = False, halved: tuple[str, ...] = ()):
         self.width, self.height = width, height
         self.n = width * height
         self.passes = passes
@@ -178,6 +188,7 @@ class Film:
             self.sums[RATIO] = np.zeros((self.n, FILM_CHANNELS))
         self.count_a = np.zeros(self.n)
         self.sum_a = np.zeros((self.n, 3))
+        self.sums_a = {name: np.zeros_like(self.sums[name]) for name in halved}
         self.lo = np.full((self.n, 3), np.inf) if track_range else None
         self.hi = np.full((self.n, 3), -np.inf) if track_range else None
 
@@ -194,6 +205,8 @@ class Film:
                 _splat_ratio(pixel, sample, values[name], replicate, total)
             else:
                 _splat(pixel, values[name], total)
+        for name, total in self.sums_a.items():
+            _splat_class_a(pixel, sample, values[name], replicate, total)
         combined = values["Combined"]
         _splat_counts(pixel, sample, combined, replicate, self.count, self.count_a, self.sum_a)
         if self.lo is not None:
@@ -216,6 +229,21 @@ class Film:
         ndu_all = ndu[:, :NDU_CHANNELS]
         return (n, na, resolve(total, ndu_all), resolve(total_a, ndu_a),
                 resolve(total - total_a, ndu_all - ndu_a))
+
+    def half_images(self, names) -> tuple[dict, dict]:
+        """The ``halved`` passes ``names`` as ``images`` gives them, over class A and over class B:
+        ({name: (height, width, channels) float32}, the same of B)."""
+        out = ({}, {})
+        for name in names:
+            images = [np.empty((self.n, self.sums[name].shape[1]), np.float32) for _ in range(2)]
+            for span in self.blocks():
+                na = self.count_a[span]
+                total, total_a = self.sums[name][span], self.sums_a[name][span]
+                images[0][span] = total_a / np.maximum(na, 1)[:, None]
+                images[1][span] = (total - total_a) / np.maximum(self.count[span] - na, 1)[:, None]
+            for half, image in zip(out, images):
+                half[name] = image.reshape(self.height, self.width, -1)
+        return out
 
     def rgb(self, span: slice = slice(None)) -> np.ndarray:
         """The Combined RGB mean of the pixels ``span`` (resolved)."""

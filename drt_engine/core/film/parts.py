@@ -3,7 +3,8 @@
 Every random number is a function of (pixel, sample id, dimension, seed), so a render of
 sample ids START..END-1 anywhere traces exactly the samples the whole render traces for
 those ids. A part therefore keeps the film's raw float64 sums (every pass, the sample
-counts, and class A's sums, which are the replicate half of the error estimate), never
+counts, and class A's sums, which are the replicate half of the error estimate, of Combined
+and of the passes the film halves: the denoiser's features when denoising is on), never
 the means: adding the sums of disjoint ranges that cover all ids gives the whole render's
 film, up to the order of the float64 additions (see ``merge``).
 
@@ -26,7 +27,8 @@ from ..settings import RenderSettings
 from .film import Film
 from .ratio_sums import RATIO
 
-FORMAT = 1
+FORMAT = 2
+"""2: the halved passes' class A sums (``halved``, ``sums_a``) travel too."""
 HEADER = "drt:part"
 _NOT_COMPARED = ("threads", "sample_start", "sample_end", "extra")
 """Settings that may differ between parts: they do not change a sample's value."""
@@ -47,6 +49,7 @@ class Part:
     sum_a: np.ndarray  # (n, 3) Combined RGB summed over class A
     sums: dict  # pass name -> (n, channels) summed over every sample
     header: dict = field(default_factory=dict)
+    sums_a: dict = field(default_factory=dict)  # halved pass name -> (n, channels) summed over class A
 
     @property
     def sample_range(self) -> tuple[int, int]:
@@ -107,9 +110,10 @@ def from_film(film: Film, settings: RenderSettings, header: dict) -> Part:
     """The part a render of ``settings.sample_range()`` leaves in ``film`` (arrays copied)."""
     header = dict(header, format=FORMAT, seed=settings.seed, settings=compared_settings(settings),
                   threads=settings.threads, sample_range=list(settings.sample_range()), passes=list(film.passes),
-                  channels={name: total.shape[1] for name, total in film.sums.items()})
+                  channels={name: total.shape[1] for name, total in film.sums.items()}, halved=list(film.sums_a))
     return Part(film.width, film.height, film.count.copy(), film.count_a.copy(), film.sum_a.copy(),
-                {name: total.copy() for name, total in film.sums.items()}, header)
+                {name: total.copy() for name, total in film.sums.items()}, header,
+                {name: total.copy() for name, total in film.sums_a.items()})
 
 
 def _sum_names(passes, channels: dict) -> list[str]:
@@ -117,22 +121,25 @@ def _sum_names(passes, channels: dict) -> list[str]:
     return [name for name in passes if name in channels] + ([RATIO] if RATIO in channels else [])
 
 
-def _channel_names(passes, channels: dict) -> list[str]:
+def _channel_names(header: dict) -> list[str]:
     """One name per float64 column, in ``_arrays`` order: prefix.column."""
+    channels = header["channels"]
     names = ["count.0", "count_a.0", "sum_a.0", "sum_a.1", "sum_a.2"]
-    return names + [f"sum.{name}.{c}" for name in _sum_names(passes, channels) for c in range(channels[name])]
+    names += [f"sum.{name}.{c}" for name in _sum_names(header["passes"], channels) for c in range(channels[name])]
+    return names + [f"suma.{name}.{c}" for name in header["halved"] for c in range(channels[name])]
 
 
 def _arrays(part: Part) -> list[np.ndarray]:
     """The (n, k) float64 arrays, in ``_channel_names`` order."""
     sums = [part.sums[name] for name in _sum_names(part.header["passes"], part.sums)]
-    return [part.count[:, None], part.count_a[:, None], part.sum_a, *sums]
+    halves = [part.sums_a[name] for name in part.header["halved"]]
+    return [part.count[:, None], part.count_a[:, None], part.sum_a, *sums, *halves]
 
 
 def write(path, part: Part) -> None:
     import OpenImageIO as oiio
 
-    names = [f"{name}.{word}" for name in _channel_names(part.header["passes"], part.header["channels"])
+    names = [f"{name}.{word}" for name in _channel_names(part.header)
              for word in ("lo", "hi")]
     bits = np.concatenate([np.ascontiguousarray(a, np.float64).view(np.uint32) for a in _arrays(part)], axis=1)
     spec = oiio.ImageSpec(part.width, part.height, len(names), oiio.UINT32)
@@ -174,14 +181,16 @@ def read(path) -> Part:
     words = bits.reshape(n, spec.nchannels).astype(np.uint64)
     index = {name: i for i, name in enumerate(spec.channelnames)}  # EXR keeps channels sorted by name
     columns = {}
-    for name in _channel_names(header["passes"], header["channels"]):
+    for name in _channel_names(header):
         if f"{name}.lo" not in index or f"{name}.hi" not in index:
             raise PartError(f"{path} is a damaged DRT part: channel {name} is missing")
         lo, hi = words[:, index[f"{name}.lo"]], words[:, index[f"{name}.hi"]]
         columns.setdefault(name.rsplit(".", 1)[0], []).append(((hi << np.uint64(32)) | lo).view(np.float64))
     array = {prefix: np.stack(cols, axis=1) for prefix, cols in columns.items()}
     sums = {name: array[f"sum.{name}"] for name in _sum_names(header["passes"], header["channels"])}
-    return Part(spec.width, spec.height, array["count"][:, 0], array["count_a"][:, 0], array["sum_a"], sums, header)
+    sums_a = {name: array[f"suma.{name}"] for name in header["halved"]}
+    return Part(spec.width, spec.height, array["count"][:, 0], array["count_a"][:, 0], array["sum_a"], sums, header,
+                sums_a)
 
 
 def check(parts: list[Part], names: list[str] | None = None) -> list[Part]:
@@ -231,10 +240,12 @@ def _difference(a, b) -> str:
 
 
 def add(film: Film, part: Part) -> None:
-    """Add a part's sums into ``film`` (a film of the same size and passes)."""
+    """Add a part's sums into ``film`` (a film of the same size, passes and halved passes)."""
     film.count += part.count
     film.count_a += part.count_a
     film.sum_a += part.sum_a
     for name, total in film.sums.items():
         total += part.sums[name]
+    for name, total in film.sums_a.items():
+        total += part.sums_a[name]
 

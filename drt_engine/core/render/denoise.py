@@ -2,14 +2,18 @@
 
 The film keeps two independent replicate halves of every pixel's samples (core.film.film): noisy
 images N_A and N_B of n_A and n_B samples, N their mean over all n. Combined is denoised three
-times, all guided by the same Denoising Albedo and Normal (traced over all the samples): D from N,
-D_A from N_A, D_B from N_B. Two figures come from them, per pixel and channel:
+times: D from N, guided by the Denoising Albedo and Normal of all the samples, D_A from N_A and D_B
+from N_B, each guided by its own half's albedo and normal (the film sums the features per half when
+denoising is on). Features shared by the three would be correlated with both halves: where they are
+noisy themselves (defocus and motion blur average many surfaces per pixel) both halves' denoisings
+follow the same feature noise, it cancels in D_A - D_B, and on dof_row the estimate read 0.37 to
+0.74 of the true error (docs/denoising.md). Two figures come from them, per pixel and channel:
 
 - **the noise the denoiser leaves**, (D_A - D_B)^2 n_A n_B / n^2: the variance of D if that noise
   falls as 1 / samples, as a linear smoother's does (the same form as the noisy image's estimate,
   adaptive.image_error). It cannot see blur of real detail: a texture smoothed flat or a thin
   shadow softened the same way in both halves cancels in D_A - D_B. On the sample scenes it read
-  0.4 to 0.6 of the true error (docs/denoising.md);
+  0.4 to 0.8 of the true error (docs/denoising.md);
 - **the error of a half's denoised image, blur included**, by cross-validation against the other
   half's noisy image, which is unbiased and independent of it:
   E[(D_A - N_B)^2] = MSE(D_A) + Var(N_B), with Var(N_B) = (N_A - N_B)^2 n_A / n in expectation, so
@@ -21,7 +25,6 @@ less than the noise alone. What it still cannot see, or sees wrongly:
 
 - bias of the noisy image itself (clamping, the ratio estimator's): N_B is the reference it
   measures against;
-- noise of the albedo and normal: the three denoisings share them;
 - per pixel it is very noisy (a difference of squares of noisy images): only its image mean is
   reported.
 """
@@ -33,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..film.denoising import ALBEDO, NORMAL
+from ..film.denoising import ALBEDO, NORMAL, PASSES as FEATURES
 from ..film.film import Film
 from ..settings import NOISY_IMAGE
 from .adaptive import RELMSE_EPSILON, TRUE_FLOOR
@@ -53,7 +56,7 @@ met the target unless a scene denoises better still."""
 
 
 class Schedule:
-    """Which steps of a render under a target error are denoised (each costs five OIDN runs): those
+    """Which steps of a render under a target error are denoised (each costs nine OIDN runs): those
     whose noisy estimate times the denoised / noisy ratio of the last step denoised (DENOISED_SHARE
     before one) is under the target. That ratio grows with the samples (OIDN gains less as the noise
     falls: docs/denoising.md), so the prediction leans low and a step that could meet the target is
@@ -74,19 +77,16 @@ ERROR_BLOCK = 1 << 20
 """Pixels whose error terms are computed at a time: float64 temporaries of a whole 8K image are GBs."""
 
 
-def denoise_film(film: Film, passes: dict, denoiser, prefilter: str, quality: str) -> Denoised:
-    """The denoised Combined image of ``film`` and its estimated error; ``passes`` are the film's
-    images (Denoising Albedo and Normal among them), ``denoiser`` a core.film.denoiser.Denoiser or,
+def denoise_film(film: Film, denoiser, prefilter: str, quality: str) -> Denoised:
+    """The denoised Combined image of ``film`` (its Denoising Albedo and Normal passes summed per
+    half: Film's ``halved``) and its estimated error; ``denoiser`` a core.film.denoiser.Denoiser or,
     for repeated denoisings, its Filters."""
     start = time.perf_counter()
     shape = (film.height, film.width, 3)
-    albedo, normal = passes.get(ALBEDO), passes.get(NORMAL)
-    if prefilter == "ACCURATE":  # the three denoisings share the features: clean them once
-        albedo, normal = denoiser.clean_features(albedo, normal, quality)
-        prefilter = "NONE"
+    features = (film.images(FEATURES), *film.half_images(FEATURES))
     noisy = [image.reshape(shape) for image in noisy_images(film)]
-    full, half_a, half_b = (denoiser.denoise(image, albedo, normal, prefilter=prefilter, quality=quality)
-                            for image in noisy)
+    full, half_a, half_b = (denoiser.denoise(image, guide[ALBEDO], guide[NORMAL], prefilter, quality)
+                            for image, guide in zip(noisy, features))
     error = denoised_error(full, half_a, half_b, noisy[1], noisy[2], film.count, film.count_a)
     return Denoised(full, error, time.perf_counter() - start)
 

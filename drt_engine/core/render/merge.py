@@ -4,15 +4,14 @@ Parts are added in the order of their sample ranges, whatever order they arrive 
 same parts always give the same bits. A farm's parts arrive one by one: ``Merger`` adds
 each as soon as every range before it is in, and logs the estimated error of the samples
 merged so far, the way a single render logs its rounds. Parts rendered with denoising on carry
-the denoiser's features and the two replicate halves, and the merged image is denoised once,
-when it is written (``Merger.images``), never part by part.
+the denoiser's features (over all samples and over class A) and the two replicate halves, and the
+merged image is denoised once, when it is written (``Merger.images``), never part by part.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..film import parts as parts_mod
-from ..film.denoising import PASSES as FEATURE_PASSES
 from ..film.film import Film
 from ..settings import PASS_CHANNELS
 from .denoise import denoise_film, denoised_passes, figures
@@ -38,7 +37,7 @@ class Merger:
         if self.first is None:
             self.first = part
             self.film = Film(part.width, part.height, tuple(part.header["passes"]),
-                             ratio=parts_mod.RATIO in part.header["channels"])
+                             ratio=parts_mod.RATIO in part.header["channels"], halved=tuple(part.header["halved"]))
         else:
             parts_mod.check_same(self.first, part, "the first part", name)
         if part.sample_range not in self.ranges:
@@ -79,8 +78,8 @@ class Merger:
             return {name: image for name, image in passes.items() if name in settings.passes}
         if self.denoised is None:
             with denoiser.filters() as filters:
-                self.denoised = denoise_film(self.film, {k: passes[k] for k in FEATURE_PASSES if k in passes},
-                                             filters, settings.denoising_prefilter, settings.denoising_quality)
+                self.denoised = denoise_film(self.film, filters, settings.denoising_prefilter,
+                                             settings.denoising_quality)
             self.log.last.update(figures(self.denoised))
         return denoised_passes(passes, self.denoised, settings.passes)
 

@@ -82,7 +82,8 @@ class Renderer:
         self.integrator = Integrator(prepared, scene, settings, self.plan)
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
-        self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio))
+        self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
+                         halved=FEATURE_PASSES if settings.use_denoising else ())
 
     @property
     def rays(self) -> dict:
@@ -187,8 +188,7 @@ class Renderer:
         total: the step that ends a render and the result share one denoising."""
         s, samples = self.settings, float(self.film.count.sum())
         if self._denoised is None or self._denoised[0] != samples:
-            features = self.film.images(FEATURE_PASSES)
-            denoised = denoise_film(self.film, features, self._filters, s.denoising_prefilter, s.denoising_quality)
+            denoised = denoise_film(self.film, self._filters, s.denoising_prefilter, s.denoising_quality)
             self._denoised = samples, denoised
             self._denoise_seconds += denoised.seconds
         return self._denoised[1]
