@@ -113,8 +113,10 @@ class Environment:
                 first = direction, radius, rows, cols
         return first
 
-    def radiance(self, dirs: np.ndarray) -> np.ndarray:
-        ev = Evaluator(self.world.program, DirectionContext(dirs), self.textures)
+    def radiance(self, dirs: np.ndarray, path=None) -> np.ndarray:
+        """(N, 3) radiance toward ``dirs`` of rays ``path`` (core.shading.lightpath.RayPath; None:
+        light samples of a camera hit, as the table is made)."""
+        ev = Evaluator(self.world.program, DirectionContext(dirs, path), self.textures)
         return np.asarray(ev(self.world.color), float)
 
     def sample(self, u: np.ndarray):
