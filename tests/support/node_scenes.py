@@ -880,3 +880,80 @@ def displacement_scene(size=32):
     square("Straight", 0.0, -1.1, straight, normal_colour)
     square("Normal linked", 2.2, -1.1, tilted_normal)
     return scene
+
+
+def _diffuse_bsdf(tree, colour):
+    bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
+    if isinstance(colour, bpy.types.NodeSocket):
+        tree.links.new(colour, bsdf.inputs["Color"])
+    else:
+        bsdf.inputs["Color"].default_value = colour
+    return bsdf.outputs["BSDF"]
+
+
+def _mixed_by_camera(tree, other, camera):
+    """A Mix Shader of ``other`` and ``camera`` (two shader outputs) by Is Camera Ray."""
+    mix = _node(tree, "ShaderNodeMixShader")
+    tree.links.new(_node(tree, "ShaderNodeLightPath").outputs["Is Camera Ray"], mix.inputs["Fac"])
+    tree.links.new(other, mix.inputs[1])
+    tree.links.new(camera, mix.inputs[2])
+    return mix.outputs["Shader"]
+
+
+def _path_material(name, surface):
+    """A material whose Surface ``surface(tree)`` (a shader output) gives."""
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    tree.links.new(surface(tree), _node(tree, "ShaderNodeOutputMaterial").inputs["Surface"])
+    return mat
+
+
+def light_path_scene(size=48):
+    """Light Path on a sharp mirror floor under a sun: a sphere that is green to the camera and red
+    to everything else (a Mix Shader by Is Camera Ray), one whose diffuse colour is made of Ray
+    Length (red), Glossy Depth (green) and Ray Depth (blue), each seen straight and in the mirror,
+    and a world that is sky blue to the camera and grey to the mirror and to light."""
+    scene = ps._scene(2 * size, size)
+    camera = scene.camera
+    camera.location = (0.0, -7.5, 1.6)  # the horizon across the image's upper part
+    camera.rotation_euler = mathutils.Vector((0.0, 7.5, -1.5)).to_track_quat("-Z", "Y").to_euler()
+    camera.data.lens = 35.0
+    world = new_world("World")
+    tree = world.node_tree
+    background = tree.nodes["Background"]
+    sky = _node(tree, "ShaderNodeBackground")
+    sky.inputs["Color"].default_value = (0.2, 0.45, 0.9, 1.0)
+    background.inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld")
+    tree.links.new(_mixed_by_camera(tree, background.outputs[0], sky.outputs[0]), output.inputs["Surface"])
+    scene.world = world
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    sun.rotation_euler = (0.5, -0.4, 0.0)
+    scene.collection.objects.link(sun)
+
+    def mirror(tree):
+        glossy = _node(tree, "ShaderNodeBsdfGlossy")
+        glossy.inputs["Roughness"].default_value = 0.0
+        glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+        return glossy.outputs["BSDF"]
+
+    def by_camera(tree):
+        return _mixed_by_camera(tree, _diffuse_bsdf(tree, (0.8, 0.1, 0.1, 1.0)), _diffuse_bsdf(tree, (0.1, 0.8, 0.1, 1.0)))
+
+    def depths(tree):
+        path = _node(tree, "ShaderNodeLightPath")
+        join = _node(tree, "ShaderNodeCombineXYZ")
+        tree.links.new(_scaled(tree, path.outputs["Ray Length"], 0.1, 0.0), join.inputs[0])
+        tree.links.new(_scaled(tree, path.outputs["Glossy Depth"], 0.8, 0.1), join.inputs[1])
+        tree.links.new(_scaled(tree, path.outputs["Ray Depth"], 0.8, 0.1), join.inputs[2])
+        return _diffuse_bsdf(tree, join.outputs[0])
+
+    bpy.ops.mesh.primitive_plane_add(size=30.0)
+    bpy.context.active_object.data.materials.append(_path_material("Mirror", mirror))
+    for x, name, surface in ((-1.1, "By camera", by_camera), (1.1, "Depths", depths)):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.9, location=(x, 0.0, 1.0), segments=48, ring_count=24)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(_path_material(name, surface))
+    return scene
