@@ -940,7 +940,8 @@ def light_path_scene(size=48):
         return glossy.outputs["BSDF"]
 
     def by_camera(tree):
-        return _mixed_by_camera(tree, _diffuse_bsdf(tree, (0.8, 0.1, 0.1, 1.0)), _diffuse_bsdf(tree, (0.1, 0.8, 0.1, 1.0)))
+        red, green = _diffuse_bsdf(tree, (0.8, 0.1, 0.1, 1.0)), _diffuse_bsdf(tree, (0.1, 0.8, 0.1, 1.0))
+        return _mixed_by_camera(tree, red, green)
 
     def depths(tree):
         path = _node(tree, "ShaderNodeLightPath")

@@ -263,8 +263,8 @@ class Integrator:
             return
         prim = surf.prim[glowing]
         hit = surf.row[glowing]
-        path = None if surf.bounces is None else RayPath(surf.straight[glowing], surf.bounces[glowing], hits.t[hit])
-        emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing], path)
+        emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
+                                             self._ray_path(surf, hits, glowing))
         e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
                          lambda smooth: self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]],
                                                                  hits.t[hit[smooth]]))
@@ -344,11 +344,11 @@ class Integrator:
                 yield group.take(sub), u_g.take(sub), shader
 
     @staticmethod
-    def _ray_path(group: SurfaceHits, hits) -> RayPath | None:
-        """The rays that reached these hits, for Light Path (None when no program reads it)."""
+    def _ray_path(group: SurfaceHits, hits, rows=slice(None)) -> RayPath | None:
+        """The rays that reached hits ``rows`` of ``group``, for Light Path (None when no program reads it)."""
         if group.bounces is None:
             return None
-        return RayPath(group.straight, group.bounces, hits.t[group.row])
+        return RayPath(group.straight[rows], group.bounces[rows], hits.t[group.row[rows]])
 
     # -- next-event estimation ----------------------------------------------------------
     def _sample_lights(self, lit) -> LightSamples:
