@@ -14,11 +14,15 @@ from tests.support.scenes import look_at, plane, translation
 HEIGHT = 5.0  # the camera's, looking straight down at the origin
 
 
-def _program(names):
-    """A program whose output 0 of its last node is the colour (Light Path's ``names``)."""
+def _program(names, scale=None):
+    """A program whose output 0 of its last node is the colour (Light Path's ``names``, the first
+    times ``scale`` when given)."""
     prog = Program()
     node = prog.add("light_path")
     refs = [(node, OUTPUTS.index(name)) for name in names]
+    if scale is not None:
+        factor = prog.add("const", value=np.asarray(scale, float)), 0
+        refs[0] = prog.add("math", [refs[0], factor, factor], operation="MULTIPLY"), 0
     return prog, (prog.add("combine", refs), 0)
 
 
@@ -98,22 +102,23 @@ def test_a_glass_slab_is_two_singular_transmissions():
     assert r > 0 and g == 0.0 and b == 0.0
 
 
-def _world(names) -> World:
-    prog, colour = _program(names)
+def _world(names, scale=None) -> World:
+    prog, colour = _program(names, scale)
     return World(program=prog, color=colour)
 
 
 def test_the_world_sees_the_camera_its_light_samples_do_not():
     """Is Camera Ray in the world: 1 for the camera, 0 for a mirror's rays and for the light samples
-    of a diffuse floor; Ray Depth one bounce further (Cycles' emission flag), 0 Ray Length."""
-    def alone(closure, matrix, names):
+    of a diffuse floor; Ray Depth one bounce further (Cycles' emission flag), Ray Length Cycles'
+    FLT_MAX (3.4028e38, measured)."""
+    def alone(closure, matrix, names, scale=None):
         return SceneData(camera=ortho_camera(translation(z=HEIGHT)), meshes=[plane(2.0)],
                          instances=[Instance(0, matrix)], materials=[Material("alone", [closure])],
-                         world=_world(names))
+                         world=_world(names, scale))
 
     diffuse = Closure("DIFFUSE", color=(0.5, 0.5, 0.5))
-    sky = alone(diffuse, translation(x=100.0), ("Is Camera Ray", "Ray Depth", "Ray Length"))
-    assert np.allclose(_pixel(sky), [1.0, 1.0, 0.0])
+    sky = alone(diffuse, translation(x=100.0), ("Ray Length", "Ray Depth", "Is Camera Ray"), scale=1e-38)
+    assert np.allclose(_pixel(sky), [3.4028235, 1.0, 1.0])
     mirror = Closure("GLOSSY", color=(1.0, 1.0, 1.0), roughness=0.0)
     tilted = alone(mirror, look_at((0, 0, 0), (0, 1, -1), up=(0, 1, 0)), ("Is Camera Ray", "Ray Depth",
                                                                           "Is Reflection Ray"))

@@ -29,7 +29,7 @@ from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
-from ..shading.lightpath import RayPath, camera_bounces, reads_light_path
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .continuation import continue_paths
 from .direct import direct_light
@@ -222,7 +222,8 @@ class Integrator:
             return
         lights = self.lights
         st = rays.straight
-        path = None if rays.bounces is None else RayPath(st, rays.bounces, np.zeros(len(rays)), emission=True)
+        path = None if rays.bounces is None else RayPath(st, rays.bounces, np.full(len(rays), BACKGROUND_LENGTH),
+                                                         emission=True)
         world = lights.world_radiance(rays.dirs, st, rays.prev_normal, path)
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]

@@ -27,7 +27,7 @@ from ..base.jit import kernel
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
-from ..shading.lightpath import RayPath, reads_light_path
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
@@ -233,7 +233,8 @@ class Lights:
             w = strategies - 1
             k = np.flatnonzero(lit[w])
             if len(k):  # the map's radiance from the environment's program
-                path = None if bounces is None else RayPath.light_samples(bounces[k], np.zeros(len(k)))
+                path = None if bounces is None else RayPath.light_samples(bounces[k],
+                                                                          np.full(len(k), BACKGROUND_LENGTH))
                 out.value[w, k] = self.environment.radiance(out.wi[w, k], path) / out.pdf[w, k, None]
             if self.world_lobes is not None:
                 out.restrict[w] = self.world_lobes

@@ -27,6 +27,7 @@ from ..base.jit import kernel
 from ..base.vectors import basis
 from ..scene import World
 from ..shading import sky
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces
 from ..shading.nodes import DirectionContext, Evaluator
 from ..shading.textures import Texture, equirect_direction, equirect_uv
 
@@ -116,6 +117,8 @@ class Environment:
     def radiance(self, dirs: np.ndarray, path=None) -> np.ndarray:
         """(N, 3) radiance toward ``dirs`` of rays ``path`` (core.shading.lightpath.RayPath; None:
         light samples of a camera hit, as the table is made)."""
+        if path is None:
+            path = RayPath.light_samples(camera_bounces(len(dirs)), np.full(len(dirs), BACKGROUND_LENGTH))
         ev = Evaluator(self.world.program, DirectionContext(dirs, path), self.textures)
         return np.asarray(ev(self.world.color), float)
 

@@ -16,9 +16,9 @@ Outputs that are 0 at every point DRT shades, as Cycles' would be for the same p
 
 Emission evaluated by light sampling and the world (seen by a ray or sampled) are evaluated as
 Cycles evaluates them, with its emission flag: one bounce further (Ray Depth + 1); a light
-sample has no ray kind, and the world's Ray Length is 0, as Cycles' background shader data.
-Without a ``RayPath`` (the environment's importance table, the emissive triangles' power
-estimate) a point is shaded as the light sample of a camera hit.
+sample has no ray kind, and the world's Ray Length is ``BACKGROUND_LENGTH``. Without a
+``RayPath`` (the environment's importance table, the emissive triangles' power estimate) a
+point is shaded as the light sample of a camera hit.
 """
 from __future__ import annotations
 
@@ -30,6 +30,9 @@ REFLECT, TRANSMIT, GLOSSY, SINGULAR = 1, 2, 4, 8
 """Bits of the ``KIND`` column: the lobe that spawned the ray (Cycles' PATH_RAY_* of the same names)."""
 KIND, DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH, TRANSPARENT_DEPTH = range(5)
 COLUMNS = 5
+BACKGROUND_LENGTH = float(np.finfo(np.float32).max)
+"""Ray Length at the world: Cycles' FLT_MAX (shader_setup_from_background; measured with Blender
+5.0's Cycles, for the camera's rays)."""
 
 OUTPUTS = ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ray", "Is Singular Ray",
            "Is Reflection Ray", "Is Transmission Ray", "Is Volume Scatter Ray", "Ray Length", "Ray Depth",
