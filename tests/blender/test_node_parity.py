@@ -1,7 +1,8 @@
 """Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
 and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
 Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
-Info, a Wireframe in pixels, the material's Displacement (as bump), Light Path on a mirror floor and a Sky
+Info, a Wireframe in pixels, the material's Displacement (as bump), Light Path (on a mirror floor, through
+glass and a transparent sheet) and a Sky
 Texture world lighting a sphere on the ground in scenes of their own.
 The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
@@ -182,6 +183,12 @@ def test_light_path_matches_cycles(drt, tmp_path):
     """Is Camera Ray driving a surface's and the world's Mix Shader, Ray Length, Glossy Depth and Ray
     Depth driving a diffuse colour, seen straight and in a sharp mirror."""
     _matches_cycles(ns.light_path_scene(), tmp_path, "light-path", "Light Path")
+
+
+def test_light_path_through_transparent_and_glass_matches_cycles(drt, tmp_path):
+    """Is Camera Ray through a transparent sheet, Transparent and Transmission Depth, Is Transmission
+    and Is Singular Ray through a sharp glass slab, on emissive spheres."""
+    _matches_cycles(ns.light_path_glass_scene(), tmp_path, "light-path-glass", "Light Path through glass")
 
 
 def test_wireframe_in_pixels_matches_cycles(drt, tmp_path):
