@@ -119,6 +119,8 @@ def test_the_world_sees_the_camera_its_light_samples_do_not():
     diffuse = Closure("DIFFUSE", color=(0.5, 0.5, 0.5))
     sky = alone(diffuse, translation(x=100.0), ("Ray Length", "Ray Depth", "Is Camera Ray"), scale=1e-38)
     assert np.allclose(_pixel(sky), [3.4028235, 1.0, 1.0])
+    only = alone(diffuse, translation(x=100.0), ("Is Camera Ray",) * 3)  # black to light samples (the table)
+    assert np.allclose(_pixel(only), 1.0)
     mirror = Closure("GLOSSY", color=(1.0, 1.0, 1.0), roughness=0.0)
     tilted = alone(mirror, look_at((0, 0, 0), (0, 1, -1), up=(0, 1, 0)), ("Is Camera Ray", "Ray Depth",
                                                                           "Is Reflection Ray"))
