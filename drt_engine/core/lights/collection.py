@@ -321,6 +321,8 @@ class Lights:
         return radiance, pdf
 
     def pdf_emissive(self, prim, dirs, t):
+        if not len(self.emissive):  # every textured emitter black to light samples (a Light Path's, say)
+            return np.zeros(len(prim))
         g = self.geometry
         return pdf_emissive_batch(g.world_ng, g.area, self.emissive_prob, prim, dirs, np.asarray(t, np.float64))
 
