@@ -1,9 +1,9 @@
 """Converter, colour and vector nodes, Fresnel and Layer Weight in DRT against Cycles: every node
 and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and Fresnel and Layer
 Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
-Info, a Wireframe in pixels, the material's Displacement (as bump), a Sky Texture world
-lighting a sphere on the ground, and closures (Oren-Nayar, Translucent) under suns in scenes of
-their own.
+Info, a Wireframe in pixels, the material's Displacement (as bump), Light Path (on a mirror floor,
+through glass and a transparent sheet), a Sky Texture world lighting a sphere on the ground, and
+closures (Oren-Nayar, Translucent) under suns in scenes of their own.
 The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
 1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still
@@ -54,17 +54,17 @@ def test_every_case_exports_without_a_warning(drt):
 
 
 def test_a_node_left_out_keeps_its_one_warning(drt):
-    """Light Path still has no handler: the socket it feeds keeps its value, with one warning naming it."""
+    """Ambient Occlusion still has no handler: the socket it feeds keeps its value, with one warning naming it."""
     scene = ns.grid_scene(ns.CASES[:1])
-    mat = new_material("Light Path")  # Light Path -> Fresnel's IOR -> Principled roughness
+    mat = new_material("Ambient Occlusion")  # Ambient Occlusion -> Fresnel's IOR -> Principled roughness
     tree = mat.node_tree
-    path = tree.nodes.new("ShaderNodeLightPath")
+    occlusion = tree.nodes.new("ShaderNodeAmbientOcclusion")
     fresnel = tree.nodes.new("ShaderNodeFresnel")
-    tree.links.new(path.outputs["Ray Length"], fresnel.inputs["IOR"])
+    tree.links.new(occlusion.outputs["AO"], fresnel.inputs["IOR"])
     tree.links.new(fresnel.outputs[0], tree.nodes["Principled BSDF"].inputs["Roughness"])
     scene.objects[ns.CASES[0].name].data.materials[0] = mat
     warnings = _cannot(render_export(scene))
-    assert len(warnings) == 1 and "Light Path" in warnings[0] and "Fresnel" not in warnings[0], warnings
+    assert len(warnings) == 1 and "Ambient Occlusion" in warnings[0] and "Fresnel" not in warnings[0], warnings
 
 
 @pytest.mark.parametrize("index", range(len(ns.CASES)), ids=[c.name for c in ns.CASES])
@@ -177,6 +177,18 @@ def test_object_info_matches_cycles(drt, tmp_path):
     """Random (the hash of plain, numbered and non-ASCII names; an instance's own), Object and
     Material Index, colour, alpha and location."""
     _matches_cycles(ns.object_info_scene(), tmp_path, "object-info", "Object Info")
+
+
+def test_light_path_matches_cycles(drt, tmp_path):
+    """Is Camera Ray driving a surface's and the world's Mix Shader, Ray Length, Glossy Depth and Ray
+    Depth driving a diffuse colour, seen straight and in a sharp mirror."""
+    _matches_cycles(ns.light_path_scene(), tmp_path, "light-path", "Light Path")
+
+
+def test_light_path_through_transparent_and_glass_matches_cycles(drt, tmp_path):
+    """Is Camera Ray through a transparent sheet, Transparent and Transmission Depth, Is Transmission
+    and Is Singular Ray through a sharp glass slab, on emissive spheres."""
+    _matches_cycles(ns.light_path_glass_scene(), tmp_path, "light-path-glass", "Light Path through glass")
 
 
 def test_wireframe_in_pixels_matches_cycles(drt, tmp_path):

@@ -882,7 +882,6 @@ def displacement_scene(size=32):
     return scene
 
 
-
 def _rough_diffuse(tree, roughness):
     return _link(tree, _node(tree, "ShaderNodeBsdfDiffuse"), Color=(0.8, 0.55, 0.3, 1.0), Roughness=roughness)
 
@@ -964,4 +963,133 @@ def closure_scene(cases, size=32):
         out = _node(tree, "ShaderNodeOutputMaterial")
         tree.links.new(case.build(tree).outputs[0], out.inputs["Surface"])
         bpy.context.active_object.data.materials.append(mat)
+    return scene
+
+
+def _diffuse_bsdf(tree, colour):
+    bsdf = _node(tree, "ShaderNodeBsdfDiffuse")
+    if isinstance(colour, bpy.types.NodeSocket):
+        tree.links.new(colour, bsdf.inputs["Color"])
+    else:
+        bsdf.inputs["Color"].default_value = colour
+    return bsdf.outputs["BSDF"]
+
+
+def _mixed_by_camera(tree, other, camera):
+    """A Mix Shader of ``other`` and ``camera`` (two shader outputs) by Is Camera Ray."""
+    mix = _node(tree, "ShaderNodeMixShader")
+    tree.links.new(_node(tree, "ShaderNodeLightPath").outputs["Is Camera Ray"], mix.inputs["Fac"])
+    tree.links.new(other, mix.inputs[1])
+    tree.links.new(camera, mix.inputs[2])
+    return mix.outputs["Shader"]
+
+
+def _path_material(name, surface):
+    """A material whose Surface ``surface(tree)`` (a shader output) gives."""
+    mat = new_material(name)
+    tree = mat.node_tree
+    tree.nodes.clear()
+    tree.links.new(surface(tree), _node(tree, "ShaderNodeOutputMaterial").inputs["Surface"])
+    return mat
+
+
+def _path_colour(tree, *channels):
+    """A colour of Light Path outputs, one (output name, scale, offset) per channel."""
+    path = _node(tree, "ShaderNodeLightPath")
+    join = _node(tree, "ShaderNodeCombineXYZ")
+    for i, (name, scale, offset) in enumerate(channels):
+        tree.links.new(_scaled(tree, path.outputs[name], scale, offset), join.inputs[i])
+    return join.outputs[0]
+
+
+def _light_path_stage(size):
+    """The Light Path scenes' camera (the horizon across the image's upper part) and world: sky
+    blue to the camera, grey to every other ray and to light."""
+    scene = ps._scene(2 * size, size)
+    camera = scene.camera
+    camera.location = (0.0, -7.5, 1.6)
+    camera.rotation_euler = mathutils.Vector((0.0, 7.5, -1.5)).to_track_quat("-Z", "Y").to_euler()
+    camera.data.lens = 35.0
+    world = new_world("World")
+    tree = world.node_tree
+    background = tree.nodes["Background"]
+    sky = _node(tree, "ShaderNodeBackground")
+    sky.inputs["Color"].default_value = (0.2, 0.45, 0.9, 1.0)
+    background.inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld")
+    tree.links.new(_mixed_by_camera(tree, background.outputs[0], sky.outputs[0]), output.inputs["Surface"])
+    scene.world = world
+    return scene
+
+
+def light_path_scene(size=48):
+    """Light Path on a sharp mirror floor under a sun: a sphere that is green to the camera and red
+    to everything else (a Mix Shader by Is Camera Ray), one whose diffuse colour is made of Ray
+    Length (red), Glossy Depth (green) and Ray Depth (blue), each seen straight and in the mirror,
+    and a world that is sky blue to the camera and grey to the mirror and to light."""
+    scene = _light_path_stage(size)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    sun.rotation_euler = (0.5, -0.4, 0.0)
+    scene.collection.objects.link(sun)
+
+    def mirror(tree):
+        glossy = _node(tree, "ShaderNodeBsdfGlossy")
+        glossy.inputs["Roughness"].default_value = 0.0
+        glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+        return glossy.outputs["BSDF"]
+
+    def by_camera(tree):
+        red, green = _diffuse_bsdf(tree, (0.8, 0.1, 0.1, 1.0)), _diffuse_bsdf(tree, (0.1, 0.8, 0.1, 1.0))
+        return _mixed_by_camera(tree, red, green)
+
+    def depths(tree):
+        return _diffuse_bsdf(tree, _path_colour(tree, ("Ray Length", 0.1, 0.0), ("Glossy Depth", 0.8, 0.1),
+                                                ("Ray Depth", 0.8, 0.1)))
+
+    bpy.ops.mesh.primitive_plane_add(size=30.0)
+    bpy.context.active_object.data.materials.append(_path_material("Mirror", mirror))
+    for x, name, surface in ((-1.1, "By camera", by_camera), (1.1, "Depths", depths)):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.9, location=(x, 0.0, 1.0), segments=48, ring_count=24)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(_path_material(name, surface))
+    return scene
+
+
+def light_path_glass_scene(size=48):
+    """Light Path through a transparent sheet and a sharp glass slab: emissive spheres behind them
+    whose colour is made of the node's outputs, one of Is Camera Ray (red: still 1 through the
+    sheet), Transparent Depth (green) and Is Transmission Ray (blue), the other of Transmission
+    Depth (red), Ray Depth (green) and Is Singular Ray (blue); the world, sky blue to the camera
+    only, seen through the sheet and in and through the glass."""
+    scene = _light_path_stage(size)
+
+    def sheet(tree):
+        transparent = _node(tree, "ShaderNodeBsdfTransparent")
+        transparent.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+        return transparent.outputs["BSDF"]
+
+    def glass(tree):
+        node = _node(tree, "ShaderNodeBsdfGlass")
+        node.inputs["Roughness"].default_value = 0.0
+        node.inputs["IOR"].default_value = 1.45
+        return node.outputs["BSDF"]
+
+    def emitting(*channels):
+        def build(tree):
+            emission = _node(tree, "ShaderNodeEmission")
+            tree.links.new(_path_colour(tree, *channels), emission.inputs["Color"])
+            return emission.outputs["Emission"]
+        return build
+
+    camera = emitting(("Is Camera Ray", 0.8, 0.1), ("Transparent Depth", 0.8, 0.1), ("Is Transmission Ray", 0.8, 0.1))
+    depths = emitting(("Transmission Depth", 0.4, 0.1), ("Ray Depth", 0.4, 0.1), ("Is Singular Ray", 0.8, 0.1))
+    for x, name, surface in ((-1.1, "Camera", camera), (1.1, "Transmission", depths)):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.9, location=(x, 0.0, 1.0), segments=48, ring_count=24)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(_path_material(name, surface))
+    bpy.ops.mesh.primitive_plane_add(size=2.2, location=(-1.1, -1.6, 1.0), rotation=(0.5 * np.pi, 0.0, 0.0))
+    bpy.context.active_object.data.materials.append(_path_material("Sheet", sheet))
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(1.1, -1.6, 1.0), scale=(2.2, 0.1, 2.2))
+    bpy.context.active_object.data.materials.append(_path_material("Glass", glass))
     return scene

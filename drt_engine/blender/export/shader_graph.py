@@ -14,7 +14,7 @@ import numpy as np
 from ...core.base.colour import LUMINANCE
 from ...core.scene import Program, TextureImage
 from ...core.shading import nodes as sn
-from ...core.shading import proctex, sky
+from ...core.shading import lightpath, proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .nodes import Issues, follow
 
@@ -683,6 +683,10 @@ class Compiler:
 
     def _node_ShaderNodeWavelength(self, node, output):
         return self.op("wavelength", (self._in(node, "Wavelength", "float"),)), 0
+
+    def _node_ShaderNodeLightPath(self, node, output):
+        """The ray's kind, length and depths at the point (core.shading.lightpath), in the world too."""
+        return self.program.add("light_path"), lightpath.OUTPUTS.index(output.identifier)
 
     # -- the hit's object, triangle and camera (core.shading.geometrynodes) ----------------------
     def _in_world(self, node) -> bool:

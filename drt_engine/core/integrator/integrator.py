@@ -29,6 +29,7 @@ from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .continuation import continue_paths
 from .direct import direct_light
@@ -38,6 +39,7 @@ from .ratio import RatioEstimator
 from .records import PathState, Samples, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
+_NO_BOUNCES = camera_bounces(0)  # the continuation kernel's bounces when no program reads Light Path
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"))
 
@@ -107,6 +109,9 @@ class Integrator:
         self.pixel_spread = camera_rays.pixel_spread(self.camera)
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
         self.ratio = frozenset(plan.ratio)
+        # paths carry their ray kind and depths only for a scene whose shader programs read them
+        self.light_path = reads_light_path(scene.world.program) or any(
+            reads_light_path(m.material.program) for m in prepared.shading)
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
 
@@ -192,7 +197,8 @@ class Integrator:
         self._count("camera", n)
         state = PathState(path=np.arange(n), origins=cam.origins, dirs=cam.directions, tmax=cam.tmax,
                           throughput=np.ones((n, 3)), prev_pdf=np.full(n, np.inf), prev_normal=np.zeros((n, 3)),
-                          prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time)
+                          prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
+                          bounces=camera_bounces(n) if self.light_path else None)
         return state, cam
 
     # -- what rays see ----------------------------------------------------------------
@@ -216,7 +222,9 @@ class Integrator:
             return
         lights = self.lights
         st = rays.straight
-        world = lights.world_radiance(rays.dirs, st, rays.prev_normal)
+        path = None if rays.bounces is None else RayPath(st, rays.bounces, np.full(len(rays), BACKGROUND_LENGTH),
+                                                         emission=True)
+        world = lights.world_radiance(rays.dirs, st, rays.prev_normal, path)
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
         if self.film_transparent:
@@ -245,7 +253,8 @@ class Integrator:
         return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material_of(prim), pos=pos,
                            ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
                            wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
-                           straight=state.straight[rows], time=state.time[rows], normal=normal)
+                           straight=state.straight[rows], time=state.time[rows], normal=normal,
+                           bounces=None if state.bounces is None else state.bounces[rows])
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
@@ -255,7 +264,8 @@ class Integrator:
             return
         prim = surf.prim[glowing]
         hit = surf.row[glowing]
-        emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing])
+        emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
+                                             self._ray_path(surf, hits, glowing))
         e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
                          lambda smooth: self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]],
                                                                  hits.t[hit[smooth]]))
@@ -322,7 +332,8 @@ class Integrator:
             hu, hv = hits.u[group.row], hits.v[group.row]
             bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
             width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
-            ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo)
+            ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
+                                 self._ray_path(group, hits))
             groups, normal = shading.bind(ctx)
             if normal is not None:
                 ng, wo = group.ng, group.wo
@@ -332,6 +343,13 @@ class Integrator:
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
                 yield group.take(sub), u_g.take(sub), shader
+
+    @staticmethod
+    def _ray_path(group: SurfaceHits, hits, rows=slice(None)) -> RayPath | None:
+        """The rays that reached hits ``rows`` of ``group``, for Light Path (None when no program reads it)."""
+        if group.bounces is None:
+            return None
+        return RayPath(group.straight[rows], group.bounces[rows], hits.t[group.row[rows]])
 
     # -- next-event estimation ----------------------------------------------------------
     def _sample_lights(self, lit) -> LightSamples:
@@ -344,7 +362,8 @@ class Integrator:
         hits = [group for group, _ in lit]
         return self.lights.sample_all(joined([h.pos for h in hits]), joined([h.ns for h in hits]),
                                       joined([u.light for _, u in lit]),
-                                      joined([h.time for h in hits]) if self.timed else None)
+                                      joined([h.time for h in hits]) if self.timed else None,
+                                      joined([h.bounces for h in hits]) if self.light_path else None)
 
     def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
@@ -374,11 +393,13 @@ class Integrator:
         n = len(hits)
         go, passthrough, transmit = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
         origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
+        next_bounces = np.empty_like(bounces)
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
-                       _c(hits.pos), _c(hits.ng), _c(hits.scale), go, origin, wi, weight, prev_pdf, passthrough,
-                       transmit)
+                       _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, go, origin, wi, weight, prev_pdf,
+                       passthrough, transmit, next_bounces)
         sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
@@ -388,7 +409,8 @@ class Integrator:
         self._count("transparent", passthrough.sum())
         return PathState(path=hits.path[sel], origins=origin[sel], dirs=wi[sel], tmax=np.full(len(sel), np.inf),
                          throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],
-                         prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel])
+                         prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel],
+                         bounces=None if hits.bounces is None else next_bounces[sel])
 
 
 def _c(a):

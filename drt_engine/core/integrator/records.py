@@ -12,8 +12,13 @@ from ..base.vectors import Frame
 
 
 def _take(record, rows):
-    """The record's rows ``rows`` (an index array, a mask or a slice), field by field."""
-    return type(record)(**{f.name: getattr(record, f.name)[rows] for f in fields(record)})
+    """The record's rows ``rows`` (an index array, a mask or a slice), field by field (a field
+    nobody asked for, None, stays None)."""
+    def rows_of(name):
+        value = getattr(record, name)
+        return None if value is None else value[rows]
+
+    return type(record)(**{f.name: rows_of(f.name) for f in fields(record)})
 
 
 def _concat(records: list):
@@ -51,7 +56,9 @@ class PathState:
     and ``prev_shading`` the geometric and shading normals of the surface it left (facing
     where it came from; the first decides which world visibility applies, the second is the
     one the world's light sampling is cosine-weighted around); ``straight`` whether the
-    camera sees through to here only through transparent surfaces."""
+    camera sees through to here only through transparent surfaces (Cycles' camera ray);
+    ``bounces`` the ray's kind and the path's depths (core.shading.lightpath), None unless a
+    shader program reads Light Path."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -63,6 +70,7 @@ class PathState:
     prev_shading: np.ndarray
     straight: np.ndarray
     time: np.ndarray  # shutter time of each ray (zeros when nothing moves)
+    bounces: np.ndarray | None = None
 
     def __len__(self):
         return len(self.path)
@@ -76,7 +84,8 @@ class SurfaceHits:
     """Rays that hit a surface, in shading order: the frame faces the incoming ray
     (``inside``: it came from the back), ``wo_l`` is the outgoing direction in that frame,
     ``scale`` the offset that clears the surface, ``row`` the hit's row in its depth's
-    intersection results, ``normal`` the mesh's shading normal as interpolated (the Normal pass)."""
+    intersection results, ``normal`` the mesh's shading normal as interpolated (the Normal pass),
+    ``bounces`` the path state's."""
 
     path: np.ndarray
     row: np.ndarray
@@ -93,6 +102,7 @@ class SurfaceHits:
     straight: np.ndarray
     time: np.ndarray
     normal: np.ndarray
+    bounces: np.ndarray | None = None
 
     def __len__(self):
         return len(self.path)

@@ -27,6 +27,7 @@ from ..base.jit import kernel
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
@@ -111,7 +112,8 @@ class Lights:
         self.world = world.radiance if lit and world.visible_lighting else None
         self._world_radiance = np.asarray(world.radiance, np.float64)
         self.world_constant = world.radiance
-        self.world_seen = lit and (world.visible_camera or world.visible_lighting)
+        seen = lit or reads_light_path(world.program)  # maybe black to light samples (the table) only
+        self.world_seen = seen and (world.visible_camera or world.visible_lighting)
         partial = world.visible_lighting and not (world.visible_diffuse and world.visible_glossy
                                                   and world.visible_transmission)
         self.world_lobes = self.world_visibility[1:] if partial else None
@@ -172,9 +174,10 @@ class Lights:
             best = np.maximum(best, self._emission_at(tris, weights, ng, corners))
         return best
 
-    def _emission_at(self, prim, bary, normal=None, corners=None):
+    def _emission_at(self, prim, bary, normal=None, corners=None, path=None):
         """Emission of triangles ``prim`` at ``bary``, its texture seeing ``normal`` (the hits'
-        shading normals), or the triangles' geometric normals at light-sampled points."""
+        shading normals), or the triangles' geometric normals at light-sampled points; ``path``
+        the rays there, for Light Path (core.shading.lightpath)."""
         g = self.geometry
         mats = g.material_of(prim)
         out = self.emission[mats]
@@ -184,15 +187,17 @@ class Lights:
                 p = g.world_corners(prim[sel]) if corners is None else corners[sel]
                 pos = np.einsum("ni,nij->nj", bary[sel], p)
                 n = g.world_normals(prim[sel], p)[0] if normal is None else normal[sel]
-                ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n)
+                ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n,
+                                     light_path=None if path is None else path.take(sel))
                 out[sel] = self.shaders[m].emission_at(ctx)
         return out
 
-    def emission_seen(self, prim, u, v, normal=None):
-        """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``)."""
+    def emission_seen(self, prim, u, v, normal=None, path=None):
+        """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``, the
+        rays that reached them ``path``)."""
         if not self.textured:
             return self.emission[self.geometry.material_of(prim)]
-        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal)
+        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal, path=path)
 
     def _frame(self, i, points, dirs, time):
         """(table, points, directions, rotation) in the frame where light i stands still."""
@@ -206,14 +211,15 @@ class Lights:
         return self.still, p, d, rotation
 
     # -- next-event estimation ----------------------------------------------------
-    def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None
-                   ) -> LightSamples:
+    def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None,
+                   bounces: np.ndarray | None = None) -> LightSamples:
         """Every strategy at shading points ``pos`` in one kernel call (lights.strategies);
         ``normal`` faces the incoming ray (the world is sampled about it); ``u`` (N, S, 2, 2): per
         strategy the point and the choice. With many lights, strategies below ``light_slots``
         each pick one light per point by estimated contribution and divide by the chance of that
         pick. Moving lights are sampled again in their own frames at ``time``; textured emission
-        and the environment's radiance come from their shader programs."""
+        and the environment's radiance come from their shader programs, which see the points'
+        paths' ``bounces`` as light samples do (core.shading.lightpath)."""
         n, strategies = len(pos), self.strategies
         pos, normal, u = (np.ascontiguousarray(a, np.float64) for a in (pos, normal, u))
         out = LightSamples.empty(strategies, n)
@@ -232,12 +238,16 @@ class Lights:
         if len(self.emissive) and self.textured:  # emission from the shader program at the sampled points
             k = np.flatnonzero(np.isin(g.material_of(pick[e]), self.textured) & lit[e])
             if len(k):
-                out.value[e, k] = self._emission_at(pick[e, k], bary[k]) / np.maximum(out.pdf[e, k], TINY)[:, None]
+                path = None if bounces is None else RayPath.light_samples(bounces[k], out.dist[e, k])
+                out.value[e, k] = self._emission_at(pick[e, k], bary[k], path=path) / np.maximum(
+                    out.pdf[e, k], TINY)[:, None]
         if self.world is not None:
             w = strategies - 1
             k = np.flatnonzero(lit[w])
             if len(k):  # the map's radiance from the environment's program
-                out.value[w, k] = self.environment.radiance(out.wi[w, k]) / out.pdf[w, k, None]
+                path = None if bounces is None else RayPath.light_samples(bounces[k],
+                                                                          np.full(len(k), BACKGROUND_LENGTH))
+                out.value[w, k] = self.environment.radiance(out.wi[w, k], path) / out.pdf[w, k, None]
             if self.world_lobes is not None:
                 out.restrict[w] = self.world_lobes
         return out
@@ -338,10 +348,10 @@ class Lights:
     def pdf_world(self, prev_normal, dirs):
         return pdf_world_batch(prev_normal, dirs, self._map_share, *self._map[2:])
 
-    def world_radiance(self, dirs, straight, prev_normal):
+    def world_radiance(self, dirs, straight, prev_normal, path=None):
         """Radiance of the world seen along ``dirs`` by camera rays (``straight``), or by rays
         reflected or refracted at a surface of geometric normal ``prev_normal`` (toward where
-        the ray came from), as the world's ray visibility allows."""
+        the ray came from), as the world's ray visibility allows; ``path`` the rays, for Light Path."""
         n = len(dirs)
         if not self.world_seen:
             return np.zeros((n, 3))
@@ -351,7 +361,7 @@ class Lights:
             value = np.zeros((n, 3))
             k = np.flatnonzero(shown)
             if len(k):
-                value[k] = self.environment.radiance(dirs[k])
+                value[k] = self.environment.radiance(dirs[k], None if path is None else path.take(k))
             return value
         return np.where(shown[:, None], self.world_constant, 0.0)
 

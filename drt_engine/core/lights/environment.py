@@ -27,6 +27,7 @@ from ..base.jit import kernel
 from ..base.vectors import basis
 from ..scene import World
 from ..shading import sky
+from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.nodes import DirectionContext, Evaluator
 from ..shading.textures import Texture, equirect_direction, equirect_uv
 
@@ -43,6 +44,7 @@ class Environment:
     def __init__(self, world: World, textures: list[Texture]):
         self.world = world
         self.textures = textures
+        self.reads_light_path = reads_light_path(world.program)
         nodes = world.program.nodes
         widths = [textures[n.params["image"]].size[0] for n in nodes if n.op == "environment"]
         widths += [sky.TABLE_WIDTH for n in nodes if n.op == "sky"]
@@ -113,8 +115,12 @@ class Environment:
                 first = direction, radius, rows, cols
         return first
 
-    def radiance(self, dirs: np.ndarray) -> np.ndarray:
-        ev = Evaluator(self.world.program, DirectionContext(dirs), self.textures)
+    def radiance(self, dirs: np.ndarray, path=None) -> np.ndarray:
+        """(N, 3) radiance toward ``dirs`` of rays ``path`` (core.shading.lightpath.RayPath; None:
+        light samples of a camera hit, as the table is made)."""
+        if path is None and self.reads_light_path:
+            path = RayPath.light_samples(camera_bounces(len(dirs)), np.full(len(dirs), BACKGROUND_LENGTH))
+        ev = Evaluator(self.world.program, DirectionContext(dirs, path), self.textures)
         return np.asarray(ev(self.world.color), float)
 
     def sample(self, u: np.ndarray):

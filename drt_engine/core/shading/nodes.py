@@ -22,7 +22,7 @@ from ..base.vectors import orthonormal_basis
 from ..scene import Program
 from . import colornodes as cn
 from . import geometrynodes as gn
-from . import proctex, sky
+from . import lightpath, proctex, sky
 from .textures import MAGENTA, Texture, equirect_uv
 
 """Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
@@ -429,6 +429,8 @@ class Evaluator:
             return (x[0] @ m[:3, :3].T + m[:3, 3],)
         if op == "backfacing":
             return (self.ctx.backfacing().astype(float),)
+        if op == "light_path":
+            return lightpath.outputs(self.ctx.light_path, n)
         if op == "brightness":
             return (cn.brightness_contrast(*x),)
         if op == "curves":
@@ -703,12 +705,14 @@ def _convert(kind, v):
 
 
 class DirectionContext:
-    """World lookups: every coordinate is the world-space ray direction."""
+    """World lookups: every coordinate is the world-space ray direction; ``light_path`` the rays
+    (core.shading.lightpath.RayPath, None: light samples)."""
 
-    def __init__(self, directions):
+    def __init__(self, directions, light_path=None):
         self.dirs = np.asarray(directions, float)
         self.n = len(self.dirs)
         self.normal = self.dirs
+        self.light_path = light_path
 
     def coord(self, name, uv_map=""):
         return self.dirs
@@ -726,7 +730,7 @@ class DirectionContext:
         return None, None
 
     def shifted(self, dp):
-        return DirectionContext(self.dirs + dp)
+        return DirectionContext(self.dirs + dp, self.light_path)
 
     def backfacing(self):
         return np.zeros(self.n, bool)

@@ -33,9 +33,11 @@ EXACT_TABLES = Tables()
 
 
 class SurfaceContext:
-    """Coordinates of a batch of hits for shader programs; ``shifted`` moves them on the surface."""
+    """Coordinates of a batch of hits for shader programs; ``shifted`` moves them on the surface.
+    ``light_path``: the rays that reached them (core.shading.lightpath.RayPath; None: light samples)."""
 
-    def __init__(self, attrs: "SurfaceAttributes", prim, bary, pos, normal, width=None, direction=None):
+    def __init__(self, attrs: "SurfaceAttributes", prim, bary, pos, normal, width=None, direction=None,
+                 light_path=None):
         self.attrs = attrs
         self.prim = prim
         self.bary = bary
@@ -46,18 +48,20 @@ class SurfaceContext:
         """The pixel's footprint across the ray, kept by ``shifted`` (which drops ``width``, so
         that lookups there filter no further)."""
         self.direction = direction
+        self.light_path = light_path
         self.n = len(prim)
 
     def shifted(self, dp):
         db = self.attrs.bary_shift(self.prim, dp)
         out = SurfaceContext(self.attrs, self.prim, self.bary + db, self.pos + dp, self.normal, None,
-                             self.direction)
+                             self.direction, self.light_path)
         out.pixel_width = self.pixel_width
         return out
 
     def turned(self, normal):
         """The same hits with ``normal`` as their shading normal (a displacement's bump)."""
-        out = SurfaceContext(self.attrs, self.prim, self.bary, self.pos, normal, self.width, self.direction)
+        out = SurfaceContext(self.attrs, self.prim, self.bary, self.pos, normal, self.width, self.direction,
+                             self.light_path)
         out.pixel_width = self.pixel_width
         return out
 

@@ -1,0 +1,90 @@
+"""Blender's Light Path node as Cycles' svm_node_light_path computes it, over a batch of shading points.
+
+What a point needs is the ray that brought it there (``RayPath``): whether the camera sees it
+straight (through transparent surfaces only, which keep a ray's kind in Cycles), the kind of
+lobe that spawned the ray otherwise, the ray's length, and the depths counted along the path:
+ray depth (every bounce but transparent ones), glossy (non-diffuse reflections), transmission
+and transparent. The integrator carries the kind and the depths per path in one small int
+array (``KIND`` bits and depth columns, updated by core.integrator.continuation).
+
+Outputs that are 0 at every point DRT shades, as Cycles' would be for the same path:
+- Is Shadow Ray: DRT's shadow rays are traced inside the direct-light kernel
+  (core.integrator.direct) and stop at the first surface, so no shader program runs for them.
+- Is Diffuse Ray and Diffuse Depth: paths continue only through non-diffuse lobes (diffuse light
+  is direct light), so no ray is ever spawned by a diffuse lobe.
+- Is Volume Scatter Ray and Portal Depth (Blender 5): DRT has no volumes and no portals.
+
+Emission evaluated by light sampling and the world (seen by a ray or sampled) are evaluated as
+Cycles evaluates them, with its emission flag: one bounce further (Ray Depth + 1); a light
+sample has no ray kind, and the world's Ray Length is ``BACKGROUND_LENGTH``. Without a
+``RayPath`` (the environment's importance table, the emissive triangles' power estimate) a
+point is shaded as the light sample of a camera hit.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+REFLECT, TRANSMIT, GLOSSY, SINGULAR = 1, 2, 4, 8
+"""Bits of the ``KIND`` column: the lobe that spawned the ray (Cycles' PATH_RAY_* of the same names)."""
+KIND, DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH, TRANSPARENT_DEPTH = range(5)
+COLUMNS = 5
+BACKGROUND_LENGTH = float(np.finfo(np.float32).max)
+"""Ray Length at the world: Cycles' FLT_MAX (shader_setup_from_background; measured with Blender
+5.0's Cycles, for the camera's rays)."""
+
+OUTPUTS = ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ray", "Is Singular Ray",
+           "Is Reflection Ray", "Is Transmission Ray", "Is Volume Scatter Ray", "Ray Length", "Ray Depth",
+           "Diffuse Depth", "Glossy Depth", "Transparent Depth", "Transmission Depth", "Portal Depth")
+"""The node's outputs, in the order the program's ``light_path`` operation returns them."""
+
+
+def camera_bounces(n: int) -> np.ndarray:
+    """The kind and depths of ``n`` camera rays: all 0."""
+    return np.zeros((n, COLUMNS), np.int32)
+
+
+@dataclass
+class RayPath:
+    """The rays that reached a batch of points: ``camera`` (N,) bool, ``bounces`` (N, COLUMNS)
+    int, ``length`` (N,), and whether the points are evaluated as emission (a light sample or
+    the world: Cycles' PATH_RAY_EMISSION)."""
+
+    camera: np.ndarray
+    bounces: np.ndarray
+    length: np.ndarray
+    emission: bool = False
+
+    def take(self, rows) -> "RayPath":
+        return RayPath(self.camera[rows], self.bounces[rows], self.length[rows], self.emission)
+
+    @classmethod
+    def light_samples(cls, bounces: np.ndarray, length: np.ndarray) -> "RayPath":
+        """Emission or world sampled from points whose paths have ``bounces``: no ray kind."""
+        kindless = bounces.copy()
+        kindless[:, KIND] = 0
+        return cls(np.zeros(len(bounces), bool), kindless, length, emission=True)
+
+
+def outputs(path: RayPath | None, n: int) -> tuple:
+    """The node's outputs (``OUTPUTS``) at ``n`` points reached by ``path`` (None: light samples of
+    camera hits, see the module's docstring)."""
+    if path is None:
+        path = RayPath.light_samples(camera_bounces(n), np.zeros(n))
+    b = path.bounces
+    kind = b[:, KIND]  # 0 for camera rays: transparent surfaces keep a ray's kind
+    zero = np.zeros(n)
+
+    def bit(mask):
+        return ((kind & mask) != 0).astype(float)
+
+    depth = b[:, DEPTH] + (1 if path.emission else 0)
+    return (path.camera.astype(float), zero, zero, bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT), zero,
+            np.asarray(path.length, float), depth.astype(float), zero, b[:, GLOSSY_DEPTH].astype(float),
+            b[:, TRANSPARENT_DEPTH].astype(float), b[:, TRANSMISSION_DEPTH].astype(float), zero)
+
+
+def reads_light_path(program) -> bool:
+    """Whether a shader program (or None) has a Light Path node."""
+    return program is not None and any(node.op == "light_path" for node in program.nodes)
