@@ -328,6 +328,7 @@ class GeometryExporter:
         self._metaballs: list = []
         self._meshed: set[int] = set()
         self._info: dict[bytes, bool] = {}  # slot materials -> whether they read Object Info
+        self._attributes_read: dict[bytes, list] = {}  # slot materials -> instance attributes they read
 
     def _slot_materials(self, obj) -> np.ndarray:
         """Scene material index per slot, as Cycles' ``find_used_shaders``."""
@@ -360,14 +361,22 @@ class GeometryExporter:
         """The Object and Instancer attributes the slots' materials read, looked up as Blender
         does for Cycles: the instancing object first (Instancer only), the object, its data."""
         out = {}
-        for index in set(slot_materials.tolist()):
-            program = self.materials.materials[index].program
-            for node in program.nodes if program is not None else ():
-                if node.op == "instance_attribute" and node.params["key"] not in out:
-                    kind, name = node.params["key"].split(":", 1)
-                    owners = ([parent] if kind == "INSTANCER" else []) + [obj, obj.data]
-                    out[node.params["key"]] = find_rgba(owners, name)
+        for key in self._attribute_keys(slot_materials):
+            kind, name = key.split(":", 1)
+            owners = ([parent] if kind == "INSTANCER" else []) + [obj, obj.data]
+            out[key] = find_rgba(owners, name)
         return out
+
+    def _attribute_keys(self, slot_materials) -> list:
+        """The instance attributes the slots' materials read, found once per set of slots (ten
+        thousand instances of one object would otherwise scan its programs ten thousand times)."""
+        key = slot_materials.tobytes()
+        found = self._attributes_read.get(key)
+        if found is None:
+            programs = [self.materials.materials[i].program for i in set(slot_materials.tolist())]
+            found = self._attributes_read[key] = list(dict.fromkeys(
+                n.params["key"] for p in programs if p is not None for n in p.nodes if n.op == "instance_attribute"))
+        return found
 
     def _place(self, obj, matrix, source, key, parent=None, random_id=None) -> None:
         slot_materials = self._slot_materials(obj)
