@@ -5,7 +5,11 @@ import pytest
 from drt_engine.core.lights.area import spherical_rectangle
 from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _sample_batch
-from drt_engine.core.scene import Light
+from drt_engine.core.lights.triangles import unoccluded_triangles_batch
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData
+from drt_engine.core.settings import RenderSettings
+from tests.support.scenes import plane, top_camera
 
 RNG = np.random.default_rng(3)
 
@@ -66,3 +70,23 @@ def test_solid_angle_sampling_is_less_noisy_than_area_sampling_near_a_large_ligh
     assert solid.mean() == pytest.approx(exact, rel=0.01)
     assert area.mean() == pytest.approx(exact, rel=0.15)
     assert solid.var() < 0.2 * area.var()
+
+
+@pytest.mark.parametrize("x", [0.0, 2.0, 4.0])
+def test_a_floor_lit_by_a_mesh_light_at_grazing_angles_gets_all_its_light(x):
+    """A 1 m emissive panel 1 m above a white floor, straight above and off to the side: the
+    floor's radiance is albedo / pi times the panel's closed-form irradiance. Shadow rays toward
+    the panel start offset from the floor; aimed parallel to the sample's direction they met the
+    panel short of the sampled point and every grazing sample was blocked (black at x = 2)."""
+    floor = Material("floor", [Closure("DIFFUSE", color=(0.5,) * 3)])
+    glow = Material("glow", [Closure("EMISSION", emission=(1.0, 1.0, 1.0))])
+    panel = plane(size=1.0, z=1.0, material=1)
+    panel.vertices = panel.vertices + [x, 0.0, 0.0]
+    panel.triangles = panel.triangles[:, ::-1].copy()  # facing the floor
+    scene = SceneData(camera=top_camera(height=0.5), meshes=[plane(), panel],
+                      instances=[Instance(0, np.eye(4)), Instance(1, np.eye(4))], materials=[floor, glow], lights=[])
+    irradiance = np.zeros((1, 3))
+    unoccluded_triangles_batch(panel.vertices, panel.triangles.astype(np.int64), np.ones((2, 3)),
+                               np.array([0, 1], np.int64), np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), irradiance)
+    image = Renderer(scene, RenderSettings(samples=64, threads=1)).render().passes["Combined"][..., 0]
+    assert image.mean() == pytest.approx(0.5 / np.pi * irradiance[0, 0], rel=0.03)

@@ -52,6 +52,14 @@ def shadow_origin(px, py, pz, gx, gy, gz, wx, wy, wz, cos_shading, lx, ly, lz, s
                        side * gz, scale)
 
 
+@kernel(inline="always")
+def _aim(x, y, z):
+    """Unit direction and length of (x, y, z)."""
+    d = math.sqrt(x * x + y * y + z * z)
+    inv = 1.0 / max(d, 1e-300)
+    return x * inv, y * inv, z * inv, d
+
+
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, geo, prim,
                  u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times, radiance, f_diff,
@@ -112,7 +120,12 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
                                        hz, scale[j])
             tmax = math.inf
             if not math.isinf(dist[k, j]):
-                tmax = max(dist[k, j] * (1.0 - 1e-6) - stop[k, j] - scale[j], 0.0)
+                # aimed at the sampled point from where the ray starts: the offset and the lift
+                # moved the origin, and a ray parallel to wi meets a mesh light's surface short of
+                # the point by offset / cosine (every grazing sample of an emissive panel was blocked)
+                wx, wy, wz, d = _aim(pos[j, 0] + wx * dist[k, j] - ox, pos[j, 1] + wy * dist[k, j] - oy,
+                                     pos[j, 2] + wz * dist[k, j] - oz)
+                tmax = max(d * (1.0 - 1e-6) - stop[k, j], 0.0)
             traced += 1
             hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time)
             if keep:
