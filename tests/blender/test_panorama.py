@@ -4,10 +4,11 @@ range of a projection moves colours and edges. The rule is the node parity's
 (procedural_scenes.parity) over RGBA: DRT's worst 4x4-block difference from Cycles (seed 0) at
 most 1.5x Cycles' own between seeds 0 and 1, plus 0.002; outside a fisheye's circle both are
 black and opaque. Depth of field is compared strongly enough (a quarter-metre aperture focused at
-half a metre) that DRT without it fails. A panorama type DRT does not render is refused with one line naming it."""
+half a metre) that DRT without it fails, and so is the camera's motion blur. A panorama type DRT does not render is refused with one line naming it."""
 from __future__ import annotations
 
 import bpy
+import mathutils
 import numpy as np
 import pytest
 
@@ -22,14 +23,16 @@ WALLS = {  # outward axis and sign -> emitted colour
     (1, -1): (1.0, 0.9, 0.1), (2, 1): (0.9, 0.2, 0.9), (2, -1): (0.1, 0.9, 0.9),
 }
 
-CASES = {  # name -> (panorama type, camera settings, depth of field (f-stop, focus distance) or None)
+CASES = {  # name -> (panorama type, camera settings, depth of field (f-stop, focus distance) or None,
+    # the camera's turn about its view axis over the frames 0 to 2, seen with a one-frame shutter at frame 1)
     "equirectangular": ("EQUIRECTANGULAR", dict(latitude_min=-1.2, latitude_max=1.4, longitude_min=-2.8,
-                                                longitude_max=2.2), None),
-    "fisheye_equidistant": ("FISHEYE_EQUIDISTANT", dict(fisheye_fov=3.6), None),
-    "fisheye_equisolid": ("FISHEYE_EQUISOLID", dict(fisheye_lens=8.0, sensor_width=30.0), None),
-    "mirrorball": ("MIRRORBALL", {}, None),
-    "equirectangular_dof": ("EQUIRECTANGULAR", {}, (0.1, 0.5)),
-    "fisheye_equidistant_dof": ("FISHEYE_EQUIDISTANT", dict(fisheye_fov=3.6), (0.1, 0.5)),
+                                                longitude_max=2.2), None, 0.0),
+    "fisheye_equidistant": ("FISHEYE_EQUIDISTANT", dict(fisheye_fov=3.6), None, 0.0),
+    "fisheye_equisolid": ("FISHEYE_EQUISOLID", dict(fisheye_lens=8.0, sensor_width=30.0), None, 0.0),
+    "mirrorball": ("MIRRORBALL", {}, None, 0.0),
+    "equirectangular_dof": ("EQUIRECTANGULAR", {}, (0.1, 0.5), 0.0),
+    "fisheye_equidistant_dof": ("FISHEYE_EQUIDISTANT", dict(fisheye_fov=3.6), (0.1, 0.5), 0.0),
+    "fisheye_equidistant_turning": ("FISHEYE_EQUIDISTANT", dict(fisheye_fov=3.6), None, 0.6),
 }
 
 SAMPLES = 256
@@ -80,13 +83,31 @@ def box_scene(panorama: str, **settings):
     return scene
 
 
+def _turn(scene, angle):
+    """Key the camera turning by ``angle`` about its view axis, linearly over frames 0 to 2, and
+    blur frame 1 over one frame."""
+    edit = bpy.context.preferences.edit
+    interpolation, edit.keyframe_new_interpolation_type = edit.keyframe_new_interpolation_type, "LINEAR"
+    cam = scene.camera
+    base = cam.rotation_euler.to_matrix()
+    for frame, a in ((0, -0.5 * angle), (2, 0.5 * angle)):
+        cam.rotation_euler = (base @ mathutils.Matrix.Rotation(a, 3, "Z")).to_euler()
+        cam.keyframe_insert("rotation_euler", frame=frame)
+    edit.keyframe_new_interpolation_type = interpolation
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = 1.0
+    scene.frame_set(1)
+
+
 @pytest.mark.parametrize("case", CASES)
 def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
-    panorama, settings, dof = CASES[case]
+    panorama, settings, dof, turn = CASES[case]
     scene = box_scene(panorama, **settings)
     if dof is not None:
         scene.camera.data.dof.use_dof = True
         scene.camera.data.dof.aperture_fstop, scene.camera.data.dof.focus_distance = dof
+    if turn:
+        _turn(scene, turn)
     drt_render, c0, c1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=case) for engine, seed in ps.RUNS]
     rh.save_side_by_side(f"panorama-{case}", drt_render.rgb, c0.rgb)
     combined = [r.passes["Combined"] for r in (drt_render, c0, c1)]
