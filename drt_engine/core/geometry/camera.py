@@ -135,13 +135,20 @@ def camera_ray(lens, m, px, py, u0, u1, use_lens):
     axial = -dz
     t_start = lens[12] / axial
     t_end = lens[13] / axial
+    return to_world(m, ox, oy, oz, dx, dy, dz, t_start, t_end, axial)
+
+
+@kernel(inline="always")
+def to_world(m, ox, oy, oz, dx, dy, dz, t_start, t_end, depth_per_t):
+    """``camera_ray``'s result from a camera-space ray: origin moved to the near plane, t_start
+    along it, and carried to the world by m."""
     wx = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3]
     wy = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3]
     wz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3]
     vx, vy, vz = unit(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
-                       m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
+                      m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
     return (wx + vx * t_start, wy + vy * t_start, wz + vz * t_start, vx, vy, vz,
-            max(t_end - t_start, 0.0), t_start, axial, True)
+            max(t_end - t_start, 0.0), t_start, depth_per_t, True)
 
 
 @kernel
@@ -166,14 +173,7 @@ def panorama_ray(lens, m, u, v, u0, u1, use_lens):
         ox, oy, oz, dx, dy, dz = ox, oz, oy, dx, dz, dy
     else:
         ox, oy, oz, dx, dy, dz = -oy, oz, -ox, -dy, dz, -dx
-    t_start = lens[12]
-    wx = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3]
-    wy = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3]
-    wz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3]
-    vx, vy, vz = unit(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
-                      m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
-    return (wx + vx * t_start, wy + vy * t_start, wz + vz * t_start, vx, vy, vz,
-            max(lens[13] - t_start, 0.0), t_start, 1.0, True)
+    return to_world(m, ox, oy, oz, dx, dy, dz, lens[12], lens[13], 1.0)
 
 
 @kernel
