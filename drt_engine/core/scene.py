@@ -302,10 +302,11 @@ class World:
 
 @dataclass
 class Camera:
-    """A pinhole or orthographic camera looking along local -Z with Y up.
+    """A pinhole, orthographic or panoramic camera looking along local -Z with Y up.
 
     ``frame`` = (left, right, bottom, top) of the image window in camera space on the
-    plane z = -1 (perspective) or in scene units (orthographic); sensor fit, pixel
+    plane z = -1 (perspective), in scene units (orthographic), or in the panorama's
+    (u, v) coordinates, 0 to 1 over the unshifted image (panoramic); sensor fit, pixel
     aspect and shift are already folded into it. ``resolution`` is the full image in
     pixels after the resolution percentage; ``window`` = (x0, y0, x1, y1) is the pixel
     rectangle actually rendered (border render), rows counted from the bottom as in
@@ -327,6 +328,18 @@ class Camera:
     blade_rotation: float = 0.0
     aperture_ratio: float = 1.0
     """Anamorphic bokeh: the aperture's x extent is divided by this ratio."""
+    panorama: str = "EQUIRECTANGULAR"
+    """For type "PANO", one of ``PANORAMA_TYPES`` (Blender's ``panorama_type``)."""
+    latitude: tuple[float, float] = (-np.pi / 2, np.pi / 2)
+    """Equirectangular: latitudes (radians) at the bottom and top of the image."""
+    longitude: tuple[float, float] = (-np.pi, np.pi)
+    """Equirectangular: longitudes (radians) at the left and right of the image (0 ahead, positive to the right)."""
+    fisheye_fov: float = np.pi
+    """Fisheyes: the angle (radians) across the image circle."""
+    fisheye_lens: float = 10.5
+    """Fisheye equisolid: focal length, in the sensor's units (mm)."""
+    sensor: tuple[float, float] = (36.0, 24.0)
+    """Fisheye equisolid: the sensor's width and height (mm) fitted to the image, as Cycles fits them."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
@@ -340,8 +353,10 @@ class Camera:
         if not (0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h):
             raise ValueError(f"render window {self.window} outside the image {w}x{h}")
         self.window = (x0, y0, x1, y1)
-        if self.type not in ("PERSP", "ORTHO"):
+        if self.type not in ("PERSP", "ORTHO", "PANO"):
             raise ValueError(f"unknown camera type {self.type!r}")
+        if self.type == "PANO" and self.panorama not in PANORAMA_TYPES:
+            raise ValueError(f"unknown panorama type {self.panorama!r}")
 
     @property
     def matrix(self) -> np.ndarray:
@@ -351,6 +366,10 @@ class Camera:
     def window_size(self) -> tuple[int, int]:
         x0, y0, x1, y1 = self.window
         return x1 - x0, y1 - y0
+
+
+PANORAMA_TYPES = ("EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT", "FISHEYE_EQUISOLID", "MIRRORBALL")
+"""Panoramic projections, as Cycles' kernel/camera/projection.h defines them."""
 
 
 @dataclass

@@ -5,13 +5,15 @@ aspect and shift folded in, scaled to the plane z = -1 for perspective cameras a
 left in scene units for orthographic ones. Depth of field: aperture radius =
 lens[mm]·1e-3 / (2·f-stop) for perspective (1 / (2·f-stop) for orthographic), in
 scene units whatever the unit scale, and 0 when depth of field is off.
+Panoramic cameras: the frame is the (u, v) square, shifted as Cycles shifts it, and
+the projection's settings follow Cycles' blender_camera_sync.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ...core.errors import SceneError
-from ...core.scene import Camera
+from ...core.scene import PANORAMA_TYPES, Camera
 
 
 def resolution(render) -> tuple[int, int]:
@@ -74,11 +76,9 @@ def export_camera(scene, camera_object) -> Camera:
     if camera_object.type != "CAMERA":
         raise SceneError(f"The scene camera '{camera_object.name}' is not a camera object")
     cam = camera_object.data
-    if cam.type not in ("PERSP", "ORTHO"):
-        raise SceneError(
-            f"Camera '{camera_object.name}' is {cam.type.lower()}: DRT renders perspective "
-            "and orthographic cameras only"
-        )
+    if cam.type == "PANO" and cam.panorama_type not in PANORAMA_TYPES:
+        raise SceneError(f"Camera '{camera_object.name}': DRT does not render the panorama type "
+                         f"{cam.panorama_type} (it renders {', '.join(PANORAMA_TYPES)})")
     render = scene.render
     width, height = resolution(render)
     if width < 1 or height < 1:
@@ -93,9 +93,10 @@ def export_camera(scene, camera_object) -> Camera:
     if dof.focus_object is not None:
         to_focus = matrix[:3, 3] - np.array(dof.focus_object.matrix_world.translation)
         focus = abs(float(matrix[:3, 2] @ to_focus))
+    pixel_aspect = (render.pixel_aspect_x, render.pixel_aspect_y)
     return Camera(
         matrices=matrix[None],
-        frame=view_plane(cam, width, height, (render.pixel_aspect_x, render.pixel_aspect_y)),
+        frame=(panorama_plane(cam) if cam.type == "PANO" else view_plane(cam, width, height, pixel_aspect)),
         resolution=(width, height),
         type=cam.type,
         clip_start=cam.clip_start,
@@ -106,4 +107,24 @@ def export_camera(scene, camera_object) -> Camera:
         blades=int(dof.aperture_blades),
         blade_rotation=float(dof.aperture_rotation),
         aperture_ratio=float(dof.aperture_ratio),
+        **(panorama_settings(cam, width, height, pixel_aspect) if cam.type == "PANO" else {}),
     )
+
+
+def panorama_plane(cam) -> tuple[float, float, float, float]:
+    """The panorama's (u, v) window: the unit square moved by the shift (a final render's,
+    where Cycles' pano_aspectratio is 0)."""
+    return cam.shift_x, 1.0 + cam.shift_x, cam.shift_y, 1.0 + cam.shift_y
+
+
+def panorama_settings(cam, width: int, height: int, pixel_aspect) -> dict:
+    """The projection's ``Camera`` fields; the equisolid sensor fitted to the image as Cycles
+    fits it (the sensor fit's side kept, the other from the image's aspect)."""
+    x_ratio, y_ratio = width * pixel_aspect[0], height * pixel_aspect[1]
+    fit = cam.sensor_fit
+    horizontal = x_ratio > y_ratio if fit == "AUTO" else fit == "HORIZONTAL"
+    size = cam.sensor_height if fit == "VERTICAL" else cam.sensor_width
+    sensor = (size, size * y_ratio / x_ratio) if horizontal else (size * x_ratio / y_ratio, size)
+    return dict(panorama=cam.panorama_type, latitude=(cam.latitude_min, cam.latitude_max),
+                longitude=(cam.longitude_min, cam.longitude_max), fisheye_fov=cam.fisheye_fov,
+                fisheye_lens=cam.fisheye_lens, sensor=sensor)

@@ -1,8 +1,11 @@
-"""Primary rays: the pixel filter's offset, the image window, the thin lens (perspective
-and orthographic).
+"""Primary rays: the pixel filter's offset, the image window, the thin lens (perspective,
+orthographic and panoramic).
 
 Rays start at the near clipping plane and stop at the far one, as Blender's camera
-clips; ``depth_per_t`` converts distance along a ray into depth along the view axis.
+clips; ``depth_per_t`` converts distance along a ray into depth along the view axis
+(panoramic cameras: distance from the eye, as Cycles' Depth pass). Panoramic projections
+follow Cycles' kernel/camera/projection.h and camera_sample_panorama; an image point
+outside a fisheye's circle or a mirror ball's disc has no ray (``valid`` false).
 """
 from __future__ import annotations
 
@@ -14,11 +17,15 @@ import numpy as np
 from ..base.jit import kernel
 from ..base.vectors import unit
 from ..base.warps import concentric_disk
-from ..scene import Camera
+from ..scene import PANORAMA_TYPES, Camera
 from .motion import Motion, frame_at
 
 FOCUS_MIN = 1e-5
 """Nearest focus distance, as Cycles clamps it: at 0 every lens ray would leave sideways."""
+
+PANORAMA_CODE = {name: 2 + i for i, name in enumerate(PANORAMA_TYPES)}
+"""``lens[0]`` of each panoramic projection (0 is perspective, 1 orthographic)."""
+EQUIRECTANGULAR, FISHEYE_EQUIDISTANT, FISHEYE_EQUISOLID, MIRRORBALL = (PANORAMA_CODE[n] for n in PANORAMA_TYPES)
 
 
 @dataclass
@@ -28,15 +35,55 @@ class CameraRays:
     tmax: np.ndarray
     t_start: np.ndarray  # distance from the eye to the near plane along the ray
     depth_per_t: np.ndarray
+    valid: np.ndarray  # false where the image point has no ray (outside a fisheye's circle)
 
 
 def lens_table(camera: Camera) -> np.ndarray:
     """The camera's numbers as one flat array for ``camera_ray`` (made once per call: a few floats)."""
     w, h = camera.resolution
     left, right, bottom, top = camera.frame
-    return np.array([camera.type != "PERSP", w, h, left, right, bottom, top, camera.aperture_radius,
+    kind = PANORAMA_CODE[camera.panorama] if camera.type == "PANO" else float(camera.type != "PERSP")
+    (lat_min, lat_max), (lon_min, lon_max) = camera.latitude, camera.longitude
+    return np.array([kind, w, h, left, right, bottom, top, camera.aperture_radius,
                      max(camera.aperture_ratio, 1e-6), camera.blades, camera.blade_rotation,
-                     max(camera.focus_distance, FOCUS_MIN), camera.clip_start, camera.clip_end], np.float64)
+                     max(camera.focus_distance, FOCUS_MIN), camera.clip_start, camera.clip_end,
+                     # Cycles' equirectangular_range: longitude from u, polar angle from v
+                     lon_min - lon_max, -lon_min, lat_min - lat_max, np.pi / 2 - lat_min,
+                     camera.fisheye_fov, camera.fisheye_lens, camera.sensor[0], camera.sensor[1]], np.float64)
+
+
+@kernel
+def panorama_direction(lens, u, v):
+    """Unit direction in Cycles' panorama frame (x ahead, z up) of image point (u, v), or
+    (0, 0, 0) outside the projection's circle."""
+    kind = lens[0]
+    if kind == EQUIRECTANGULAR:
+        phi = lens[14] * u + lens[15]
+        theta = lens[16] * v + lens[17]
+        return math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)
+    if kind == MIRRORBALL:  # the view reflected in a ball seen from -y
+        bx, bz = 2.0 * u - 1.0, 2.0 * v - 1.0
+        if bx * bx + bz * bz > 1.0:
+            return 0.0, 0.0, 0.0
+        by = -math.sqrt(max(1.0 - bx * bx - bz * bz, 0.0))
+        c = -2.0 * by  # 2 (n . i) with i = (0, -1, 0)
+        return c * bx, c * by + 1.0, c * bz
+    if kind == FISHEYE_EQUIDISTANT:
+        x, y = 2.0 * (u - 0.5), 2.0 * (v - 0.5)
+        r = math.sqrt(x * x + y * y)
+        if r > 1.0:
+            return 0.0, 0.0, 0.0
+        theta = 0.5 * r * lens[18]
+    else:  # equisolid: r = 2 f sin(theta / 2) on the sensor, inside the circle of the fov
+        x, y = (u - 0.5) * lens[20], (v - 0.5) * lens[21]
+        r = math.sqrt(x * x + y * y)
+        if r > 2.0 * lens[19] * math.sin(0.25 * lens[18]):
+            return 0.0, 0.0, 0.0
+        theta = 2.0 * math.asin(min(r / (2.0 * lens[19]), 1.0))
+    if r == 0.0:
+        return 1.0, 0.0, 0.0
+    s = math.sin(theta) / r
+    return math.cos(theta), -x * s, y * s
 
 
 @kernel
@@ -61,11 +108,14 @@ def camera_ray(lens, m, px, py, u0, u1, use_lens):
     when ``use_lens``, carried to the world by m (3, 4).
 
     Returns origin on the near plane, unit direction, the distance to the far plane, the
-    distance from the eye to the near plane, and depth per unit distance along the ray.
+    distance from the eye to the near plane, depth per unit distance along the ray, and
+    whether the image point has a ray at all.
     """
     sx = lens[3] + (px / lens[1]) * (lens[4] - lens[3])
     sy = lens[5] + (py / lens[2]) * (lens[6] - lens[5])
     focus = lens[11]
+    if lens[0] >= 2.0:
+        return panorama_ray(lens, m, sx, sy, u0, u1, use_lens)
     if lens[0] == 0.0:  # perspective: from the eye (or a point of the lens) toward the plane in focus
         ox, oy, oz = 0.0, 0.0, 0.0
         dx, dy, dz = unit(sx, sy, -1.0)
@@ -85,18 +135,50 @@ def camera_ray(lens, m, px, py, u0, u1, use_lens):
     axial = -dz
     t_start = lens[12] / axial
     t_end = lens[13] / axial
+    return to_world(m, ox, oy, oz, dx, dy, dz, t_start, t_end, axial)
+
+
+@kernel(inline="always")
+def to_world(m, ox, oy, oz, dx, dy, dz, t_start, t_end, depth_per_t):
+    """``camera_ray``'s result from a camera-space ray: origin moved to the near plane, t_start
+    along it, and carried to the world by m."""
     wx = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3]
     wy = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3]
     wz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3]
     vx, vy, vz = unit(m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz, m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz,
-                       m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
+                      m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz)
     return (wx + vx * t_start, wy + vy * t_start, wz + vz * t_start, vx, vy, vz,
-            max(t_end - t_start, 0.0), t_start, axial)
+            max(t_end - t_start, 0.0), t_start, depth_per_t, True)
 
 
 @kernel
-def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens, time, out):
-    """Camera rays into out (N, 9); a moving camera's frame at each ray's time, its scale dropped."""
+def panorama_ray(lens, m, u, v, u0, u1, use_lens):
+    """``camera_ray`` of a panoramic camera at image point (u, v), as Cycles' camera_sample_panorama:
+    the lens shifts the origin across the ray and aims it back at the point ``focus`` along it
+    (focus on a sphere); clipping is by distance from the eye."""
+    dx, dy, dz = panorama_direction(lens, u, v)
+    if dx == 0.0 and dy == 0.0 and dz == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False
+    ox, oy, oz = 0.0, 0.0, 0.0
+    if use_lens:
+        ax, ay = aperture_sample(lens, u0, u1)
+        ux, uy, uz = unit(1.0 - dx * dx, -dx * dy, -dx * dz)  # across the ray, toward the frame's x
+        vx, vy, vz = dy * uz - dz * uy, dz * ux - dx * uz, dx * uy - dy * ux
+        ox, oy, oz = ux * ax + vx * ay, uy * ax + vy * ay, uz * ax + vz * ay
+        f = lens[11]
+        dx, dy, dz = unit(dx * f - ox, dy * f - oy, dz * f - oz)
+    # Cycles' panorama frame into the camera's (looking down -z, y up); the mirror ball's
+    # frame looks down -y
+    if lens[0] == MIRRORBALL:
+        ox, oy, oz, dx, dy, dz = ox, oz, oy, dx, dz, dy
+    else:
+        ox, oy, oz, dx, dy, dz = -oy, oz, -ox, -dy, dz, -dx
+    return to_world(m, ox, oy, oz, dx, dy, dz, lens[12], lens[13], 1.0)
+
+
+@kernel
+def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens, time, out, valid):
+    """Camera rays into out (N, 9) and valid (N,); a moving camera's frame at each ray's time, its scale dropped."""
     m = matrix.copy()
     for i in range(len(px)):
         if moving:
@@ -106,8 +188,8 @@ def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens,
                 for r in range(3):
                     m[r, c] /= length
         u0, u1 = (u[i, 0], u[i, 1]) if use_lens else (0.0, 0.0)
-        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5], out[i, 6], out[i, 7], out[i, 8] = \
-            camera_ray(lens, m, px[i], py[i], u0, u1, use_lens)
+        (out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5], out[i, 6], out[i, 7], out[i, 8],
+         valid[i]) = camera_ray(lens, m, px[i], py[i], u0, u1, use_lens)
 
 
 @kernel
@@ -136,19 +218,26 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
     moving = time is not None and motion.moving
     use_lens = lens is not None and camera.aperture_radius > 0
     out = np.empty((n, 9))
+    valid = np.empty(n, bool)
     _rays(lens_table(camera), np.ascontiguousarray(camera.matrix[:3]), *motion.table, moving,
           np.asarray(px, np.float64), np.asarray(py, np.float64),
           np.asarray(lens, np.float64) if use_lens else np.zeros((0, 2)), use_lens,
-          np.asarray(time, np.float64) if moving else np.zeros(0), out)
-    return CameraRays(out[:, :3], out[:, 3:6], out[:, 6], out[:, 7], out[:, 8])
+          np.asarray(time, np.float64) if moving else np.zeros(0), out, valid)
+    return CameraRays(out[:, :3], out[:, 3:6], out[:, 6], out[:, 7], out[:, 8], valid)
 
 
 def pixel_spread(camera: Camera) -> tuple[float, float]:
     """A pixel's footprint width as a + b t at distance t along a camera ray: (a, b).
 
-    Perspective: b is the pixel's angle; orthographic: a is its size. Texture lookups
-    filter over this footprint (projected onto the surface)."""
+    Perspective: b is the pixel's angle; orthographic: a is its size; panoramic: b is the
+    pixel's angle at the image centre. Texture lookups filter over this footprint (projected
+    onto the surface)."""
     w = camera.resolution[0]
     left, right, _, _ = camera.frame
     size = abs(right - left) / w
+    if camera.type == "PANO":
+        per_u = {"EQUIRECTANGULAR": abs(camera.longitude[1] - camera.longitude[0]),
+                 "FISHEYE_EQUIDISTANT": camera.fisheye_fov, "FISHEYE_EQUISOLID": camera.sensor[0] / camera.fisheye_lens,
+                 "MIRRORBALL": 4.0}[camera.panorama]  # the direction's angle per unit of u there
+        return 0.0, size * per_u
     return (0.0, size) if camera.type == "PERSP" else (size, 0.0)

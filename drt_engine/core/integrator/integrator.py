@@ -133,6 +133,8 @@ class Integrator:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
             out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
+        if not cam.valid.all():  # no ray outside a fisheye's circle: black and opaque, as Cycles leaves it
+            state = state.take(np.flatnonzero(cam.valid))
         for depth in range(s.max_depth + 1):
             if len(state) == 0:
                 break
