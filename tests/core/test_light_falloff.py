@@ -73,8 +73,8 @@ def _emitter(prog, colour) -> Material:
 @pytest.mark.parametrize("smooth", [0.0, 2.0])
 def test_an_emitter_seen_by_the_camera_falls_off_over_the_hit_distance(smooth):
     prog, colour = _program(2.0, smooth, FALLOFF)
-    scene = SceneData(camera=ortho_camera(translation(z=HEIGHT)), meshes=[plane(4.0)], instances=[Instance(0, np.eye(4))],
-                      materials=[_emitter(prog, colour)])
+    scene = SceneData(camera=ortho_camera(translation(z=HEIGHT)), meshes=[plane(4.0)],
+                      instances=[Instance(0, np.eye(4))], materials=[_emitter(prog, colour)])
     d = HEIGHT - CLIP
     expected = [_cycles(2.0, smooth, d, o) for o in FALLOFF]
     assert np.allclose(_pixel(scene), expected, rtol=1e-5)
