@@ -191,6 +191,12 @@ def test_light_path_through_transparent_and_glass_matches_cycles(drt, tmp_path):
     _matches_cycles(ns.light_path_glass_scene(), tmp_path, "light-path-glass", "Light Path through glass")
 
 
+def test_light_falloff_matches_cycles(drt, tmp_path):
+    """Quadratic (smoothed) and Linear (its Strength linked) on emissive spheres seen straight and in
+    a sharp mirror (each ray's own length), and Linear at the world (Strength as is)."""
+    _matches_cycles(ns.light_falloff_scene(), tmp_path, "light-falloff", "Light Falloff")
+
+
 def test_wireframe_in_pixels_matches_cycles(drt, tmp_path):
     _matches_cycles(ns.wireframe_scene(), tmp_path, "wireframe-pixels", "Wireframe in pixels")
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from drt_engine.core.scene import Program
-from drt_engine.core.shading.lightpath import OUTPUTS, RayPath, outputs
+from drt_engine.core.shading.lightpath import ESTIMATE_LENGTH, OUTPUTS, RayPath, outputs
 from tests.support.core_cases import Closure, Instance, Material, SceneData, World, ortho_camera, render
 from tests.support.scenes import look_at, plane, translation
 
@@ -132,7 +132,8 @@ def test_the_world_sees_the_camera_its_light_samples_do_not():
 
 def test_outputs_without_a_path_are_a_camera_hits_light_samples():
     out = dict(zip(OUTPUTS, outputs(None, 3)))
-    assert np.all(out["Ray Depth"] == 1.0) and not any(out[k].any() for k in OUTPUTS if k != "Ray Depth")
+    assert np.all(out["Ray Depth"] == 1.0) and np.all(out["Ray Length"] == ESTIMATE_LENGTH)
+    assert not any(out[k].any() for k in OUTPUTS if k not in ("Ray Depth", "Ray Length"))
     bounces = np.array([[2 | 4, 3, 2, 1, 4]])
     seen = dict(zip(OUTPUTS, outputs(RayPath(np.zeros(1, bool), bounces, np.array([2.5])), 1)))
     assert [seen[k][0] for k in ("Is Transmission Ray", "Is Glossy Ray", "Is Reflection Ray", "Ray Depth",

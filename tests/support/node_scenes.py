@@ -1056,6 +1056,48 @@ def light_path_scene(size=48):
     return scene
 
 
+def light_falloff_scene(size=48):
+    """Light Falloff on the Light Path stage's sharp mirror floor: two emissive spheres seen
+    straight (the camera's ray length) and in the mirror (the reflected ray's), one Quadratic
+    smoothed (Strength 4, Smooth 20), one Linear whose Strength is linked (0.5 to the camera, 0.2
+    to the mirror's rays); the world's grey Background of strength Linear (Strength as is there)."""
+    scene = _light_path_stage(size)
+    tree = scene.world.node_tree
+    world_falloff = _node(tree, "ShaderNodeLightFalloff")
+    world_falloff.inputs["Strength"].default_value = 1.0
+    tree.links.new(world_falloff.outputs["Linear"], tree.nodes["Background"].inputs["Strength"])
+
+    def mirror(tree):
+        glossy = _node(tree, "ShaderNodeBsdfGlossy")
+        glossy.inputs["Roughness"].default_value = 0.0
+        glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+        return glossy.outputs["BSDF"]
+
+    def emitting(output, strength, smooth):
+        def build(tree):
+            falloff = _node(tree, "ShaderNodeLightFalloff")
+            if isinstance(strength, tuple):
+                camera = _node(tree, "ShaderNodeLightPath").outputs["Is Camera Ray"]
+                tree.links.new(_scaled(tree, camera, *strength), falloff.inputs["Strength"])
+            else:
+                falloff.inputs["Strength"].default_value = strength
+            falloff.inputs["Smooth"].default_value = smooth
+            emission = _node(tree, "ShaderNodeEmission")
+            emission.inputs["Color"].default_value = (1.0, 0.85, 0.6, 1.0)
+            tree.links.new(falloff.outputs[output], emission.inputs["Strength"])
+            return emission.outputs["Emission"]
+        return build
+
+    bpy.ops.mesh.primitive_plane_add(size=30.0)
+    bpy.context.active_object.data.materials.append(_path_material("Mirror", mirror))
+    for x, name, surface in ((-1.1, "Quadratic", emitting("Quadratic", 4.0, 20.0)),
+                             (1.1, "Linear", emitting("Linear", (0.3, 0.2), 0.0))):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.9, location=(x, 0.0, 1.0), segments=48, ring_count=24)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(_path_material(name, surface))
+    return scene
+
+
 def light_path_glass_scene(size=48):
     """Light Path through a transparent sheet and a sharp glass slab: emissive spheres behind them
     whose colour is made of the node's outputs, one of Is Camera Ray (red: still 1 through the

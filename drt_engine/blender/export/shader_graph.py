@@ -688,6 +688,11 @@ class Compiler:
         """The ray's kind, length and depths at the point (core.shading.lightpath), in the world too."""
         return self.program.add("light_path"), lightpath.OUTPUTS.index(output.identifier)
 
+    def _node_ShaderNodeLightFalloff(self, node, output):
+        """Strength over the ray's length at the point (core.shading.lightpath.falloff), in the world too."""
+        args = (self._in(node, "Strength", "float"), self._in(node, "Smooth", "float"))
+        return self.op("light_falloff", args), lightpath.FALLOFF.index(output.identifier)
+
     # -- the hit's object, triangle and camera (core.shading.geometrynodes) ----------------------
     def _in_world(self, node) -> bool:
         """Whether the node is compiled for the world, where there is no object, triangle or surface

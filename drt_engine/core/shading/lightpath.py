@@ -1,4 +1,5 @@
-"""Blender's Light Path node as Cycles' svm_node_light_path computes it, over a batch of shading points.
+"""Blender's Light Path and Light Falloff nodes as Cycles' svm_node_light_path and
+svm_node_light_falloff compute them, over a batch of shading points.
 
 What a point needs is the ray that brought it there (``RayPath``): whether the camera sees it
 straight (through transparent surfaces only, which keep a ray's kind in Cycles), the kind of
@@ -18,7 +19,10 @@ Emission evaluated by light sampling and the world (seen by a ray or sampled) ar
 Cycles evaluates them, with its emission flag: one bounce further (Ray Depth + 1); a light
 sample has no ray kind, and the world's Ray Length is ``BACKGROUND_LENGTH``. Without a
 ``RayPath`` (the environment's importance table, the emissive triangles' power estimate) a
-point is shaded as the light sample of a camera hit.
+point is shaded as the light sample of a camera hit, ``ESTIMATE_LENGTH`` away.
+
+Light Falloff reads the same Ray Length: a surface hit's distance, a light-sampled emitter's
+distance from the shaded point, the world's FLT_MAX (where Cycles passes Strength through).
 """
 from __future__ import annotations
 
@@ -38,6 +42,11 @@ OUTPUTS = ("Is Camera Ray", "Is Shadow Ray", "Is Diffuse Ray", "Is Glossy Ray", 
            "Is Reflection Ray", "Is Transmission Ray", "Is Volume Scatter Ray", "Ray Length", "Ray Depth",
            "Diffuse Depth", "Glossy Depth", "Transparent Depth", "Transmission Depth", "Portal Depth")
 """The node's outputs, in the order the program's ``light_path`` operation returns them."""
+FALLOFF = ("Quadratic", "Linear", "Constant")
+"""Light Falloff's outputs, in the order the program's ``light_falloff`` operation returns them."""
+ESTIMATE_LENGTH = 1.0
+"""Ray Length where no ray is known (the emissive triangles' power estimate): a unit distance, so
+that emission growing with distance (Light Falloff's Linear and Constant) keeps its light samples."""
 
 
 def camera_bounces(n: int) -> np.ndarray:
@@ -70,8 +79,7 @@ class RayPath:
 def outputs(path: RayPath | None, n: int) -> tuple:
     """The node's outputs (``OUTPUTS``) at ``n`` points reached by ``path`` (None: light samples of
     camera hits, see the module's docstring)."""
-    if path is None:
-        path = RayPath.light_samples(camera_bounces(n), np.zeros(n))
+    path = _known(path, n)
     b = path.bounces
     kind = b[:, KIND]  # 0 for camera rays: transparent surfaces keep a ray's kind
     zero = np.zeros(n)
@@ -85,6 +93,24 @@ def outputs(path: RayPath | None, n: int) -> tuple:
             b[:, TRANSPARENT_DEPTH].astype(float), b[:, TRANSMISSION_DEPTH].astype(float), zero)
 
 
+def falloff(strength, smooth, path: RayPath | None, n: int) -> tuple:
+    """Light Falloff's outputs (``FALLOFF``) at ``n`` points reached by ``path``, as Cycles 5's
+    svm_node_light_falloff: Strength times 1, the Ray Length or its square, smoothed near the
+    light by length² / (Smooth + length²) where Smooth > 0; at the world (FLT_MAX) Strength as is."""
+    length = np.asarray(_known(path, n).length, float)
+    strength = np.broadcast_to(np.asarray(strength, float), (n,))
+    smooth = np.broadcast_to(np.asarray(smooth, float), (n,))
+    squared = length * length
+    soft = np.where(smooth > 0.0, squared / np.where(smooth > 0.0, smooth + squared, 1.0), 1.0)
+    world = length == BACKGROUND_LENGTH
+    return tuple(np.where(world, strength, strength * scale * soft) for scale in (1.0, length, squared))
+
+
+def _known(path: RayPath | None, n: int) -> RayPath:
+    """``path``, or for None the light samples of camera hits ``ESTIMATE_LENGTH`` away."""
+    return RayPath.light_samples(camera_bounces(n), np.full(n, ESTIMATE_LENGTH)) if path is None else path
+
+
 def reads_light_path(program) -> bool:
-    """Whether a shader program (or None) has a Light Path node."""
-    return program is not None and any(node.op == "light_path" for node in program.nodes)
+    """Whether a shader program (or None) reads the ray's path: has a Light Path or a Light Falloff node."""
+    return program is not None and any(node.op in ("light_path", "light_falloff") for node in program.nodes)

@@ -431,6 +431,8 @@ class Evaluator:
             return (self.ctx.backfacing().astype(float),)
         if op == "light_path":
             return lightpath.outputs(self.ctx.light_path, n)
+        if op == "light_falloff":
+            return lightpath.falloff(x[0], x[1], self.ctx.light_path, n)
         if op == "brightness":
             return (cn.brightness_contrast(*x),)
         if op == "curves":
