@@ -121,6 +121,8 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     sampling with light sampling requires.
     """
     n = sel.shape[1]
+    if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False
     count = 0
     acc = 0.0
     for k in range(n):
