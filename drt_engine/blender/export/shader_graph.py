@@ -27,6 +27,12 @@ DISPLACEMENT_MATCHED_FROM = (4, 5)
 4x4 block 0.043 on the tests' displacement scene against a limit of 0.013, 0.065 with the whole
 footprint as its step); before this version the displacement is named in the material's warning."""
 
+FALLOFF_WORLD_MATCHED_FROM = (5, 0)
+"""The first Blender whose Cycles gives a world's Light Falloff as DRT does (Strength as is at the
+world's FLT_MAX ray length; measured with 5.0's and 5.2's Cycles): 4.2's differs (worst 4x4 block
+0.27 on the tests' Light Falloff scene against a limit of 0.043)."""
+VERSION_FALLOFF_WORLD = "this Blender's Light Falloff at the world: rendered as Cycles 5.0+ computes it"
+
 ISLANDS = "geometry:random_per_island"
 POINTINESS = "geometry:pointiness"
 """The corner attributes the geometry export adds for Geometry's Random Per Island and Pointiness
@@ -689,7 +695,10 @@ class Compiler:
         return self.program.add("light_path"), lightpath.OUTPUTS.index(output.identifier)
 
     def _node_ShaderNodeLightFalloff(self, node, output):
-        """Strength over the ray's length at the point (core.shading.lightpath.falloff), in the world too."""
+        """Strength over the ray's length at the point (core.shading.lightpath.falloff), in the world too
+        (named in the world's warning on a Blender whose Cycles computes it otherwise there)."""
+        if self.world and bpy.app.version < FALLOFF_WORLD_MATCHED_FROM:
+            self.issues.add(f"'{node.name}' ({VERSION_FALLOFF_WORLD})")
         args = (self._in(node, "Strength", "float"), self._in(node, "Smooth", "float"))
         return self.op("light_falloff", args), lightpath.FALLOFF.index(output.identifier)
 
