@@ -682,8 +682,8 @@ def test_film_transparent():
 def test_missing_or_unsupported_camera_is_a_scene_error():
     scene = empty_scene()
     scene.camera.data.type = "PANO"
-    scene.camera.data.panorama_type = "CENTRAL_CYLINDRICAL"
-    with pytest.raises(SceneError, match="panorama type CENTRAL_CYLINDRICAL"):
+    scene.camera.data.panorama_type = "FISHEYE_LENS_POLYNOMIAL"
+    with pytest.raises(SceneError, match="panorama type FISHEYE_LENS_POLYNOMIAL"):
         render_export(scene)
     scene.camera = None
     with pytest.raises(SceneError, match="No camera found in scene"):

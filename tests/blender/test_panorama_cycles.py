@@ -117,7 +117,12 @@ def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
     assert combined[1][..., :3].mean() > 0.1  # the box is seen
 
 
-@pytest.mark.parametrize("panorama", ["EQUIANGULAR_CUBEMAP_FACE", "FISHEYE_LENS_POLYNOMIAL", "CENTRAL_CYLINDRICAL"])
+LEFT_OUT = [t for t in ("EQUIANGULAR_CUBEMAP_FACE", "FISHEYE_LENS_POLYNOMIAL", "CENTRAL_CYLINDRICAL")
+            if t in bpy.types.Camera.bl_rna.properties["panorama_type"].enum_items.keys()]
+"""The panorama types DRT does not render that this Blender offers (4.2 has no Central Cylindrical)."""
+
+
+@pytest.mark.parametrize("panorama", LEFT_OUT)
 def test_a_panorama_type_left_out_is_one_clear_error(drt, panorama):
     scene = box_scene(panorama)
     with pytest.raises(SceneError) as error:
