@@ -152,11 +152,13 @@ class Integrator:
             rows = np.flatnonzero(hits.hit & ~on_light)
             if len(rows) == 0:
                 break
+            mat = self.geometry.material_of(hits.prim[rows])
             if len(self.prepared.shaders) > 1:
                 # hits ordered by material (stably): each material's hits are one slice, so its
                 # arrays are views, and per path nothing changes (groups keep their order)
-                rows = rows[np.argsort(self.geometry.material_of(hits.prim[rows]), kind="stable")]
-            surf = self._surface(state, hits, rows, ray_times)
+                order = np.argsort(mat, kind="stable")
+                rows, mat = rows[order], mat[order]
+            surf = self._surface(state, hits, rows, mat, ray_times)
             self._emission_seen(surf, state, hits, out)
             if depth == 0:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
@@ -242,9 +244,9 @@ class Integrator:
             sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
             add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
 
-    def _surface(self, state: PathState, hits, rows, ray_times) -> SurfaceHits:
-        """The surface hits ``rows`` of this depth: position, normals and a frame facing the ray
-        (core.integrator.hits)."""
+    def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
+        """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
+        facing the ray (core.integrator.hits)."""
         n = len(rows)
         pos, ng, frame, wo_l, normal = (np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3)),
                                         np.empty((n, 3)))
@@ -252,7 +254,7 @@ class Integrator:
         surface_hits(self.geometry.tables, hits.prim, hits.u, hits.v, self.geometry.time_values(ray_times),
                      rows, state.dirs, pos, ng, frame, wo_l, inside, scale, normal)
         prim = hits.prim[rows]
-        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=self.geometry.material_of(prim), pos=pos,
+        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=mat, pos=pos,
                            ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
                            wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
                            straight=state.straight[rows], time=state.time[rows], normal=normal,
