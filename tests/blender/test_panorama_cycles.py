@@ -12,6 +12,7 @@ import mathutils
 import numpy as np
 import pytest
 
+from drt_engine.blender.export.shader_graph import FISHEYE_WINDOW_MATCHED_FROM, VERSION_FISHEYE_WINDOW
 from drt_engine.core.errors import SceneError
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
@@ -115,6 +116,47 @@ def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
     print(f"{case}: DRT {figures['worst']:.4f}, Cycles' seeds {figures['cycles_seeds']:.4f}")
     assert figures["ok"], ps.message(case, figures)
     assert combined[1][..., :3].mean() > 0.1  # the box is seen
+
+
+def _window_material():
+    """Emission of Texture Coordinate's Window (u red, v green)."""
+    mat = new_material("window")
+    tree = mat.node_tree
+    tree.nodes.clear()
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(coords.outputs["Window"], emission.inputs["Color"])
+    out = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+    return mat
+
+
+WINDOW_CASES = {name: CASES[name][:2] for name in ("equirectangular", "fisheye_equidistant", "fisheye_equisolid",
+                                                   "mirrorball")}
+
+
+@pytest.mark.parametrize("case", WINDOW_CASES)
+def test_window_coordinates_under_a_panoramic_camera_match_cycles(drt, tmp_path, case):
+    """Cycles inverts the panorama's projection for Window; the perspective formula paints
+    other gradients here and fails. A Blender whose Cycles mirrors it under a fisheye (4.2's) has
+    the node named in the material's warning."""
+    panorama, settings = WINDOW_CASES[case]
+    scene = box_scene(panorama, **settings)
+    window = _window_material()
+    for obj in scene.collection.objects:
+        if obj.type == "MESH":
+            obj.data.materials[0] = window
+    warnings = render_export(scene).warnings
+    if panorama.startswith("FISHEYE") and bpy.app.version < FISHEYE_WINDOW_MATCHED_FROM:
+        assert len(warnings) == 1 and VERSION_FISHEYE_WINDOW in warnings[0], warnings
+        return
+    assert not warnings, warnings
+    renders = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=f"window-{case}") for engine, seed in ps.RUNS]
+    combined = [r.passes["Combined"] for r in renders]
+    figures = ps.parity(*combined)
+    print(f"window {case}: DRT {figures['worst']:.4f}, Cycles' seeds {figures['cycles_seeds']:.4f}")
+    assert figures["ok"], ps.message(f"window {case}", figures)
+    assert combined[1][..., :2].std() > 0.1  # the gradients are seen
 
 
 LEFT_OUT = [t for t in ("EQUIANGULAR_CUBEMAP_FACE", "FISHEYE_LENS_POLYNOMIAL", "CENTRAL_CYLINDRICAL")

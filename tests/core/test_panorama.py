@@ -127,3 +127,16 @@ def test_a_moving_panoramic_camera_turns_its_rays_with_it():
     d = still.directions[0] @ _matrix()[:3, :3]
     assert np.allclose(rays.directions[0], _matrix()[:3, :3] @ d, atol=1e-12)
     assert np.allclose(rays.directions[1], turned[:3, :3] @ d, atol=1e-9)
+
+
+@pytest.mark.parametrize("panorama", PANORAMA_TYPES)
+def test_window_of_a_point_on_a_ray_is_its_image_point(panorama):
+    """Texture Coordinate's Window under a panorama: the image point whose ray reaches the point."""
+    cam = _camera(panorama)
+    rng = np.random.default_rng(4)
+    px, py = rng.random(3000) * W, rng.random(3000) * H
+    rays = camera_rays.generate(cam, px, py, None)
+    ok = rays.valid
+    points = rays.origins[ok] + rays.directions[ok] * rng.uniform(0.5, 30.0, ok.sum())[:, None]
+    u, v = camera_rays.panorama_window(cam, points).T
+    assert np.allclose(u, px[ok] / W, atol=1e-9) and np.allclose(v, py[ok] / H, atol=1e-9)

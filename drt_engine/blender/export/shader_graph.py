@@ -33,6 +33,12 @@ world's FLT_MAX ray length; measured with 5.0's and 5.2's Cycles): 4.2's differs
 0.27 on the tests' Light Falloff scene against a limit of 0.043)."""
 VERSION_FALLOFF_WORLD = "this Blender's Light Falloff at the world: rendered as Cycles 5.0+ computes it"
 
+FISHEYE_WINDOW_MATCHED_FROM = (4, 3)
+"""The first Blender whose Cycles gives Texture Coordinate's Window under a fisheye as DRT does,
+the image point of the ray (measured in 4.3.2, 5.0 and 5.2); 4.2's Cycles mirrors u about the
+image's centre there (worst 4x4 block 0.88 on the panorama tests' Window scene)."""
+VERSION_FISHEYE_WINDOW = "Window under this Blender's fisheye camera: rendered as Cycles 4.3+ computes it"
+
 ISLANDS = "geometry:random_per_island"
 POINTINESS = "geometry:pointiness"
 """The corner attributes the geometry export adds for Geometry's Random Per Island and Pointiness
@@ -340,7 +346,14 @@ class Compiler:
                  "Reflection": "reflection", "Window": "window"}
         if name not in table:
             return self._unsupported(node, f"Texture Coordinate {name}")
+        if name == "Window" and bpy.app.version < FISHEYE_WINDOW_MATCHED_FROM and self._fisheye():
+            self.issues.add(f"'{node.name}' ({VERSION_FISHEYE_WINDOW})")
         return self._coord(table[name])
+
+    def _fisheye(self) -> bool:
+        camera = self.layer[0].camera if self.layer is not None else None
+        return (camera is not None and camera.type == "CAMERA" and camera.data.type == "PANO"
+                and camera.data.panorama_type.startswith("FISHEYE"))
 
     def _node_ShaderNodeUVMap(self, node, output):
         return self._coord("uv", node.uv_map)

@@ -87,6 +87,56 @@ def panorama_direction(lens, u, v):
 
 
 @kernel
+def panorama_point(lens, dx, dy, dz):
+    """Image point (u, v) of unit direction d in Cycles' panorama frame, the inverse of
+    ``panorama_direction``: Cycles' direction_to_panorama, which Texture Coordinate's Window reads."""
+    kind = lens[0]
+    if kind == EQUIRECTANGULAR:
+        return ((math.atan2(dy, dx) - lens[15]) / lens[14],
+                (math.acos(min(max(dz, -1.0), 1.0)) - lens[17]) / lens[16])
+    if kind == MIRRORBALL:  # the ball's normal halfway between the view (0, -1, 0) and d
+        dy -= 1.0
+        div = 2.0 * math.sqrt(max(-0.5 * dy, 0.0))
+        if div > 0.0:
+            dx, dz = dx / div, dz / div
+        return 0.5 * (dx + 1.0), 0.5 * (dz + 1.0)
+    across = math.sqrt(dy * dy + dz * dz)
+    if across == 0.0:
+        return 0.5, 0.5
+    if kind == FISHEYE_EQUIDISTANT:
+        r = math.atan2(across, dx) / lens[18]  # 0.5 on the circle (theta half the fov)
+        return 0.5 - r * dy / across, 0.5 + r * dz / across
+    r = 2.0 * lens[19] * math.sin(0.5 * math.acos(min(max(dx, -1.0), 1.0)))
+    return 0.5 - r * dy / across / lens[20], 0.5 + r * dz / across / lens[21]
+
+
+@kernel
+def _panorama_points(lens, m, points, out):
+    """``panorama_point`` of each world point seen from the camera (``m``: world to camera, 3 x 4)."""
+    for i in range(len(points)):
+        px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+        cx = m[0, 0] * px + m[0, 1] * py + m[0, 2] * pz + m[0, 3]
+        cy = m[1, 0] * px + m[1, 1] * py + m[1, 2] * pz + m[1, 3]
+        cz = m[2, 0] * px + m[2, 1] * py + m[2, 2] * pz + m[2, 3]
+        # the camera's frame (looking down -z, y up) into Cycles' panorama frame (x ahead, z up;
+        # the mirror ball's looks down -y), as panorama_ray turns it the other way
+        if lens[0] == MIRRORBALL:
+            x, y, z = unit(cx, cz, cy)
+        else:
+            x, y, z = unit(-cz, -cx, cy)
+        out[i, 0], out[i, 1] = panorama_point(lens, x, y, z)
+
+
+def panorama_window(camera: Camera, points: np.ndarray) -> np.ndarray:
+    """(N, 2) image points (0 to 1 over the unshifted image) of world ``points`` through a
+    panoramic camera at mid-shutter, as Cycles' camera_world_to_ndc has them."""
+    out = np.empty((len(points), 2))
+    _panorama_points(lens_table(camera), np.ascontiguousarray(np.linalg.inv(camera.matrix)[:3]),
+                     np.ascontiguousarray(points, np.float64), out)
+    return out
+
+
+@kernel
 def aperture_sample(lens, u0, u1):
     """Uniform point on the aperture: a disk, or a regular polygon with ``blades`` sides."""
     blades = int(lens[9])

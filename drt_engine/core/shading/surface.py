@@ -17,6 +17,7 @@ import numpy as np
 from ..base import vectors as vec
 from ..base.constants import TINY
 from ..bsdf.shader import MaterialShader, Tables
+from ..geometry.camera import panorama_window
 from ..scene import Closure, Material, SceneData
 from . import geometrynodes as gn
 from .nodes import Evaluator
@@ -145,8 +146,11 @@ class SurfaceContext:
 
     def _window(self):
         """Cycles' camera_world_to_ndc: the point projected into the camera's full frame, (0, 0)
-        at its bottom left and (1, 1) at its top right, z 0."""
+        at its bottom left and (1, 1) at its top right, z 0 (a panorama's: its own projection's
+        inverse, core.geometry.camera)."""
         cam = self.attrs.scene.camera
+        if cam.type == "PANO":
+            return np.concatenate([panorama_window(cam, self.pos), np.zeros((self.n, 1))], axis=1)
         m = np.linalg.inv(cam.matrix)
         p = self.pos @ m[:3, :3].T + m[:3, 3]
         s = p[:, :2] / np.where(p[:, 2:] < 0, -p[:, 2:], TINY) if cam.type == "PERSP" else p[:, :2]
