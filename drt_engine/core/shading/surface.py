@@ -200,26 +200,42 @@ class SurfaceContext:
 
 
 class SurfaceAttributes:
-    """Per-triangle access to the meshes' corner data through ``Geometry.source_of``."""
+    """Per-triangle access to the meshes' corner data through ``Geometry.source_of``.
+
+    Corner data depends on the mesh only, so hits are grouped by mesh (ten thousand instances of
+    one mesh are one group); what depends on the instance (its transform, Object Info, its
+    attributes) is gathered per hit from arrays over the instances, made once."""
 
     def __init__(self, scene: SceneData, geometry):
         self.scene = scene
         self.geometry = geometry
-        self._mesh_of = np.array([instance.mesh for instance in scene.instances], np.int64)
+        instances = scene.instances
+        self._mesh_of = np.array([instance.mesh for instance in instances], np.int64)
+        self._matrix = np.array([instance.matrix for instance in instances]).reshape(-1, 4, 4)
+        self._color = np.array([instance.color for instance in instances]).reshape(-1, 4)
+        self._pass_index = np.array([instance.pass_index for instance in instances], np.float64)
+        self._random = np.array([instance.random for instance in instances], np.float64)
+        self._instance_values = {}  # attribute key -> (instances, 4)
         self._texspaces = {}  # id(mesh) -> (corner, size); the scene outlives this object
 
+    def _instances(self, prim):
+        """The instance of each hit."""
+        return self.geometry.source_of(prim)[:, 0]
+
     def _groups(self, prim):
+        """(hits, mesh, their triangles in it) per mesh the hits ``prim`` are on."""
         source = self.geometry.source_of(prim)
-        inst = source[:, 0]
-        for i in np.unique(inst):
-            sel = np.flatnonzero(inst == i)
-            yield sel, self.scene.instances[i], self.scene.meshes[self._mesh_of[i]], source[sel, 1]
+        mesh = self._mesh_of[source[:, 0]]
+        order = np.argsort(mesh, kind="stable")
+        bounds = np.flatnonzero(np.diff(mesh[order])) + 1
+        for sel in np.split(order, bounds) if len(order) else ():
+            yield sel, self.scene.meshes[mesh[sel[0]]], source[sel, 1]
 
     def corner(self, prim, bary, key):
         kind, name = key
         width = 2 if kind == "uv" else 4
         out = np.zeros((len(prim), width))
-        for sel, _, mesh, tri in self._groups(prim):
+        for sel, mesh, tri in self._groups(prim):
             if name:
                 data = mesh.attributes.get(name)
             else:
@@ -235,42 +251,37 @@ class SurfaceAttributes:
         return out
 
     def instance_attribute(self, prim, key):
-        out = np.zeros((len(prim), 4))
-        for sel, inst, _, _ in self._groups(prim):
-            value = inst.attributes.get(key)
-            if value is not None:
-                out[sel] = value
-        return out
+        values = self._instance_values.get(key)
+        if values is None:
+            none = np.zeros(4)
+            values = self._instance_values[key] = np.array(
+                [instance.attributes.get(key, none) for instance in self.scene.instances]).reshape(-1, 4)
+        return values[self._instances(prim)]
 
     def width(self, prim, name):
         out = np.zeros(len(prim), np.int64)
-        for sel, _, mesh, _ in self._groups(prim):
+        for sel, mesh, _ in self._groups(prim):
             data = mesh.attributes.get(name) if name else mesh.colors
             out[sel] = 0 if data is None else data.shape[2]
         return out
 
     def object_position(self, prim, bary):
         out = np.zeros((len(prim), 3))
-        for sel, _, mesh, tri in self._groups(prim):
+        for sel, mesh, tri in self._groups(prim):
             out[sel] = np.einsum("ni,nij->nj", bary[sel], mesh.vertices[mesh.triangles[tri]])
         return out
 
     def object_matrix(self, prim):
-        out = np.empty((len(prim), 4, 4))
-        for sel, inst, _, _ in self._groups(prim):
-            out[sel] = inst.matrix
-        return out
+        return self._matrix[self._instances(prim)]
 
     def object_normal(self, prim, normal):
-        out = np.zeros((len(prim), 3))
-        for sel, inst, _, _ in self._groups(prim):
-            out[sel] = vec.normalize(normal[sel] @ inst.matrix[:3, :3], 1e-300)
-        return out
+        m = self._matrix[self._instances(prim), :3, :3]
+        return vec.normalize(np.einsum("nj,njk->nk", normal, m), 1e-300)
 
     def texspace(self, prim):
         lo = np.zeros((len(prim), 3))
         size = np.ones((len(prim), 3))
-        for sel, _, mesh, _ in self._groups(prim):
+        for sel, mesh, _ in self._groups(prim):
             lo[sel], size[sel] = self._texspace_of(mesh)
         return lo, size
 
@@ -297,22 +308,16 @@ class SurfaceAttributes:
 
     def object_info(self, prim):
         """Per hit: the object's location (mid-shutter), colour, alpha, pass index and random number."""
-        n = len(prim)
-        location, color = np.zeros((n, 3)), np.zeros((n, 4))
-        index, random = np.zeros(n), np.zeros(n)
-        for sel, inst, _, _ in self._groups(prim):
-            location[sel] = inst.matrix[:3, 3]
-            color[sel] = inst.color
-            index[sel] = inst.pass_index
-            random[sel] = inst.random
-        return location, color[:, :3], color[:, 3].copy(), index, random
+        inst = self._instances(prim)
+        color = self._color[inst]
+        return self._matrix[inst, :3, 3], color[:, :3], color[:, 3].copy(), self._pass_index[inst], self._random[inst]
 
     def object_tangent(self, prim, bary, uv_map):
         """Object-space MikkTSpace tangents of the UV map interpolated at the hits, their bitangent
         signs, and where the mesh has them."""
         n = len(prim)
         t, sign, found = np.zeros((n, 3)), np.ones(n), np.zeros(n, bool)
-        for sel, _, mesh, tri in self._groups(prim):
+        for sel, mesh, tri in self._groups(prim):
             data = mesh.attributes.get("tangent:" + uv_map)
             if data is not None:
                 v = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
@@ -339,16 +344,20 @@ class SurfaceAttributes:
         t, sign = self._triangle_tangent(prim, normal, uv_map)
         if bary is None:
             return t, sign
-        for sel, inst, mesh, tri in self._groups(prim):
+        inst = None
+        for sel, mesh, tri in self._groups(prim):
             data = mesh.attributes.get("tangent:" + uv_map)
             if data is None:
                 continue
+            inst = self._instances(prim) if inst is None else inst
+            m = self._matrix[inst[sel], :3, :3]
             v = np.einsum("ni,nij->nj", bary[sel], data[tri].astype(np.float64))
-            world = v[:, :3] @ inst.matrix[:3, :3].T
+            world = np.einsum("nkj,nj->nk", m, v[:, :3])
             world -= normal[sel] * np.einsum("ij,ij->i", world, normal[sel])[:, None]
             ok = np.linalg.norm(world, axis=1) > 1e-12
             t[sel[ok]] = vec.normalize(world[ok], 1e-300)
-            sign[sel] = np.where(v[:, 3] < 0, -1.0, 1.0) * np.sign(np.linalg.det(inst.matrix[:3, :3]) or 1.0)
+            det = np.linalg.det(m)
+            sign[sel] = np.where(v[:, 3] < 0, -1.0, 1.0) * np.where(det == 0.0, 1.0, np.sign(det))
         return t, sign
 
     def _triangle_tangent(self, prim, normal, uv_map):
