@@ -16,6 +16,7 @@
 #                    the true error (bench/denoise_figures.py --calibration: docs/denoising.md, bench/denoise_calibration.json)
 #   make bench-farm  Dask per-task overhead, 2 local workers vs 1 process, N-machine model (bench/farm.py)
 #   make texture-parity  DRT vs Cycles per procedural texture and mode (bench/texture_parity.py: docs/shader-node-parity.md)
+#   make node-parity DRT vs Cycles per shader node case and closure (bench/node_parity.py: docs/shader-node-parity.md)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes the venvs and wheels/
 #   make blender-env build (once, cached in BLENDER_ENV) a Debian 13 root with Blender 4.3.2; needs root
@@ -52,7 +53,7 @@ STAGE := $(DIST)/.stage
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-instances bench-ratio bench-denoise bench-farm texture-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-instances bench-ratio bench-denoise bench-farm texture-parity node-parity clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -157,3 +158,6 @@ test-blender: blender-env extension
 
 texture-parity: $(STAMP)
 	$(PY) bench/texture_parity.py
+
+node-parity: $(STAMP)
+	$(PY) bench/node_parity.py

@@ -78,12 +78,9 @@ def test_fresnel_and_layer_weight_on_spheres_match_cycles(drt, tmp_path):
     scene = ns.facing_scene()
     drt_render, c0, c1 = ps.parity_renders(scene, tmp_path, "facing")
     rh.save_side_by_side("fresnel-layer-weight", drt_render.rgb, c0.rgb)
-    size = c0.rgb.shape[0] // 2
-    for row, side in enumerate(("front", "back")):
-        for i, (name, _) in enumerate(ns.FACING):
-            part = (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size))
-            figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
-            assert figures["ok"], ps.message(f"{name} ({side})", figures)
+    for name, side, part in ns.facing_parts(c0.rgb.shape[0] // 2):
+        figures = ps.parity(drt_render.rgb[part], c0.rgb[part], c1.rgb[part])
+        assert figures["ok"], ps.message(f"{name} ({side})", figures)
 
 
 class _Socket:
@@ -315,8 +312,7 @@ def test_closure_matches_cycles(closures, case):
         assert len(named) == 1 and VERSION_OREN_NAYAR in named[0], warnings
         return
     assert not named, warnings
-    i, size, m = CLOSURE_CASES.index(case), renders[0].rgb.shape[0], ps.MARGIN
-    part = (slice(m, size - m), slice(i * size + m, (i + 1) * size - m))
+    part = ns.closure_part(CLOSURE_CASES.index(case), renders[0].rgb.shape[0])
     figures = ps.parity(*(r.rgb[part] for r in renders))
     print(f"{case.name}: {figures}")
     assert figures["ok"], ps.message(case.name, figures)

@@ -596,6 +596,12 @@ coordinates in perspective: a diffuse sphere each, coloured by the node, in fron
 normals turned inwards, from the back."""
 
 
+def facing_parts(size: int):
+    """(case, side, pixels) of each sphere of ``facing_scene``'s image: the front row, then the back."""
+    return [(name, side, (slice(row * size, (row + 1) * size), slice(i * size, (i + 1) * size)))
+            for row, side in enumerate(("front", "back")) for i, (name, _) in enumerate(FACING)]
+
+
 def facing_scene(size=32):
     """The FACING cases on smooth diffuse spheres under a uniform white world (each point of a
     sphere then reflects its colour), seen in perspective: the incoming direction meets the
@@ -933,6 +939,13 @@ CLOSURES = (
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
 textured, and a Principled BSDF's Diffuse Roughness) and upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front)."""
+
+
+def closure_part(i: int, size: int):
+    """Case i's square of ``closure_scene``'s image without its edge pixels (the pixel filter's
+    reach into the next square)."""
+    m = ps.MARGIN
+    return slice(m, size - m), slice(i * size + m, (i + 1) * size - m)
 
 
 def closure_scene(cases, size=32):

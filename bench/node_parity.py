@@ -1,0 +1,101 @@
+"""Measure DRT's shader nodes and closures against Cycles and write the figures into docs/shader-node-parity.md.
+
+Renders the scenes tests/blender/test_node_parity.py holds DRT to (the grid of node cases, the
+spheres of the nodes that see the view, the closures' squares, and the scenes compared whole:
+Pointiness, attributes, Object Info, Light Path, Light Falloff, Wireframe, displacement, the
+mirror-ball environment and each sky model this Blender offers) with DRT (seed 0) and Cycles (seeds
+0 and 1), writes docs/node_parity.json, and replaces the page's block between the markers below
+with each case's worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
+A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
+Run from the repository root: .venv/bin/python bench/node_parity.py (``make node-parity``).
+"""
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import bpy  # noqa: E402
+
+import drt_engine  # noqa: E402
+from bench.blocks import replace_between  # noqa: E402
+from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM  # noqa: E402
+from drt_engine.blender.export.shader_graph import (DISPLACEMENT_MATCHED_FROM,  # noqa: E402
+                                                   FALLOFF_WORLD_MATCHED_FROM)
+from tests.support import node_scenes as ns  # noqa: E402
+from tests.support import procedural_scenes as ps  # noqa: E402
+from tests.support import sky_scenes  # noqa: E402
+
+MARK_BEGIN, MARK_END = "<!-- node parity: begin -->", "<!-- node parity: end -->"
+JSON_PATH = ROOT / "docs" / "node_parity.json"
+PAGE = ROOT / "docs" / "shader-node-parity.md"
+NAMED = "named in the warning: this Blender's Cycles computes it otherwise"
+
+
+def _whole_scenes() -> dict:
+    """Label -> (scene builder, first Blender whose Cycles DRT matches) of the scenes compared whole."""
+    scenes = {"Geometry Pointiness": (ns.pointiness_scene, (0, 0)),
+              "Attribute Object, Instancer, View Layer": (ns.attribute_scene, (0, 0)),
+              "Environment Texture Mirror Ball": (ns.mirror_ball_scene, (0, 0)),
+              "Object Info": (ns.object_info_scene, (0, 0)),
+              "Light Path (camera, length, depths; in a mirror)": (ns.light_path_scene, (0, 0)),
+              "Light Path through transparent and glass": (ns.light_path_glass_scene, (0, 0)),
+              "Light Falloff (surfaces and world)": (ns.light_falloff_scene, FALLOFF_WORLD_MATCHED_FROM),
+              "Wireframe in pixels": (ns.wireframe_scene, (0, 0)),
+              "Displacement socket as bump": (ns.displacement_scene, DISPLACEMENT_MATCHED_FROM)}
+    for name, props in sky_scenes.CASES.items():
+        if sky_scenes.offered(props["sky_type"]):
+            scenes[f"Sky Texture {name}"] = (lambda props=props: sky_scenes.sky_scene(props), (0, 0))
+    return scenes
+
+
+def _figures(renders, part=(slice(None), slice(None))) -> dict:
+    return ps.parity(*(r.rgb[part] for r in renders))
+
+
+def measure() -> dict:
+    cases = {}
+    with tempfile.TemporaryDirectory() as out:
+        grid = ps.grid_tiles(ns.grid_scene(), len(ns.CASES), out, "nodes")
+        cases.update({case.name: ps.tile_figures(grid, i) for i, case in enumerate(ns.CASES)})
+        facing = ps.parity_renders(ns.facing_scene(), out, "facing")
+        for name, side, part in ns.facing_parts(facing[0].rgb.shape[0] // 2):
+            cases[f"{name} ({side})"] = _figures(facing, part)
+        closures = [c for c in ns.CLOSURES if bpy.app.version >= c.since]
+        renders = ps.parity_renders(ns.closure_scene(closures), out, "closures")
+        for i, case in enumerate(closures):
+            named = case.oren_nayar and bpy.app.version < OREN_NAYAR_MATCHED_FROM
+            cases[case.name] = NAMED if named else _figures(renders, ns.closure_part(i, renders[0].rgb.shape[0]))
+        for label, (build, since) in _whole_scenes().items():
+            cases[label] = NAMED if bpy.app.version < since else _figures(ps.parity_renders(build(), out, "whole"))
+    return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "cases": cases}
+
+
+def table(figures: dict) -> str:
+    rows = [f"Measured by `bench/node_parity.py` (Blender {figures['blender']}, {figures['samples']} samples): "
+            "the worst 4x4-block difference of DRT from Cycles, beside Cycles' own worst between two seeds; "
+            "a case passes at 1.5x that plus 0.002.", "",
+            "| node or closure | DRT vs Cycles | Cycles vs Cycles | within |", "|---|---|---|---|"]
+    for name, f in figures["cases"].items():
+        if isinstance(f, str):
+            rows.append(f"| {name} | {f} | | |")
+        else:
+            rows.append(f"| {name} | {f['worst']:.4f} | {f['cycles_seeds']:.4f} | {'yes' if f['ok'] else '**no**'} |")
+    return "\n".join(rows) + "\n"
+
+
+def main() -> None:
+    drt_engine.register()
+    figures = measure()
+    JSON_PATH.write_text(json.dumps(figures, indent=1) + "\n")
+    replace_between(PAGE, MARK_BEGIN, MARK_END, table(figures))
+    failed = [name for name, f in figures["cases"].items() if not isinstance(f, str) and not f["ok"]]
+    print(f"{len(figures['cases'])} cases, {len(failed)} outside the limit" + (f": {failed}" if failed else ""))
+
+
+if __name__ == "__main__":
+    main()
