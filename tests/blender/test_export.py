@@ -762,3 +762,23 @@ def test_export_can_be_cancelled():
     add_object(scene, "Cube", cube_mesh())
     with pytest.raises(RenderCancelled):
         export_scene(bpy.context.evaluated_depsgraph_get(), cancel=lambda: True)
+
+
+def test_object_types_drt_does_not_render_are_named_in_one_warning():
+    """Hair curves, point clouds, volumes and hair particles render in Cycles; DRT leaves them out,
+    never silently. Text and curves reach the export as meshes and render; an empty renders in neither."""
+    scene = empty_scene()
+    add_object(scene, "Cube", cube_mesh())
+    for name, data in (("Strands", bpy.data.hair_curves.new("Strands")), ("Points", bpy.data.pointclouds.new("Points")),
+                       ("Smoke", bpy.data.volumes.new("Smoke")), ("Label", bpy.data.curves.new("Label", "FONT")),
+                       ("Empty", None)):
+        scene.collection.objects.link(bpy.data.objects.new(name, data))
+    fur = add_object(scene, "Furry", cube_mesh())
+    fur.modifiers.new("Fur", "PARTICLE_SYSTEM").particle_system.settings.type = "HAIR"
+    data = render_export(scene)
+    (warning,) = data.warnings
+    for name, what in (("Strands", "hair curves"), ("Points", "point cloud"), ("Smoke", "volume"),
+                       ("Furry", "hair particles")):
+        assert f"'{name}' ({what})" in warning, warning
+    assert "Label" not in warning and "Empty" not in warning and "'Cube'" not in warning
+    assert len(data.instances) == 3  # the two cubes and the text

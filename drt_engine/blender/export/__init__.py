@@ -23,6 +23,10 @@ from .world import export_world
 CANCEL_CHECK_INTERVAL = 256
 """Instances exported between two calls of the cancel callback."""
 
+LEFT_OUT_TYPES = {"CURVES": "hair curves", "POINTCLOUD": "point cloud", "VOLUME": "volume"}
+"""Object types Cycles renders and DRT does not yet (text, curves and surfaces reach the export as
+meshes; empties, armatures, grease pencil and the like render in neither)."""
+
 
 def export_scene(
     depsgraph,
@@ -49,6 +53,7 @@ def export_scene(
     geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes)
     lights = []
     light_keys = []
+    left_out: dict[str, str] = {}  # object name -> what of it is not rendered
     for count, instance in enumerate(depsgraph.object_instances):
         if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
             raise RenderCancelled("Render cancelled during scene export")
@@ -61,10 +66,17 @@ def export_scene(
             if light is not None:
                 lights.append(light)
                 light_keys.append(instance_key(instance))
+        elif obj.type in LEFT_OUT_TYPES:
+            left_out[obj.name] = LEFT_OUT_TYPES[obj.type]
         else:
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
+            if not instance.is_instance and obj.type == "MESH" and _shows_hair(obj, depsgraph.mode == "RENDER"):
+                left_out[obj.name] = "hair particles"
     geometry.finish()
+    if left_out:
+        warnings.append("not rendered (DRT does not render these yet): "
+                        + ", ".join(f"'{name}' ({what})" for name, what in sorted(left_out.items())))
     scene_data = SceneData(
         camera=camera,
         meshes=geometry.meshes,
@@ -79,3 +91,10 @@ def export_scene(
     if frame_set is not None:
         add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)
     return scene_data
+
+
+def _shows_hair(obj, render: bool) -> bool:
+    """Whether the object shows hair particles as strands (Cycles renders them as curves)."""
+    return any(m.type == "PARTICLE_SYSTEM" and (m.show_render if render else m.show_viewport)
+               and m.particle_system.settings.type == "HAIR" and m.particle_system.settings.render_type == "PATH"
+               for m in obj.modifiers)
