@@ -14,6 +14,8 @@ from ...core.errors import RenderCancelled
 from ...core.scene import SceneData
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
+from .left_out import TYPES as LEFT_OUT_TYPES
+from .left_out import LeftOut
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key
@@ -22,10 +24,6 @@ from .world import export_world
 
 CANCEL_CHECK_INTERVAL = 256
 """Instances exported between two calls of the cancel callback."""
-
-LEFT_OUT_TYPES = {"CURVES": "hair curves", "POINTCLOUD": "point cloud", "VOLUME": "volume"}
-"""Object types Cycles renders and DRT does not yet (text, curves and surfaces reach the export as
-meshes; empties, armatures, grease pencil and the like render in neither)."""
 
 
 def export_scene(
@@ -53,37 +51,34 @@ def export_scene(
     geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes)
     lights = []
     light_keys = []
-    left_out: dict[str, str] = {}  # object name -> what of it is not rendered
+    left_out = LeftOut(depsgraph.mode == "RENDER")
     for count, instance in enumerate(depsgraph.object_instances):
         if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
             raise RenderCancelled("Render cancelled during scene export")
         if not instance.show_self:
             continue
         obj = instance.object
+        left_out.look_at(obj, instance.is_instance)
         matrix = np.array(instance.matrix_world, dtype=np.float64)
         if obj.type == "LIGHT":
             light = export_light(obj, matrix, warnings)
             if light is not None:
                 lights.append(light)
                 light_keys.append(instance_key(instance))
-        elif obj.type in LEFT_OUT_TYPES:
-            left_out[obj.name] = LEFT_OUT_TYPES[obj.type]
-        else:
+        elif obj.type not in LEFT_OUT_TYPES:
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
-            if not instance.is_instance and obj.type == "MESH" and _shows_hair(obj, depsgraph.mode == "RENDER"):
-                left_out[obj.name] = "hair particles"
     geometry.finish()
-    if left_out:
-        warnings.append("not rendered (DRT does not render these yet): "
-                        + ", ".join(f"'{name}' ({what})" for name, what in sorted(left_out.items())))
+    world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
+    left_out.look_at_world(world)
+    warnings.extend(left_out.warnings())
     scene_data = SceneData(
         camera=camera,
         meshes=geometry.meshes,
         instances=geometry.instances,
         materials=materials.materials,
         lights=lights,
-        world=export_world(getattr(depsgraph.view_layer, "world_override", None) or scene.world, warnings, images),
+        world=export_world(world, warnings, images),
         images=images.images,
         film_transparent=scene.render.film_transparent,
         warnings=warnings,
@@ -92,9 +87,3 @@ def export_scene(
         add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)
     return scene_data
 
-
-def _shows_hair(obj, render: bool) -> bool:
-    """Whether the object shows hair particles as strands (Cycles renders them as curves)."""
-    return any(m.type == "PARTICLE_SYSTEM" and (m.show_render if render else m.show_viewport)
-               and m.particle_system.settings.type == "HAIR" and m.particle_system.settings.render_type == "PATH"
-               for m in obj.modifiers)

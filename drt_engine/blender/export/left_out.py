@@ -1,0 +1,90 @@
+"""What of a scene Cycles renders and DRT does not yet, found while exporting: objects of the types
+it leaves out (one warning) and object and light settings it does not read (another), so that a
+scene relying on them is never rendered differently without a word.
+
+Each object is looked at once (its instances share its settings). Lights' camera visibility and
+the world's ray visibility are read (export.lights, export.world) and so are not listed here.
+"""
+from __future__ import annotations
+
+TYPES = {"CURVES": "hair curves", "POINTCLOUD": "point cloud", "VOLUME": "volume"}
+"""Object types Cycles renders and DRT does not (text, curves and surfaces reach the export as
+meshes; empties, armatures, grease pencil and the like render in neither)."""
+
+SHOWN = 3
+"""Object names a setting's entry shows before "and N more"."""
+
+OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning calls another value
+    ("visible_camera", True, "camera ray visibility off"),
+    ("visible_shadow", True, "shadow ray visibility off"),
+    ("visible_diffuse", True, "diffuse ray visibility off"),
+    ("visible_glossy", True, "glossy ray visibility off"),
+    ("visible_transmission", True, "transmission ray visibility off"),
+    ("is_holdout", False, "holdout"),
+    ("is_shadow_catcher", False, "shadow catcher"),
+)
+LIGHT_SETTINGS = OBJECT_SETTINGS[2:5]
+"""A light's own camera visibility is read; its shadow visibility is Cast Shadow (below)."""
+
+
+class LeftOut:
+    """What of the exported objects DRT does not render: objects by their name, settings by what is
+    left out. ``render``: the depsgraph is a final render's (modifiers' render switches apply)."""
+
+    def __init__(self, render: bool):
+        self.render = render
+        self._seen: set[str] = set()
+        self._objects: dict[str, str] = {}  # object name -> what of it is not rendered
+        self._names: dict[str, list[str]] = {}
+
+    def look_at(self, obj, instanced: bool) -> None:
+        """Note what of ``obj`` DRT leaves out (once per object; ``instanced``: seen as an instance,
+        whose particle systems are its instancer's)."""
+        name = obj.name
+        if name in self._seen:
+            return
+        self._seen.add(name)
+        if obj.type in TYPES:
+            self._objects[name] = TYPES[obj.type]
+        elif obj.type == "MESH" and not instanced and self._shows_hair(obj):
+            self._objects[name] = "hair particles"
+        light = obj.type == "LIGHT"
+        for attribute, rendered, what in LIGHT_SETTINGS if light else OBJECT_SETTINGS:
+            if getattr(obj, attribute, rendered) != rendered:
+                self._add(what, name)
+        if light and not getattr(obj.data, "use_shadow", True):
+            self._add("cast shadow off", name)
+        linking = getattr(obj, "light_linking", None)  # Blender 4.0+
+        if linking is not None and (linking.receiver_collection is not None or linking.blocker_collection is not None):
+            self._add("light or shadow linking", name)
+        if getattr(obj, "lightgroup", ""):
+            self._add("light group", name)
+
+    def look_at_world(self, world) -> None:
+        if world is not None and getattr(world, "lightgroup", ""):
+            self._add("light group", f"world '{world.name}'")
+
+    def _shows_hair(self, obj) -> bool:
+        """Whether the object shows hair particles as strands (Cycles renders them as curves)."""
+        return any(m.type == "PARTICLE_SYSTEM" and (m.show_render if self.render else m.show_viewport)
+                   and m.particle_system.settings.type == "HAIR" and m.particle_system.settings.render_type == "PATH"
+                   for m in obj.modifiers)
+
+    def _add(self, what: str, name: str) -> None:
+        self._names.setdefault(what, []).append(name)
+
+    def warnings(self) -> list[str]:
+        """One line naming the objects not rendered, one naming every setting left out and the
+        objects that use it (each only when there is something to name)."""
+        out = []
+        if self._objects:
+            out.append("not rendered (DRT does not render these yet): "
+                       + ", ".join(f"'{name}' ({what})" for name, what in sorted(self._objects.items())))
+        if not self._names:
+            return out
+        parts = []
+        for what, names in self._names.items():
+            shown = ", ".join(n if n.startswith("world '") else f"'{n}'" for n in names[:SHOWN])
+            more = f" and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
+            parts.append(f"{what} ({shown}{more})")
+        return out + ["object and light settings DRT does not render yet, rendered as if unset: " + "; ".join(parts)]
