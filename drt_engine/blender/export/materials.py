@@ -214,12 +214,24 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     output = material.node_tree.get_output_node("CYCLES")
     closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     displacement = None if output is None else _displacement(material, output, compiler, issues)
+    unread_outputs(material.node_tree, output, issues)
     varying = any(c.inputs for c in closures) or displacement is not None
     return (Material(material.name, closures, compiler.program if varying else None, displacement),
             issues.message(f"Material '{material.name}'"))
 
 
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
+
+
+def unread_outputs(tree, output, issues) -> None:
+    """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
+    Volume socket and AOV Output nodes."""
+    volume = None if output is None else output.inputs.get("Volume")
+    if volume is not None and volume.is_linked:
+        issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeOutputAOV":
+            issues.add(f"'{node.name}' (AOV Output: shader AOVs are not written yet)")
 
 
 def _displacement(material, output, compiler, issues):

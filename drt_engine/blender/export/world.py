@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.scene import World
-from .materials import uses_nodes
+from .materials import unread_outputs, uses_nodes
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import Compiler, ImageTable, is_ref
 
@@ -44,6 +44,7 @@ def export_world(world, warnings: list[str], images: ImageTable) -> World:
         return [compiler.scale(compiler.mul(weight, color), strength)]
 
     parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
+    unread_outputs(world.node_tree, output, issues)
     visibility = _visibility(world)
     message = issues.message(f"World '{world.name}'")
     if message:
