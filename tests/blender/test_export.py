@@ -813,3 +813,31 @@ def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
     cubes[3].light_linking.receiver_collection = None
     lamp.visible_glossy, lamp.data.use_shadow = True, True
     assert not render_export(scene).warnings
+
+
+@pytest.mark.skipif(not hasattr(bpy.types, "ShaderNodeBsdfMetallic"), reason="Blender 5's Metallic BSDF")
+@pytest.mark.parametrize("fresnel", ["F82", "PHYSICAL_CONDUCTOR"])
+def test_metallic_bsdf_is_a_principled_metal(fresnel):
+    """F82: Cycles' Principled metal (base colour, Edge Tint as its tint); Physical Conductor: the
+    F82-tint fit of its IOR and extinction, named in the warning."""
+    from drt_engine.core.bsdf.microfacet import conductor_f82
+    empty_scene()
+    material, tree, output = _new_node_material("Metal")
+    node = tree.nodes.new("ShaderNodeBsdfMetallic")
+    node.inputs["Base Color"].default_value = (0.9, 0.6, 0.2, 1.0)
+    node.inputs["Edge Tint"].default_value = (0.5, 0.7, 0.9, 1.0)
+    node.inputs["Roughness"].default_value = 0.25
+    node.fresnel_type = fresnel  # the other mode's sockets are then gone
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Metal")
+    assert closure.kind == "PRINCIPLED" and closure.metallic == 1.0 and closure.roughness == pytest.approx(0.25)
+    if fresnel == "F82":
+        np.testing.assert_allclose(closure.color, [0.9, 0.6, 0.2], rtol=1e-6)
+        np.testing.assert_allclose(closure.specular_tint, [0.5, 0.7, 0.9], rtol=1e-6)
+        assert not data.warnings
+    else:
+        f0, tint = conductor_f82(node.inputs["IOR"].default_value[:], node.inputs["Extinction"].default_value[:])
+        np.testing.assert_allclose(closure.color, f0, rtol=1e-6)
+        np.testing.assert_allclose(closure.specular_tint, tint, rtol=1e-6)
+        assert len(data.warnings) == 1 and "Physical Conductor" in data.warnings[0]

@@ -897,6 +897,15 @@ def _principled_rough(tree):
                  **{"Base Color": (0.3, 0.6, 0.8, 1.0), "Diffuse Roughness": 1.0})
 
 
+def _metallic(tree):
+    """Blender 5's Metallic BSDF with F82 Fresnel, roughness 0.35, a bluish edge tint and a base
+    colour from gold at the bottom of the sphere to copper at its top (Generated z)."""
+    ramp = _link(tree, _node(tree, "ShaderNodeMix", data_type="RGBA"), Factor_Float=_generated_z(tree, 1.0, 0.0),
+                 A_Color=(0.95, 0.7, 0.3, 1.0), B_Color=(0.95, 0.45, 0.3, 1.0))
+    return _link(tree, _node(tree, "ShaderNodeBsdfMetallic"), Roughness=0.35,
+                 **{"Base Color": ramp.outputs[2], "Edge Tint": (0.6, 0.8, 1.0, 1.0)})
+
+
 def _translucent(tree, colour=(0.3, 0.9, 0.4, 1.0)):
     return _link(tree, _node(tree, "ShaderNodeBsdfTranslucent"), Color=colour)
 
@@ -928,6 +937,7 @@ class ClosureCase:
 
 
 CLOSURES = (
+    ClosureCase("Metallic BSDF, F82, base colour from a texture", "sphere", _metallic, since=(5, 0)),
     ClosureCase("Oren-Nayar, roughness 1", "sphere", lambda tree: _rough_diffuse(tree, 1.0), True),
     ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
                 lambda tree: _rough_diffuse(tree, _generated_z(tree, 1.0, 0.0)), True),
@@ -935,7 +945,9 @@ CLOSURES = (
     ClosureCase("Translucent", "square", _translucent),
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
 )
-"""Closures under two suns, each in its own square of ``closure_scene``: rough diffuse spheres
+"""Closures under two suns, each in its own square of ``closure_scene``: a Metallic BSDF sphere
+(first: a glossy neighbour would light the translucent squares through Cycles' transmission
+bounces, which DRT does not trace through a Translucent), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
 textured, and a Principled BSDF's Diffuse Roughness) and upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front)."""

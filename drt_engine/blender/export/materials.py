@@ -11,6 +11,7 @@ from dataclasses import replace
 import bpy
 import numpy as np
 
+from ...core.bsdf.microfacet import conductor_f82
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import DISPLACEMENT_MATCHED_FROM, Compiler, ImageTable, is_ref
@@ -183,7 +184,30 @@ def _emission(node, weight, issues, compiler):
     return [_weighted(closure, weight, value.varying)]
 
 
+def _metallic(node, weight, issues, compiler):
+    """Blender 5's Metallic BSDF. With its F82 Fresnel it is Cycles' Principled metal (the base
+    colour as f0, Edge Tint as the F82 tint, through the same bsdf_microfacet_setup_fresnel_f82_tint),
+    so a Principled closure of metallic 1; Physical Conductor's IOR and extinction go through their
+    F82-tint fit (core.bsdf.microfacet.conductor_f82), named in the warning."""
+    value = _Inputs(node, compiler, issues)
+    for feature, name in (("anisotropy", "Anisotropy"), ("thin film", "Thin Film Thickness")):
+        if value(0.0, name) > 0.0:
+            issues.add(f"'{node.name}' {feature}")
+    if getattr(node, "fresnel_type", "F82") == "PHYSICAL_CONDUCTOR":
+        color, tint = conductor_f82(rgb(value(np.ones(3), "IOR")), rgb(value(np.zeros(3), "Extinction")))
+        issues.add(f"'{node.name}' Physical Conductor (rendered through the F82-tint fit of its IOR and extinction)")
+    else:
+        color = rgb(value(0.8, "Base Color", field="color", kind="color"))
+        tint = rgb(value(1.0, "Edge Tint", field="specular_tint", kind="color"))
+    closure = Closure("PRINCIPLED", color=color, metallic=1.0, specular_tint=tint,
+                      roughness=value(0.5, "Roughness", field="roughness", kind="float"),
+                      multiscatter=_multiscatter(node, issues))
+    value.normal()
+    return [_weighted(closure, weight, value.varying)]
+
+
 CLOSURE_NODES = {
+    "ShaderNodeBsdfMetallic": _metallic,
     "ShaderNodeBsdfPrincipled": _principled,
     "ShaderNodeBsdfDiffuse": _bsdf("DIFFUSE"),
     "ShaderNodeBsdfGlossy": _bsdf("GLOSSY"),

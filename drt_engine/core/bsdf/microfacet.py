@@ -132,6 +132,22 @@ F82_M = (1.0 / 7.0) * (1.0 - 1.0 / 7.0) ** 6
 """The F82 correction's c (1 - c)^6 at c = 1/7."""
 
 
+def conductor_f82(n, k) -> tuple[np.ndarray, np.ndarray]:
+    """(f0, F82 tint) per channel of a conductor of complex IOR n + ik: its exact Fresnel at normal
+    incidence, and at the F82 cosine 1/7 its ratio to Schlick's from that f0 (Hoffman's F82-tint
+    fit of a measured metal; for Blender's Metallic BSDF in Physical Conductor mode)."""
+    eta = np.asarray(n, np.float64) + 1j * np.asarray(k, np.float64)
+
+    def fresnel(c):
+        cos_t = np.sqrt(1.0 - (1.0 - c * c) / (eta * eta))
+        r_s = (c - eta * cos_t) / (c + eta * cos_t)
+        r_p = (eta * c - cos_t) / (eta * c + cos_t)
+        return 0.5 * (np.abs(r_s) ** 2 + np.abs(r_p) ** 2)
+
+    f0 = fresnel(1.0)
+    return f0, fresnel(1.0 / 7.0) / (f0 + (1.0 - f0) * F82_K)
+
+
 @kernel
 def f82_parts(cos_i, f82):
     """Metal Fresnel (Schlick with the F82-tint correction, Hoffman 2019, as Cycles) of one colour
