@@ -204,3 +204,23 @@ def test_shader_programs_evaluate_the_texture_ops():
                                 [dirs, *(np.full(50, v) for v in (0.0, 4.0, 1.5, 0.5, 2.0, 1.0, 1.0, 0.8))])[1]
     np.testing.assert_array_equal(out, expected)
     assert out.std() > 0.05
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_gabor_is_finite_and_in_range_for_extreme_inputs(dims):
+    """Phase in [0, 1], intensity >= 0 and every output finite, far from the origin, at zero
+    scale, frequency and orientation vector, and for out-of-range anisotropy."""
+    from drt_engine.core.shading.proctex.gabor import gabor_texture
+    rng = np.random.default_rng(5)
+    n = 400
+    vector = np.concatenate([rng.normal(size=(n - 4, 3)) * 3.0, [[1e7, -3e6, 2e5], [0, 0, 0], [-1e-30, 5, 7],
+                                                                  [0.5, 0.5, 0.5]]])
+    scale = np.where(np.arange(n) % 7 == 0, 0.0, 4.0)
+    frequency = np.where(np.arange(n) % 5 == 0, 0.0, 2.0)
+    anisotropy = rng.uniform(-0.5, 1.5, n)
+    orientation = rng.uniform(-4, 4, n)
+    direction = np.where((np.arange(n) % 3 == 0)[:, None], 0.0, rng.normal(size=(n, 3)))
+    value, phase, intensity = gabor_texture(dims, vector, scale, frequency, anisotropy, orientation, direction)
+    assert np.isfinite(value).all() and np.isfinite(phase).all() and np.isfinite(intensity).all()
+    assert (phase >= 0).all() and (phase <= 1).all() and (intensity >= 0).all()
+    assert value[scale > 0].std() > 0.01  # a pattern, not a constant

@@ -109,7 +109,16 @@ CASES = (
     Case("Brick offset and squash, smooth mortar", "ShaderNodeTexBrick", "Fac",
          {"offset": 0.3, "offset_frequency": 3, "squash": 0.6, "squash_frequency": 2},
          {"Scale": 0.8, "Mortar Size": 0.05, "Mortar Smooth": 0.6, "Bias": 0.2}),
-)
+) + ((  # Blender 4.3+
+    Case("Gabor 2D", "ShaderNodeTexGabor", "Value", {"gabor_type": "2D"},
+         {"Scale": 3.0, "Frequency": 2.0, "Anisotropy": 0.3, "Orientation 2D": 0.6}),
+    Case("Gabor 2D anisotropic, intensity", "ShaderNodeTexGabor", "Intensity", {"gabor_type": "2D"},
+         {"Scale": 2.5, "Frequency": 3.0, "Anisotropy": 1.0, "Orientation 2D": -0.4}),
+    Case("Gabor 3D, phase", "ShaderNodeTexGabor", "Phase", {"gabor_type": "3D"},
+         {"Scale": 2.0, "Frequency": 1.5, "Anisotropy": 0.5, "Orientation 3D": (0.3, 0.5, 0.8)}),
+    Case("Gabor 3D isotropic", "ShaderNodeTexGabor", "Value", {"gabor_type": "3D"},
+         {"Scale": 2.5, "Frequency": 2.0, "Anisotropy": 0.0}),
+) if hasattr(bpy.types, "ShaderNodeTexGabor") else ())
 
 
 def _math(tree, operation, a, b, clamp=False):

@@ -552,7 +552,7 @@ class Compiler:
     def _procedural(self, node, output, op, **params):
         """A procedural texture node: its vector (Generated coordinates when unlinked, as in
         Cycles), its other sockets in core.shading.proctex's order, and the output's index."""
-        kinds = {"Vector": "vector", "Color1": "color", "Color2": "color", "Mortar": "color"}
+        kinds = {"Vector": "vector", "Color1": "color", "Color2": "color", "Mortar": "color", "Orientation 3D": "vector"}
         args = [self._vector_or(node, "generated")]
         args += [self._in(node, name, kinds.get(name, "float")) for name in proctex.INPUTS[op][1:]]
         return self.op(op, args, **params), proctex.OUTPUTS[op].index(output.identifier)
@@ -578,6 +578,9 @@ class Compiler:
 
     def _node_ShaderNodeTexWhiteNoise(self, node, output):
         return self._procedural(node, output, "white_noise", dims=int(node.noise_dimensions[0]))
+
+    def _node_ShaderNodeTexGabor(self, node, output):
+        return self._procedural(node, output, "gabor", dims=int(node.gabor_type[0]))
 
     def _node_ShaderNodeTexBrick(self, node, output):
         return self._procedural(node, output, "brick", offset=float(node.offset),

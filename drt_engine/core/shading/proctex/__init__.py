@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import noise, patterns, voronoi
+from . import gabor, noise, patterns, voronoi
 
 INPUTS = {
     "noise": ("Vector", "W", "Scale", "Detail", "Roughness", "Lacunarity", "Offset", "Gain", "Distortion"),
@@ -20,6 +20,7 @@ INPUTS = {
     "white_noise": ("Vector", "W"),
     "brick": ("Vector", "Color1", "Color2", "Mortar", "Scale", "Mortar Size", "Mortar Smooth", "Bias",
               "Brick Width", "Row Height"),
+    "gabor": ("Vector", "Scale", "Frequency", "Anisotropy", "Orientation 2D", "Orientation 3D"),
 }
 OUTPUTS = {
     "noise": ("Fac", "Color"),
@@ -29,6 +30,7 @@ OUTPUTS = {
     "magic": ("Color", "Fac"),
     "white_noise": ("Value", "Color"),
     "brick": ("Color", "Fac"),
+    "gabor": ("Value", "Phase", "Intensity"),
 }
 OPS = tuple(INPUTS)
 HASH_PCG = "pcg"
@@ -60,6 +62,9 @@ def evaluate(op: str, p: dict, x: list) -> tuple:
         return color, color.mean(axis=1)
     if op == "white_noise":
         return patterns.white_noise(p["dims"], *x)
+    if op == "gabor":  # the orientation of the other dimension count is a disabled socket, read as 0
+        direction = x[5] if x[5].ndim == 2 else np.zeros((len(x[5]), 3))
+        return gabor.gabor_texture(p["dims"], *x[:5], direction)
     if op == "brick":
         return patterns.brick(*x, p["offset"], p["offset_frequency"], p["squash"], p["squash_frequency"])
     raise KeyError(op)
