@@ -71,8 +71,9 @@ def sample_direction(vertices, a, b, c, omega, px, py, pz, u0, u1):
     sin_part = abs(ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx))
     h = math.hypot(cos_part, sin_part)
     cos_alpha, sin_alpha = (cos_part / h, sin_part / h) if h > 0 else (1.0, 0.0)
-    phi = u0 * omega - math.atan2(sin_alpha, cos_alpha)
-    s, t = math.sin(phi), math.cos(phi)
+    # s, t: sine and cosine of (u0 * omega - alpha)
+    sa, ca = math.sin(u0 * omega), math.cos(u0 * omega)
+    s, t = sa * cos_alpha - ca * sin_alpha, ca * cos_alpha + sa * sin_alpha
     uu = t - cos_alpha
     vv = s + sin_alpha * cos_c
     den = (vv * s + uu * t) * sin_alpha
