@@ -127,7 +127,7 @@ def test_emissive_triangle_samples_have_the_pdf_of_pdf_emissive():
     ls = lights.sample(0, pos, np.tile([0, 0, 1.0], (n, 1)), RNG.random((n, 2)), RNG.random(n))
     hits = lights.geometry.intersect(pos + 1e-6 * ls.wi, ls.wi, np.full(n, np.inf))
     assert hits.hit.all() and np.allclose(hits.t + 1e-6, ls.dist, rtol=1e-5)
-    pdf = lights.pdf_emissive(hits.prim, ls.wi, ls.dist)
+    pdf = lights.pdf_emissive(hits.prim, pos, ls.wi, ls.dist)
     assert np.allclose(pdf, ls.pdf, rtol=1e-5)
     assert np.allclose(ls.value * ls.pdf[:, None], [2.0, 1.0, 0.5], rtol=1e-9)
 

@@ -271,8 +271,8 @@ class Integrator:
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
                                              self._ray_path(surf, hits, glowing))
         e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
-                         lambda smooth: self.lights.pdf_emissive(prim[smooth], state.dirs[hit[smooth]],
-                                                                 hits.t[hit[smooth]]))
+                         lambda smooth: self.lights.pdf_emissive(prim[smooth], state.origins[hit[smooth]],
+                                                                 state.dirs[hit[smooth]], hits.t[hit[smooth]]))
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]

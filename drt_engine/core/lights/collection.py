@@ -332,16 +332,17 @@ class Lights:
             _suns_batch(table, self.table, np.array([i], np.int64), slots, origins, d, radiance, pdf)
         return radiance, pdf
 
-    def pdf_emissive(self, prim, dirs, t):
-        """Light sampling's density (solid angle) of directions ``dirs`` that hit triangles ``prim``
-        at distances ``t``: zero on triangles it never picks."""
+    def pdf_emissive(self, prim, origins, dirs, t):
+        """Light sampling's density (solid angle) of directions ``dirs`` from ``origins`` that hit
+        triangles ``prim`` at distances ``t``: zero on triangles it never picks."""
         out = np.zeros(len(prim))
         e = np.searchsorted(self.emissive, prim)
         found = np.flatnonzero(e < len(self.emissive))
         found = found[self.emissive[e[found]] == prim[found]]
         if len(found):
-            _, _, ng, area, _ = self.emitters
-            out[found] = pdf_emissive_batch(ng, area, self.emissive_prob, e[found], dirs[found],
+            vertices, triangles, ng, area, _ = self.emitters
+            out[found] = pdf_emissive_batch(vertices, triangles, ng, area, self.emissive_prob, e[found],
+                                            np.ascontiguousarray(origins[found], np.float64), dirs[found],
                                             np.asarray(t, np.float64)[found])
         return out
 

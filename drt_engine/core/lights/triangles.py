@@ -1,8 +1,9 @@
 """Emissive triangles, together one next-event strategy: pick, sample, pdf and closed form.
 
 A triangle is picked by its emitted power (``pick_triangle`` over a cdf lights.collection
-builds), then a point on it uniformly by area; both sides emit, and the solid-angle pdf includes
-the chance of the pick. Batch loops over a wave's points, since the triangles are not rows of
+builds), then a point on it uniformly in the solid angle it subtends where that is large
+(lights.spherical_triangle), else uniformly by area; both sides emit, and the solid-angle pdf
+includes the chance of the pick. Batch loops over a wave's points, since the triangles are not rows of
 the light table. The closed form (``unoccluded_triangles``) sums each triangle's projected
 solid angle (Lambert's edge integral, lights.solid_angle) times its constant emission: O(number
 of triangles) per point.
@@ -16,6 +17,7 @@ import numpy as np
 from ..base.constants import TINY
 from ..base.jit import kernel
 from .solid_angle import polygon4
+from .spherical_triangle import barycentrics_along, sample_direction, subtended
 
 
 # -- sampling --------------------------------------------------------------------------------------
@@ -27,12 +29,19 @@ def pick_triangle(cdf, u):
 
 @kernel(inline="always")
 def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
-    """A point uniform on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in
-    solid angle including the chance ``prob[i]`` of picking the triangle, two-sided."""
-    su = math.sqrt(u0)
-    b0, b1 = 1.0 - su, u1 * su
-    b2 = 1.0 - b0 - b1
+    """A point on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in solid
+    angle including the chance ``prob[i]`` of picking the triangle, two-sided. Uniform in the
+    solid angle where lights.spherical_triangle chooses so, else uniform by area."""
     a, b, c = triangles[i, 0], triangles[i, 1], triangles[i, 2]
+    nx, ny, nz = ng[i, 0], ng[i, 1], ng[i, 2]
+    omega = subtended(vertices, a, b, c, nx, ny, nz, px, py, pz)
+    if omega > 0:
+        dx, dy, dz = sample_direction(vertices, a, b, c, omega, px, py, pz, u0, u1)
+        b0, b1 = barycentrics_along(vertices, a, b, c, px, py, pz, dx, dy, dz)
+    else:
+        su = math.sqrt(u0)
+        b0, b1 = 1.0 - su, u1 * su
+    b2 = 1.0 - b0 - b1
     qx = b0 * vertices[a, 0] + b1 * vertices[b, 0] + b2 * vertices[c, 0]
     qy = b0 * vertices[a, 1] + b1 * vertices[b, 1] + b2 * vertices[c, 1]
     qz = b0 * vertices[a, 2] + b1 * vertices[b, 2] + b2 * vertices[c, 2]
@@ -40,18 +49,28 @@ def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
     dist = math.sqrt(tx * tx + ty * ty + tz * tz)
     inv = 1.0 / max(dist, TINY)
     wx, wy, wz = tx * inv, ty * inv, tz * inv
-    cos_l = abs(wx * ng[i, 0] + wy * ng[i, 1] + wz * ng[i, 2])
-    pdf = dist * dist / max(cos_l, TINY) * (prob[i] / area[i])
+    cos_l = abs(wx * nx + wy * ny + wz * nz)
+    if omega > 0:
+        pdf = prob[i] / omega
+    else:
+        pdf = dist * dist / max(cos_l, TINY) * (prob[i] / area[i])
     return wx, wy, wz, dist, pdf, b0, b1, cos_l
 
 
 @kernel
-def pdf_emissive_batch(ng, area, prob, prim, dirs, t):
+def pdf_emissive_batch(vertices, triangles, ng, area, prob, prim, origins, dirs, t):
+    """``sample_triangle``'s pdf of directions ``dirs`` from ``origins`` that reach emissive
+    triangles ``prim`` (their indices among the emitters) at distances ``t``."""
     out = np.empty(len(prim))
     for j in range(len(prim)):
         i = prim[j]
-        cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
-        out[j] = prob[i] / area[i] * t[j] * t[j] / cos_l
+        omega = subtended(vertices, triangles[i, 0], triangles[i, 1], triangles[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
+                          origins[j, 0], origins[j, 1], origins[j, 2])
+        if omega > 0:
+            out[j] = prob[i] / omega
+        else:
+            cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
+            out[j] = prob[i] / area[i] * t[j] * t[j] / cos_l
     return out
 
 
