@@ -11,6 +11,7 @@ import bpy
 import numpy as np
 
 from tests.support import render_helpers as rh
+from tests.support.datablocks import new_material
 from drt_engine.blender.properties import BLENDER_PASS_TOGGLES, DRT_PASS_TOGGLES
 from drt_engine.core.settings import PASS_CHANNELS
 
@@ -47,7 +48,7 @@ def material(kind="DIFFUSE", color=None, strength=1.0, name=None, **inputs):
     color = color or ((1.0, 1.0, 1.0) if kind == "EMISSION" else (0.8, 0.8, 0.8))
     node_type = {"DIFFUSE": "ShaderNodeBsdfDiffuse", "EMISSION": "ShaderNodeEmission",
                  "GLOSSY": "ShaderNodeBsdfAnisotropic", "GLASS": "ShaderNodeBsdfGlass"}[kind]
-    mat = bpy.data.materials.new(name or kind.title())
+    mat = new_material(name or kind.title())
     tree = mat.node_tree
     tree.nodes.clear()
     node = tree.nodes.new(node_type)
