@@ -24,6 +24,9 @@ PASSES = (
     "Noise",  # standard error of the Combined estimate per pixel
     "Denoising Albedo",  # Cycles' albedo of the first diffuse-like hit, for the Denoise node (core.film.denoising)
     "Denoising Normal",  # its normal in Cycles' camera space
+    "Mist",  # Cycles' mist: 0 near, 1 far and for the background, by the world's mist settings
+    "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
+    "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -38,8 +41,15 @@ PASS_CHANNELS = {
     "Noise": "RGB",
     "Denoising Albedo": "RGB",
     "Denoising Normal": "XYZ",
+    "Mist": "Z",
+    "IndexOB": "X",
+    "IndexMA": "X",
     "Noisy Image": "RGBA",
 }
+FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
+"""Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
+mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
+writes these at sample 0 only, core.film.film)."""
 NOISY_IMAGE = "Noisy Image"
 """With denoising on, the Combined image as rendered, before OIDN (Cycles' pass of that name); not
 one of ``PASSES``: the render adds it, no setting asks for it."""
