@@ -103,6 +103,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         target_error=drt.target_error,
         sample_start=drt.sample_offset,
         sample_end=drt.sample_offset + drt.sample_count if drt.sample_count else 0,
+        pass_alpha_threshold=view_layer.pass_alpha_threshold,
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),
         use_denoising=drt.use_denoising,
         denoising_prefilter=drt.denoising_prefilter,

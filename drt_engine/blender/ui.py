@@ -231,6 +231,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col = layout.column(heading="Indexes", align=True)
         col.prop(view_layer, "use_pass_object_index")
         col.prop(view_layer, "use_pass_material_index")
+        col.prop(view_layer, "pass_alpha_threshold")
         col = layout.column(heading="Light", align=True)
         col.prop(view_layer, "use_pass_diffuse_color", text="Diffuse Color")
         col.prop(view_layer, "use_pass_glossy_color", text="Glossy Color")

@@ -80,6 +80,9 @@ class RenderSettings:
     target_error: float = 0.0
     sample_start: int = 0  # first sample id of this render's range (a farm part renders one range)
     sample_end: int = 0  # one past its last sample id; 0 = samples
+    # the view layer's Alpha Threshold: a hit at least this opaque ends the index passes (IndexOB,
+    # IndexMA) of its path; a more transparent one hands them on to the hit behind it (Cycles' rule)
+    pass_alpha_threshold: float = 0.5
     # Cycles from Blender 5.2 on scales Denoising Normal by the feature walk's mean throughput
     # (measured: seen in a mirror of tint t, |n| = mean(t)); 5.0 and older write unit normals
     weighted_denoising_normal: bool = False

@@ -79,13 +79,17 @@ def test_indices_are_the_first_hits(pattern):
         assert np.all(a == ia) and np.all(b == ib) and np.all(bg == 0), name
 
 
-@pytest.mark.parametrize("transparency, index", [(0.75, 3.0), (0.25, 7.0)])
-def test_a_mostly_transparent_hit_passes_the_indices_on(transparency, index):
-    """Under Cycles' alpha threshold (opacity 0.5) a hit's index is replaced by the next hit's on the
-    path: B a quarter opaque shows A's index, B three quarters opaque its own. (DRT's paths always
+@pytest.mark.parametrize("transparency, threshold, index", [(0.75, 0.5, 3.0), (0.25, 0.5, 7.0), (0.75, 0.2, 7.0),
+                                                          (0.75, 0.0, 7.0)])
+def test_a_mostly_transparent_hit_passes_the_indices_on(transparency, threshold, index):
+    """Under the view layer's alpha threshold (Cycles' default 0.5) a hit's index is replaced by the
+    next hit's on the path: B a quarter opaque shows A's index, B three quarters opaque its own, and
+    so does B a quarter opaque under a threshold of 0.2 or 0 (0: the first hit). (DRT's paths always
     continue through a transparent lobe, its only non-diffuse one; Cycles' pick it or the diffuse by
     weight and end at the diffuse, so there a sample 0 stops at such a B now and then.)"""
-    _, b, _ = columns(render(scene(transparency=transparency), settings(samples=4))[1].passes["IndexOB"])
+    s = settings(samples=4)
+    s.pass_alpha_threshold = threshold
+    _, b, _ = columns(render(scene(transparency=transparency), s)[1].passes["IndexOB"])
     assert np.all(b == index)
 
 

@@ -177,7 +177,8 @@ def _extend_range(pixel, combined, lo, hi):
 
 
 class Film:
-    """Sums per pixel of the window: samples, every pass, and Combined RGB over class A.
+    """Sums per pixel of the window: samples, every pass, and Combined RGB over class A; the
+    ``FIRST_SAMPLE_PASSES`` hold only their pixel's first sample, read as it is.
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums

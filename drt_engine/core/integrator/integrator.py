@@ -44,7 +44,6 @@ _NO_BOUNCES = camera_bounces(0)  # the continuation kernel's bounces when no pro
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
         ("IndexOB", "X"), ("IndexMA", "X"))
-_ALPHA_THRESHOLD = 0.5  # Cycles' pass_alpha_threshold (Blender's default): a hit this opaque ends the index passes
 
 
 @dataclass
@@ -303,7 +302,7 @@ class Integrator:
         """Mist and the index passes at the hits the camera sees directly or through transparency,
         as Cycles' film_write_data_passes: each hit takes (1 - mist) of Mist, weighted by the path's
         throughput times the hit's opacity; an index is the last such hit's until one is at least
-        half opaque (the film keeps the first sample's, core.film.film)."""
+        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film)."""
         rows = np.flatnonzero(group.straight)
         if len(rows) == 0:
             return
@@ -319,7 +318,7 @@ class Integrator:
                 out.aux["IndexOB"][path, 0] = self.object_index[self.geometry.source_of(group.prim[rows])[:, 0]]
             if "IndexMA" in out.aux:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
-            out.indexed[path] = opacity[open_].mean(axis=1) >= _ALPHA_THRESHOLD
+            out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
