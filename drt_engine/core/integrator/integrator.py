@@ -116,8 +116,9 @@ class Integrator:
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
-        self.object_index = np.array([float(i.pass_index) for i in scene.instances] + [0.0])
-        self.material_index = np.array([float(m.pass_index) for m in scene.materials] + [0.0])
+        indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
+        self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
+        self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
 
