@@ -14,7 +14,9 @@ import bpy
 import numpy as np
 import pytest
 
+from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.film import film as film_module
+from drt_engine.core.film import mist as mist_module
 from drt_engine.core.integrator.integrator import Integrator
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
@@ -43,10 +45,12 @@ def _add(op, mat, index, **kw):
     return obj
 
 
-def mist_scene(falloff="QUADRATIC"):
+def mist_scene(falloff="QUADRATIC", camera="PERSP"):
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -9.0, 3.0))
     scene.camera.data.lens = 35.0
+    scene.camera.data.type = camera
+    scene.camera.data.ortho_scale = 9.0
     world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.05, 0.06, 1.0)
     world.mist_settings.start, world.mist_settings.depth = 4.0, 14.0
@@ -87,13 +91,14 @@ def index_figures(drt: np.ndarray, cycles: np.ndarray) -> dict:
             "values": sorted(set(np.unique(cycles).tolist())), "drt_values": sorted(set(np.unique(drt).tolist()))}
 
 
-@pytest.mark.parametrize("falloff", FALLOFFS)
-def test_mist_matches_cycles(drt, falloff, tmp_path):
-    drt_r, c0, c1 = renders(mist_scene(falloff), tmp_path, f"mist-{falloff.lower()}")
+@pytest.mark.parametrize("falloff, camera", [(f, "PERSP") for f in FALLOFFS] + [("LINEAR", "ORTHO")])
+def test_mist_matches_cycles(drt, falloff, camera, tmp_path):
+    """Orthographic cameras measure the distance along the view axis (Cycles' camera_distance)."""
+    drt_r, c0, c1 = renders(mist_scene(falloff, camera), tmp_path, f"mist-{falloff.lower()}-{camera.lower()}")
     figures = ps.parity(drt_r.passes["Mist"], c0.passes["Mist"], c1.passes["Mist"])
-    print(f"Mist {falloff}: {figures}")
-    assert figures["ok"], ps.message(f"Mist {falloff}", figures)
-    assert c0.passes["Mist"].min() < 0.3 and c0.passes["Mist"].max() == 1.0  # the ramp crosses the image
+    print(f"Mist {falloff} {camera}: {figures}")
+    assert figures["ok"], ps.message(f"Mist {falloff} {camera}", figures)
+    assert c0.passes["Mist"].min() < 0.3 and c0.passes["Mist"].max() > 0.99  # the ramp crosses the image
 
 
 @pytest.mark.parametrize("name", ["IndexOB", "IndexMA"])
@@ -115,6 +120,30 @@ def test_the_comparisons_fail_without_the_computation(drt, monkeypatch, tmp_path
     assert not ps.parity(off.passes["Mist"], c0.passes["Mist"], c1.passes["Mist"])["ok"]
     for name in ("IndexOB", "IndexMA"):
         assert index_figures(off.passes[name][..., 0], c0.passes[name][..., 0])["interior_differ"] > 0, name
+
+
+def test_orthographic_mist_fails_with_the_distance_from_the_camera(drt, monkeypatch, tmp_path):
+    """An orthographic camera's mist measured from the camera's position instead of along its axis."""
+    scene = mist_scene("LINEAR", "ORTHO")
+    _, c0, c1 = renders(scene, tmp_path, "euclid")
+    made = mist_module.Mist.__init__
+
+    def from_position(self, camera, world):
+        made(self, camera, world)
+        self.axis = None
+
+    monkeypatch.setattr(mist_module.Mist, "__init__", from_position)
+    wrong = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, passes=PASSES, name="euclid-drt")
+    assert not ps.parity(wrong.passes["Mist"], c0.passes["Mist"], c1.passes["Mist"])["ok"]
+
+
+def test_mist_fails_when_hits_count_as_opaque(drt, monkeypatch, tmp_path):
+    """The half-transparent sphere's mist taken whole (no opacity weight)."""
+    scene = mist_scene("LINEAR")
+    _, c0, c1 = renders(scene, tmp_path, "opaque")
+    monkeypatch.setattr(MaterialShader, "transparency", lambda self, mu_o, rows=None: np.zeros((len(mu_o), 3)))
+    wrong = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, passes=PASSES, name="opaque-drt")
+    assert not ps.parity(wrong.passes["Mist"], c0.passes["Mist"], c1.passes["Mist"])["ok"]
 
 
 def test_averaged_indices_fail(drt, monkeypatch, tmp_path):
