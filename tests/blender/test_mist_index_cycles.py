@@ -54,8 +54,8 @@ def mist_scene(falloff="QUADRATIC", camera="PERSP"):
     world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.05, 0.05, 0.06, 1.0)
     world.mist_settings.start, world.mist_settings.depth = 4.0, 14.0
-    world.mist_settings.falloff = falloff
-    scene.world = world
+    world.mist_settings.falloff = falloff or "LINEAR"
+    scene.world = world if falloff is not None else None  # None: Cycles' film defaults
     floor, red, glassy = (_material("Floor", (0.5, 0.5, 0.5), 1), _material("Red", (0.8, 0.1, 0.1), 2),
                           _material("Veil", (0.1, 0.3, 0.8), 4, alpha=0.6))
     _add(bpy.ops.mesh.primitive_plane_add, floor, 11, size=40.0)
@@ -91,10 +91,11 @@ def index_figures(drt: np.ndarray, cycles: np.ndarray) -> dict:
             "values": sorted(set(np.unique(cycles).tolist())), "drt_values": sorted(set(np.unique(drt).tolist()))}
 
 
-@pytest.mark.parametrize("falloff, camera", [(f, "PERSP") for f in FALLOFFS] + [("LINEAR", "ORTHO")])
+@pytest.mark.parametrize("falloff, camera", [(f, "PERSP") for f in FALLOFFS] + [("LINEAR", "ORTHO"), (None, "PERSP")])
 def test_mist_matches_cycles(drt, falloff, camera, tmp_path):
-    """Orthographic cameras measure the distance along the view axis (Cycles' camera_distance)."""
-    drt_r, c0, c1 = renders(mist_scene(falloff, camera), tmp_path, f"mist-{falloff.lower()}-{camera.lower()}")
+    """Orthographic cameras measure the distance along the view axis (Cycles' camera_distance); a
+    scene without a world has Cycles' film defaults (start 0, depth 100, linear)."""
+    drt_r, c0, c1 = renders(mist_scene(falloff, camera), tmp_path, f"mist-{falloff}-{camera.lower()}")
     figures = ps.parity(drt_r.passes["Mist"], c0.passes["Mist"], c1.passes["Mist"])
     print(f"Mist {falloff} {camera}: {figures}")
     assert figures["ok"], ps.message(f"Mist {falloff} {camera}", figures)
