@@ -3,7 +3,7 @@ previews) and viewport.py (Rendered shading)."""
 import bpy
 
 from .final import render as final_render
-from .properties import pass_layout, registered_passes
+from .properties import pass_layout, registered_passes, result_pass_name
 from .viewport import ViewportSession
 
 
@@ -33,7 +33,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def update_render_passes(self, scene=None, renderlayer=None):
         for name in registered_passes(scene, renderlayer):
-            self.register_pass(scene, renderlayer, name, *pass_layout(name))
+            self.register_pass(scene, renderlayer, result_pass_name(name), *pass_layout(name))
 
 
 classes = (DRTRenderEngine,)

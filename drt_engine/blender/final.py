@@ -20,7 +20,7 @@ from .hooks import render_hooks
 from .oidn import UNAVAILABLE, oidn_library
 from .part_files import keep_part
 from .preview import PREVIEW_LAYER, preview_settings
-from .properties import settings_from_scene
+from .properties import result_pass_name, settings_from_scene
 from .status import COMPILING, done_line, one_line, stats_line
 
 DISPLAY_INTERVAL = 1.0
@@ -66,7 +66,7 @@ def write_passes(result, passes: dict) -> None:
     """Copy the core's (h, w, C) arrays, rows bottom-to-top like Blender's, into a render result."""
     layer_passes = result.layers[0].passes
     for name, pixels in passes.items():
-        target = layer_passes.get(name)
+        target = layer_passes.get(result_pass_name(name))
         if target is not None:
             target.rect.foreach_set(np.ascontiguousarray(pixels, dtype=np.float32).ravel())
 

@@ -24,6 +24,9 @@ BLENDER_PASS_TOGGLES = {
     "GlossCol": "use_pass_glossy_color",
     "Emit": "use_pass_emit",
     "Env": "use_pass_environment",
+    "Mist": "use_pass_mist",
+    "IndexOB": "use_pass_object_index",
+    "IndexMA": "use_pass_material_index",
 }
 """Passes Blender has its own view-layer toggle for (the compositor knows them by these names)."""
 
@@ -34,6 +37,15 @@ DRT_PASS_TOGGLES = {
     "Denoising Normal": "use_pass_denoising_data",
 }
 """DRT's own passes, toggled by ``view_layer.drt.<property>``."""
+
+RESULT_NAMES_5 = {"IndexOB": "Object Index", "IndexMA": "Material Index"}
+"""Passes Blender 5.0+ names otherwise in its render result (the view-layer toggles create them so)."""
+
+
+def result_pass_name(name: str) -> str:
+    """The name of pass ``name`` in this Blender's render result and compositor."""
+    return RESULT_NAMES_5.get(name, name) if bpy.app.version >= (5, 0, 0) else name
+
 
 _PASS_TYPES = {"RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "Z": "VALUE", "X": "VALUE"}
 
@@ -91,6 +103,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         target_error=drt.target_error,
         sample_start=drt.sample_offset,
         sample_end=drt.sample_offset + drt.sample_count if drt.sample_count else 0,
+        pass_alpha_threshold=view_layer.pass_alpha_threshold,
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),
         use_denoising=drt.use_denoising,
         denoising_prefilter=drt.denoising_prefilter,

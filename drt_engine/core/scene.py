@@ -85,6 +85,8 @@ class Material:
     """The shading normal bumped by the output's Displacement socket (Cycles' "Bump Only"): an
     output ``(node, socket)`` of ``program``, evaluated before the closures' inputs, which then
     see it as the hit's normal."""
+    pass_index: int = 0
+    """The material's pass index (Material Index pass)."""
 
     @property
     def emission(self) -> np.ndarray:
@@ -291,6 +293,12 @@ class World:
     visible_diffuse: bool = True
     visible_glossy: bool = True
     visible_transmission: bool = True
+    mist_start: float = 0.0
+    mist_depth: float = 100.0
+    mist_falloff: float = 1.0
+    """The world's mist settings as Cycles reads them: the Mist pass ramps from 0 at ``mist_start``
+    to 1 at ``mist_start + mist_depth`` from the camera, raised to ``mist_falloff`` (quadratic 2,
+    linear 1, inverse quadratic 0.5). The defaults are Cycles' film's, what it uses without a world."""
 
     @property
     def visible_lighting(self) -> bool:

@@ -24,6 +24,9 @@ PASSES = (
     "Noise",  # standard error of the Combined estimate per pixel
     "Denoising Albedo",  # Cycles' albedo of the first diffuse-like hit, for the Denoise node (core.film.denoising)
     "Denoising Normal",  # its normal in Cycles' camera space
+    "Mist",  # Cycles' mist: 0 near, 1 far and for the background, by the world's mist settings
+    "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
+    "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -38,8 +41,15 @@ PASS_CHANNELS = {
     "Noise": "RGB",
     "Denoising Albedo": "RGB",
     "Denoising Normal": "XYZ",
+    "Mist": "Z",
+    "IndexOB": "X",
+    "IndexMA": "X",
     "Noisy Image": "RGBA",
 }
+FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
+"""Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
+mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
+writes these at sample 0 only, core.film.film)."""
 NOISY_IMAGE = "Noisy Image"
 """With denoising on, the Combined image as rendered, before OIDN (Cycles' pass of that name); not
 one of ``PASSES``: the render adds it, no setting asks for it."""
@@ -70,6 +80,9 @@ class RenderSettings:
     target_error: float = 0.0
     sample_start: int = 0  # first sample id of this render's range (a farm part renders one range)
     sample_end: int = 0  # one past its last sample id; 0 = samples
+    # the view layer's Alpha Threshold: a hit at least this opaque ends the index passes (IndexOB,
+    # IndexMA) of its path; a more transparent one hands them on to the hit behind it (Cycles' rule)
+    pass_alpha_threshold: float = 0.5
     # Cycles from Blender 5.2 on scales Denoising Normal by the feature walk's mean throughput
     # (measured: seen in a mirror of tint t, |n| = mean(t)); 5.0 and older write unit normals
     weighted_denoising_normal: bool = False

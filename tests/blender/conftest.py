@@ -13,6 +13,7 @@ import pytest
 
 import drt_engine
 from drt_engine.blender.engine import DRTRenderEngine
+from drt_engine.blender.properties import result_pass_name
 from drt_engine.core.settings import PASS_CHANNELS
 from drt_engine.headless.cli import exit_now
 from tests.support import sample_scene_files
@@ -129,8 +130,8 @@ def render_exr(scene, path) -> dict:
 
 
 def pass_pixels(channels: dict, layer: str, name: str) -> np.ndarray:
-    """(h, w, C) pixels of one pass of one view layer, channels in PASS_CHANNELS order."""
-    names = [f"{layer}.{name}.{c}" for c in PASS_CHANNELS[name]]
+    """(h, w, C) pixels of one pass of one view layer (by DRT's name), channels in PASS_CHANNELS order."""
+    names = [f"{layer}.{result_pass_name(name)}.{c}" for c in PASS_CHANNELS[name]]
     missing = [key for key in names if key not in channels]
     assert not missing, f"channels {missing} not in the file: {sorted(channels)}"
     return np.stack([channels[key] for key in names], axis=-1)

@@ -19,6 +19,7 @@ from drt_engine.core.render import adaptive
 from drt_engine.blender.engine import DRTRenderEngine
 from drt_engine.blender.final import progress_callback, render_window
 from drt_engine.blender.hooks import render_hooks
+from drt_engine.blender.properties import result_pass_name
 from drt_engine.blender.status import done_line, stats_line
 from drt_engine.core.render.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
@@ -89,13 +90,14 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
     scene = bl.emission_scene(strength=STRENGTH)
     view_layer = scene.view_layers[LAYER]
     for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_diffuse_color",
-                 "use_pass_glossy_color", "use_pass_emit", "use_pass_environment"):
+                 "use_pass_glossy_color", "use_pass_emit", "use_pass_environment", "use_pass_mist",
+                 "use_pass_object_index", "use_pass_material_index"):
         setattr(view_layer, attr, True)
     view_layer.drt.use_pass_sample_count = True
     view_layer.drt.use_pass_noise = True
     view_layer.drt.use_pass_denoising_data = True
     channels = bl.render_exr(scene, tmp_path / "all.exr")
-    assert bl.passes_in(channels, LAYER) == set(PASSES)
+    assert bl.passes_in(channels, LAYER) == {result_pass_name(name) for name in PASSES}
     for name in PASSES:
         assert np.all(np.isfinite(bl.pass_pixels(channels, LAYER, name))), name
     np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Emit"), STRENGTH, rtol=1e-4)

@@ -575,6 +575,26 @@ def test_world_background_colour_times_strength():
     assert data.warnings == []
 
 
+@pytest.mark.parametrize("falloff, exponent", [("QUADRATIC", 2.0), ("LINEAR", 1.0), ("INVERSE_QUADRATIC", 0.5)])
+def test_mist_settings_and_pass_indices(falloff, exponent):
+    """The world's mist (no world: Cycles' film defaults) and the object and material pass indices."""
+    scene = empty_scene()
+    obj = add_object(scene, "Cube", cube_mesh())
+    obj.pass_index = 6
+    mat = new_material("Indexed")
+    mat.pass_index = 9
+    obj.data.materials.append(mat)
+    data = render_export(scene)
+    assert (data.world.mist_start, data.world.mist_depth, data.world.mist_falloff) == (0.0, 100.0, 1.0)
+    scene.world = new_world("World")
+    mist = scene.world.mist_settings
+    mist.start, mist.depth, mist.falloff = 2.5, 7.0, falloff
+    data = render_export(scene)
+    assert (data.world.mist_start, data.world.mist_depth, data.world.mist_falloff) == (2.5, 7.0, exponent)
+    assert [i.pass_index for i in data.instances] == [6]
+    assert [m.pass_index for m in data.materials if m.name == "Indexed"] == [9]
+
+
 def test_world_texture_without_image_is_magenta_with_one_warning():
     """As Cycles (measured: an Image Texture without an image renders (1, 0, 1))."""
     scene = empty_scene()

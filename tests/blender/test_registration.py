@@ -141,15 +141,19 @@ def test_settings_from_scene(drt):
     view_layer.use_pass_z = True
     view_layer.use_pass_environment = True
     view_layer.drt.use_pass_noise = True
+    view_layer.use_pass_mist = view_layer.use_pass_object_index = view_layer.use_pass_material_index = True
+    view_layer.pass_alpha_threshold = 0.25
     settings = properties.settings_from_scene(scene, view_layer)
     assert settings == RenderSettings(
         samples=9, seed=7, sampling_pattern="JITTERED", max_depth=3, clamp=4.5, threads=2,
-        filter_type="GAUSSIAN", filter_size=2.25, passes=("Combined", "Depth", "Env", "Noise"),
+        filter_type="GAUSSIAN", filter_size=2.25,
+        passes=("Combined", "Depth", "Env", "Noise", "Mist", "IndexOB", "IndexMA"), pass_alpha_threshold=0.25,
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,
         adaptive_mode="CONTRAST", time_limit=12.0, target_error=pytest.approx(0.02),
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),  # as this Blender's Cycles writes it
     )
     view_layer.use_pass_z = view_layer.use_pass_environment = view_layer.drt.use_pass_noise = False
+    view_layer.use_pass_mist = view_layer.use_pass_object_index = view_layer.use_pass_material_index = False
     assert properties.settings_from_scene(scene, view_layer).passes == ("Combined",)
 
 

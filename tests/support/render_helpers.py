@@ -25,10 +25,14 @@ PASS_TOGGLES = {
     "GlossCol": ("use_pass_glossy_color", "RGB"),
     "Emit": ("use_pass_emit", "RGB"),
     "Env": ("use_pass_environment", "RGB"),
+    "Mist": ("use_pass_mist", "Z"),
+    "IndexOB": ("use_pass_object_index", "X"),
+    "IndexMA": ("use_pass_material_index", "X"),
 }
 """Passes both renderers write, by Blender's view-layer toggle and channel ids."""
 
-BLENDER5_NAMES = {"DiffCol": "Diffuse Color", "GlossCol": "Glossy Color", "Emit": "Emission", "Env": "Environment"}
+BLENDER5_NAMES = {"DiffCol": "Diffuse Color", "GlossCol": "Glossy Color", "Emit": "Emission", "Env": "Environment",
+                  "IndexOB": "Object Index", "IndexMA": "Material Index"}
 """Names Cycles in Blender 5.0 writes for the passes Blender 4 (and DRT) call by their short names."""
 
 

@@ -224,7 +224,8 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     """The material as closures, and a warning (or None) about what was approximated."""
     if not uses_nodes(material):
         color = np.array(material.diffuse_color[:3], dtype=np.float64)
-        return Material(material.name, [Closure("DIFFUSE", color=color, roughness=0.0)]), None
+        return Material(material.name, [Closure("DIFFUSE", color=color, roughness=0.0)],
+                        pass_index=material.pass_index), None
     issues = Issues()
     compiler = Compiler(images, issues, layer=layer, pass_index=material.pass_index)
 
@@ -240,7 +241,8 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     displacement = None if output is None else _displacement(material, output, compiler, issues)
     unread_outputs(material.node_tree, output, issues)
     varying = any(c.inputs for c in closures) or displacement is not None
-    return (Material(material.name, closures, compiler.program if varying else None, displacement),
+    return (Material(material.name, closures, compiler.program if varying else None, displacement,
+                     pass_index=material.pass_index),
             issues.message(f"Material '{material.name}'"))
 
 

@@ -4,9 +4,11 @@ Mix and Add Shader are flattened; a World without a node tree uses ``world.color
 Cycles does; no world at all is black. A Background whose colour or strength comes from
 nodes (an Environment Texture through Mapping, say) becomes a program the core evaluates
 per ray direction and importance samples. Ray visibility: Camera, Diffuse, Glossy and
-Transmission.
+Transmission. The world's mist settings go with it (the Mist pass reads them, as Cycles' film does).
 """
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -24,9 +26,19 @@ def _visibility(world) -> dict:
             "visible_transmission": vis.transmission}
 
 
+MIST_FALLOFF = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
+"""Blender's mist falloff as the exponent Cycles raises the mist ramp to."""
+
+
 def export_world(world, warnings: list[str], images: ImageTable) -> World:
     if world is None:
         return World()
+    mist = world.mist_settings
+    return replace(_background(world, warnings, images), mist_start=float(mist.start), mist_depth=float(mist.depth),
+                   mist_falloff=MIST_FALLOFF[mist.falloff])
+
+
+def _background(world, warnings: list[str], images: ImageTable) -> World:
     if not uses_nodes(world):
         return World(radiance=world.color[:3])
     output = world.node_tree.get_output_node("CYCLES")

@@ -1,4 +1,5 @@
-"""What a hit's lobes show in the colour passes: DiffCol / GlossCol and Cycles' Denoising Albedo."""
+"""What a hit's lobes show in the passes: DiffCol / GlossCol, Cycles' Denoising Albedo, and the
+transparency Mist and the index passes weigh a hit by."""
 from __future__ import annotations
 
 from ..base.jit import kernel
@@ -85,3 +86,17 @@ def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
             s1 += a1
             s2 += a2
     return d0, d1, d2, s0, s1, s2, total == 0.0 or 4.0 * diffuse > total
+
+
+@kernel(inline="always")
+def transparency(lp, lt, hp, r, mu, mu_o):
+    """The transparent lobes' summed weight RGB (Cycles' ``surface_shader_transparency``)."""
+    j, t = locate(mu, mu_o)
+    c0 = c1 = c2 = 0.0
+    for l in range(lp.shape[0]):
+        if int(lp[l, P_KIND]) == TRANSPARENT:
+            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            c0 += a0
+            c1 += a1
+            c2 += a2
+    return c0, c1, c2

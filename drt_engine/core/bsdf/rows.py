@@ -6,7 +6,7 @@ import numpy as np
 
 from ..base.jit import kernel
 from .mixture import eval_lobes, sample_lobes, selection
-from .passes import colours, denoising_albedos
+from .passes import colours, denoising_albedos, transparency
 from .tables import lobe_scale, locate, ms_factor
 
 
@@ -54,6 +54,12 @@ def denoising_rows(lp, lt, hp, prow, mu, mu_o, inside, diff, spec, take):
         diff[i, 0], diff[i, 1], diff[i, 2] = v[0], v[1], v[2]
         spec[i, 0], spec[i, 1], spec[i, 2] = v[3], v[4], v[5]
         take[i] = v[6]
+
+
+@kernel
+def transparency_rows(lp, lt, hp, prow, mu, mu_o, out):
+    for i in range(len(mu_o)):
+        out[i, 0], out[i, 1], out[i, 2] = transparency(lp, lt, hp, prow[i], mu, mu_o[i])
 
 
 @kernel

@@ -29,7 +29,8 @@ from ..scene import Closure, Material
 from . import layout
 from . import microfacet as mf
 from .records import BsdfSample, BsdfValue
-from .rows import colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, weights_rows
+from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
+                   weights_rows)
 
 
 @dataclass(eq=False)
@@ -557,6 +558,13 @@ class MaterialShader:
         denoising_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(mu_o), _bools(inside),
                        diff, spec, take)
         return diff, spec, take
+
+    def transparency(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
+        """(N, 3) the transparent lobes' weight per hit: what Mist and the index passes see through."""
+        out = np.zeros((len(mu_o), 3))
+        if any(lobe.kind == "transparent" for lobe in self.lobes):
+            transparency_rows(self.lp, self.lt, self.hp, self.hit_rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        return out
 
     def lobe_weights(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
         """(N, L, 3) weight of each lobe at view cosines mu_o: its scale (weight, layers above,

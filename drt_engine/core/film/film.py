@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..settings import PASS_CHANNELS
+from ..settings import FIRST_SAMPLE_PASSES, PASS_CHANNELS
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 
 _TABLE = 1024
@@ -123,6 +123,16 @@ def _splat(pixel, values, total):
 
 
 @kernel
+def _splat_first(pixel, sample, values, replicate, total):
+    """Set each pixel's value to its first sample's (id 0 of replicate 0, or of the only sequence):
+    exactly one sample of a pixel, in whichever wave or part it is traced, so parts still add."""
+    for i in range(len(pixel)):
+        if sample[i] == 0 and replicate <= 0:
+            for c in range(values.shape[1]):
+                total[pixel[i], c] += values[i, c]
+
+
+@kernel
 def _splat_counts(pixel, sample, combined, replicate, count, count_a, sum_a):
     """Sample counts, and the count and Combined RGB sums of class A: the samples of replicate 1,
     or (replicate < 0: GRID, nothing to replicate) the class of each sample id."""
@@ -167,7 +177,8 @@ def _extend_range(pixel, combined, lo, hi):
 
 
 class Film:
-    """Sums per pixel of the window: samples, every pass, and Combined RGB over class A.
+    """Sums per pixel of the window: samples, every pass, and Combined RGB over class A; the
+    ``FIRST_SAMPLE_PASSES`` hold only their pixel's first sample, read as it is.
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
@@ -203,6 +214,8 @@ class Film:
         for name, total in self.sums.items():
             if name == RATIO:
                 _splat_ratio(pixel, sample, values[name], replicate, total)
+            elif name in FIRST_SAMPLE_PASSES:
+                _splat_first(pixel, sample, values[name], replicate, total)
             else:
                 _splat(pixel, values[name], total)
         for name, total in self.sums_a.items():
@@ -288,6 +301,8 @@ class Film:
             unknown = ~np.isfinite(var)
             var[unknown] = mean[unknown] ** 2
             return np.sqrt(var)
+        if name in FIRST_SAMPLE_PASSES:
+            return self.sums[name][span]
         mean = self.sums[name][span] / np.maximum(count, 1)[:, None]
         if name == "Combined" and self.ratio:
             mean[:, :3] = self.rgb(span)

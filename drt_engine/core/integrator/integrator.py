@@ -25,6 +25,7 @@ from ..base.constants import TINY
 from ..base.vectors import Frame
 from ..film.denoising import Features
 from ..film.film import PixelFilter
+from ..film.mist import Mist
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
@@ -41,7 +42,8 @@ from .records import PathState, Samples, SurfaceHits
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _NO_BOUNCES = camera_bounces(0)  # the continuation kernel's bounces when no program reads Light Path
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
-        ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"))
+        ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
+        ("IndexOB", "X"), ("IndexMA", "X"))
 
 
 @dataclass
@@ -76,6 +78,7 @@ class WaveOutput:
     alpha: np.ndarray
     aux: dict
     features: Features | None = None  # the denoising features' walks, when those passes are on
+    indexed: np.ndarray | None = None  # per path: its index passes are final (an opaque enough hit was seen)
     ratio: RatioEstimator | None = None
 
     def values(self, clamp: float) -> dict:
@@ -112,6 +115,10 @@ class Integrator:
         # paths carry their ray kind and depths only for a scene whose shader programs read them
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
+        self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
+        indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
+        self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
+        self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
         self._rays_lock = threading.Lock()
 
@@ -131,6 +138,10 @@ class Integrator:
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
+        if "Mist" in out.aux:
+            out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
+        if "IndexOB" in out.aux or "IndexMA" in out.aux:
+            out.indexed = np.zeros(n, bool)
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
             out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
         if not cam.valid.all():  # no ray outside a fisheye's circle: black and opaque, as Cycles leaves it
@@ -173,6 +184,8 @@ class Integrator:
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
+                if self.mist is not None or out.indexed is not None:
+                    self._data_passes(group, shader, out)
                 if light is not None and shader.lobes:
                     self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out)
                     start += len(group)
@@ -285,6 +298,28 @@ class Integrator:
             aux["Normal"][surf.path] = surf.normal
         if "Position" in aux:
             aux["Position"][surf.path] = surf.pos
+
+    def _data_passes(self, group: SurfaceHits, shader, out: WaveOutput):
+        """Mist and the index passes at the hits the camera sees directly or through transparency,
+        as Cycles' film_write_data_passes: each hit takes (1 - mist) of Mist, weighted by the path's
+        throughput times the hit's opacity; an index is the last such hit's until one is at least
+        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film)."""
+        rows = np.flatnonzero(group.straight)
+        if len(rows) == 0:
+            return
+        path = group.path[rows]
+        opacity = np.clip(1.0 - shader.transparency(group.wo_l[rows, 2], rows), 0.0, 1.0)
+        if self.mist is not None:
+            seen = (group.throughput[rows] * opacity).mean(axis=1)
+            out.aux["Mist"][path, 0] -= (1.0 - self.mist.amount(group.pos[rows])) * seen
+        if out.indexed is not None:
+            open_ = ~out.indexed[path]
+            rows, path = rows[open_], path[open_]
+            if "IndexOB" in out.aux:
+                out.aux["IndexOB"][path, 0] = self.object_index[self.geometry.source_of(group.prim[rows])[:, 0]]
+            if "IndexMA" in out.aux:
+                out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
+            out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
