@@ -75,6 +75,19 @@ def test_lights_are_hidden_from_the_camera_unless_visible_camera():
     assert mean(scene, samples=4) == pytest.approx(L)
 
 
+@pytest.mark.parametrize("transparent", [False, True])
+def test_a_visible_light_lets_the_camera_see_what_is_behind_it(transparent):
+    """Cycles' integrate_light: a light is no surface, so the camera ray adds its emission and goes
+    on; the world behind adds its own (or, with a transparent film, makes the pixel transparent)."""
+    facing_up = translation(0, 0, -1) @ np.diag([1.0, -1.0, -1.0, 1.0])
+    light = Light("AREA", facing_up, radiance=np.full(3, L), size_x=1.0, visible_camera=True)
+    scene = SceneData(top_camera(height=1.0, half_width=0.01), lights=[light], world=World(np.full(3, 0.25)))
+    scene.film_transparent = transparent
+    combined = Renderer(scene, RenderSettings(samples=4, threads=1)).render().passes["Combined"]
+    assert combined[..., :3].mean() == pytest.approx(L if transparent else L + 0.25)
+    assert combined[..., 3].mean() == pytest.approx(0.0 if transparent else 1.0)
+
+
 def _tiled_lights(n_side, size=4000.0, height=1.5):
     tile = size / n_side
     return [Light("AREA", translation(-size / 2 + (i + 0.5) * tile, -size / 2 + (j + 0.5) * tile, height),

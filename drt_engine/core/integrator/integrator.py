@@ -159,8 +159,9 @@ class Integrator:
             on_light = light_id >= 0
             self._lights_hit(state.take(np.flatnonzero(on_light)), light_t[on_light], light_id[on_light],
                              light_le[on_light], out)
-            self._escaped(state.take(np.flatnonzero(~hits.hit & ~on_light)), out)
-            rows = np.flatnonzero(hits.hit & ~on_light)
+            # a light is no surface: as in Cycles (integrate_light), rays go on past it
+            self._escaped(state.take(np.flatnonzero(~hits.hit)), out)
+            rows = np.flatnonzero(hits.hit)
             if len(rows) == 0:
                 break
             mat = self.geometry.material_of(hits.prim[rows])
@@ -220,7 +221,8 @@ class Integrator:
 
     # -- what rays see ----------------------------------------------------------------
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
-        """Lights hit directly: always by reflected and refracted rays, by the camera if asked."""
+        """Lights hit directly: always by reflected and refracted rays, by the camera if asked; the
+        rays go on to what is behind, which alone decides the pixel's alpha."""
         if len(rays) == 0:
             return
 
@@ -229,9 +231,6 @@ class Integrator:
                                    rays.time[smooth])
 
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
-        if self.film_transparent:
-            direct = rays.straight
-            out.alpha[rays.path[direct]] -= rays.throughput[direct].mean(axis=1)
 
     def _escaped(self, rays: PathState, out: WaveOutput):
         """Escaped rays see the world (and, after a bounce, the suns)."""
