@@ -11,7 +11,6 @@ Run from the repository root: .venv/bin/python bench/node_parity.py (``make node
 """
 from __future__ import annotations
 
-import json
 import sys
 import tempfile
 from pathlib import Path
@@ -22,7 +21,7 @@ sys.path.insert(0, str(ROOT))
 import bpy  # noqa: E402
 
 import drt_engine  # noqa: E402
-from bench.blocks import replace_between  # noqa: E402
+from bench.texture_parity import publish, row  # noqa: E402
 from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM  # noqa: E402
 from drt_engine.blender.export.shader_graph import (DISPLACEMENT_MATCHED_FROM,  # noqa: E402
                                                    FALLOFF_WORLD_MATCHED_FROM)
@@ -32,7 +31,6 @@ from tests.support import sky_scenes  # noqa: E402
 
 MARK_BEGIN, MARK_END = "<!-- node parity: begin -->", "<!-- node parity: end -->"
 JSON_PATH = ROOT / "docs" / "node_parity.json"
-PAGE = ROOT / "docs" / "shader-node-parity.md"
 NAMED = "named in the warning: this Blender's Cycles computes it otherwise"
 
 
@@ -80,21 +78,14 @@ def table(figures: dict) -> str:
             "the worst 4x4-block difference of DRT from Cycles, beside Cycles' own worst between two seeds; "
             "a case passes at 1.5x that plus 0.002.", "",
             "| node or closure | DRT vs Cycles | Cycles vs Cycles | within |", "|---|---|---|---|"]
-    for name, f in figures["cases"].items():
-        if isinstance(f, str):
-            rows.append(f"| {name} | {f} | | |")
-        else:
-            rows.append(f"| {name} | {f['worst']:.4f} | {f['cycles_seeds']:.4f} | {'yes' if f['ok'] else '**no**'} |")
+    rows += [row(name, f) for name, f in figures["cases"].items()]
     return "\n".join(rows) + "\n"
 
 
 def main() -> None:
     drt_engine.register()
     figures = measure()
-    JSON_PATH.write_text(json.dumps(figures, indent=1) + "\n")
-    replace_between(PAGE, MARK_BEGIN, MARK_END, table(figures))
-    failed = [name for name, f in figures["cases"].items() if not isinstance(f, str) and not f["ok"]]
-    print(f"{len(figures['cases'])} cases, {len(failed)} outside the limit" + (f": {failed}" if failed else ""))
+    publish(figures, JSON_PATH, (MARK_BEGIN, MARK_END), table(figures))
 
 
 if __name__ == "__main__":
