@@ -89,6 +89,9 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         seed=drt.seed,
         sampling_pattern=drt.sampling_pattern,
         max_depth=drt.max_depth,
+        diffuse_bounces=drt.diffuse_bounces,
+        min_light_bounces=drt.min_light_bounces,
+        min_transparent_bounces=drt.min_transparent_bounces,
         clamp=drt.clamp,
         threads=drt.threads,
         filter_type=drt.filter_type,
@@ -164,11 +167,36 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     max_depth: IntProperty(
         name="Max Depth",
-        description="Longest chain of specular and glossy reflections and refractions "
-        "followed from the camera (diffuse surfaces take direct light only)",
+        description="Longest chain of reflections and refractions followed from the camera "
+        "(Cycles' Total bounces, transparent ones included)",
         default=8,
         min=0,
         soft_max=64,
+        max=1024,
+    )
+    diffuse_bounces: IntProperty(
+        name="Diffuse",
+        description="Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse "
+        "surfaces take direct light only, the classic distribution ray traced image",
+        default=0,
+        min=0,
+        soft_max=32,
+        max=1024,
+    )
+    min_light_bounces: IntProperty(
+        name="Min Light Bounces",
+        description="Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
+        "only paths with diffuse bounces are ended so",
+        default=0,
+        min=0,
+        max=1024,
+    )
+    min_transparent_bounces: IntProperty(
+        name="Min Transparent Bounces",
+        description="Transparent bounces before Russian roulette may end a path (Cycles' Min "
+        "Transparent Bounces); only with diffuse bounces",
+        default=0,
+        min=0,
         max=1024,
     )
     clamp: FloatProperty(
