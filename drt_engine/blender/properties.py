@@ -127,6 +127,12 @@ def _update_scene_passes(self, context):
         view_layer.update_render_passes()
 
 
+def _bounces(name: str, description: str, default: int = 0, soft_max: int = 64) -> dict:
+    """The arguments of a count of bounces, as the Light Paths panel shows them."""
+    return {"name": name, "description": description, "default": default, "min": 0, "soft_max": soft_max,
+            "max": 1024}
+
+
 class DRTSceneSettings(bpy.types.PropertyGroup):
     samples: IntProperty(
         name="Samples",
@@ -165,40 +171,18 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         ),
         default="SOBOL",
     )
-    max_depth: IntProperty(
-        name="Max Depth",
-        description="Longest chain of reflections and refractions followed from the camera "
-        "(Cycles' Total bounces, transparent ones included)",
-        default=8,
-        min=0,
-        soft_max=64,
-        max=1024,
-    )
-    diffuse_bounces: IntProperty(
-        name="Diffuse",
-        description="Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse "
-        "surfaces take direct light only, the classic distribution ray traced image",
-        default=0,
-        min=0,
-        soft_max=32,
-        max=1024,
-    )
-    min_light_bounces: IntProperty(
-        name="Min Light Bounces",
-        description="Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
-        "only paths with diffuse bounces are ended so",
-        default=0,
-        min=0,
-        max=1024,
-    )
-    min_transparent_bounces: IntProperty(
-        name="Min Transparent Bounces",
-        description="Transparent bounces before Russian roulette may end a path (Cycles' Min "
-        "Transparent Bounces); only with diffuse bounces",
-        default=0,
-        min=0,
-        max=1024,
-    )
+    max_depth: IntProperty(**_bounces(
+        "Max Depth", "Longest chain of reflections and refractions followed from the camera (Cycles' Total "
+        "bounces, transparent ones included)", default=8))
+    diffuse_bounces: IntProperty(**_bounces(
+        "Diffuse", "Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse surfaces take "
+        "direct light only, the classic distribution ray traced image", soft_max=32))
+    min_light_bounces: IntProperty(**_bounces(
+        "Min Light Bounces", "Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
+        "only paths with diffuse bounces are ended so"))
+    min_transparent_bounces: IntProperty(**_bounces(
+        "Min Transparent Bounces", "Transparent bounces before Russian roulette may end a path (Cycles' Min "
+        "Transparent Bounces); only with diffuse bounces"))
     clamp: FloatProperty(
         name="Clamp",
         description="Largest radiance one sample may contribute, to tame fireflies at the "
