@@ -89,6 +89,9 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         seed=drt.seed,
         sampling_pattern=drt.sampling_pattern,
         max_depth=drt.max_depth,
+        diffuse_bounces=drt.diffuse_bounces,
+        min_light_bounces=drt.min_light_bounces,
+        min_transparent_bounces=drt.min_transparent_bounces,
         clamp=drt.clamp,
         threads=drt.threads,
         filter_type=drt.filter_type,
@@ -122,6 +125,12 @@ def _update_scene_passes(self, context):
     """Denoising adds or removes the Noisy Image pass of every view layer."""
     for view_layer in self.id_data.view_layers:
         view_layer.update_render_passes()
+
+
+def _bounces(name: str, description: str, default: int = 0, soft_max: int = 64) -> dict:
+    """The arguments of a count of bounces, as the Light Paths panel shows them."""
+    return {"name": name, "description": description, "default": default, "min": 0, "soft_max": soft_max,
+            "max": 1024}
 
 
 class DRTSceneSettings(bpy.types.PropertyGroup):
@@ -162,15 +171,18 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         ),
         default="SOBOL",
     )
-    max_depth: IntProperty(
-        name="Max Depth",
-        description="Longest chain of specular and glossy reflections and refractions "
-        "followed from the camera (diffuse surfaces take direct light only)",
-        default=8,
-        min=0,
-        soft_max=64,
-        max=1024,
-    )
+    max_depth: IntProperty(**_bounces(
+        "Max Depth", "Longest chain of reflections and refractions followed from the camera (Cycles' Total "
+        "bounces, transparent ones included)", default=8))
+    diffuse_bounces: IntProperty(**_bounces(
+        "Diffuse", "Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse surfaces take "
+        "direct light only, the classic distribution ray traced image", soft_max=32))
+    min_light_bounces: IntProperty(**_bounces(
+        "Min Light Bounces", "Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
+        "only paths with diffuse bounces are ended so"))
+    min_transparent_bounces: IntProperty(**_bounces(
+        "Min Transparent Bounces", "Transparent bounces before Russian roulette may end a path (Cycles' Min "
+        "Transparent Bounces); only with diffuse bounces"))
     clamp: FloatProperty(
         name="Clamp",
         description="Largest radiance one sample may contribute, to tame fireflies at the "

@@ -7,6 +7,7 @@ class name and missing ones are skipped: names move between Blender 4.2 and 5.0.
 import bpy
 
 from .oidn import unavailable_reason
+from .presets import DRT_MT_light_paths_presets, DRT_OT_light_paths_preset
 
 ENGINE = "DRT"
 
@@ -168,11 +169,20 @@ class DRT_PT_sampling_range(DRTButtonsPanel, bpy.types.Panel):
 class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
+    def draw_header_preset(self, context):
+        self.layout.menu(DRT_MT_light_paths_presets.__name__, text="", icon="PRESET")
+
     def draw(self, context):
         layout = split(self.layout)
         drt = context.scene.drt
+        col = layout.column(align=True)
+        col.prop(drt, "max_depth", text="Total")
+        col.prop(drt, "diffuse_bounces")
+        col = layout.column(align=True)
+        col.active = drt.diffuse_bounces > 0  # Russian roulette ends only paths with diffuse bounces
+        col.prop(drt, "min_light_bounces")
+        col.prop(drt, "min_transparent_bounces")
         col = layout.column()
-        col.prop(drt, "max_depth")
         col.prop(drt, "clamp")
         col.prop(drt, "shadow_estimator")
 
@@ -242,6 +252,8 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer.drt, "use_pass_noise")
 
 
+PRESET_CLASSES = (DRT_OT_light_paths_preset, DRT_MT_light_paths_presets)
+"""The Light Paths panel's preset menu and what it runs."""
 classes = (
     DRT_PT_sampling,
     DRT_PT_sampling_adaptive,
@@ -256,7 +268,7 @@ classes = (
 
 
 def register():
-    for cls in classes:
+    for cls in PRESET_CLASSES + classes:
         bpy.utils.register_class(cls)
     for panel in _shared_panels():
         if ENGINE not in panel.COMPAT_ENGINES:
@@ -267,5 +279,5 @@ def register():
 def unregister():
     while _opened:
         _opened.pop().COMPAT_ENGINES.discard(ENGINE)
-    for cls in reversed(classes):
+    for cls in reversed(PRESET_CLASSES + classes):
         bpy.utils.unregister_class(cls)

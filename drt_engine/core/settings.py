@@ -66,6 +66,13 @@ class RenderSettings:
     seed: int = 0
     sampling_pattern: str = "SOBOL"
     max_depth: int = 8
+    # Cycles' Diffuse bounces: how many diffuse reflections a path may take (0: direct light only
+    # on diffuse surfaces, DRT's classic image; core.integrator.bounces)
+    diffuse_bounces: int = 0
+    # Cycles' Min Light Bounces and Min Transparent Bounces: Russian roulette ends paths after
+    # them (only with diffuse bounces; core.integrator.continuation.roulette)
+    min_light_bounces: int = 0
+    min_transparent_bounces: int = 0
     clamp: float = 0.0
     threads: int = 0
     filter_type: str = "BLACKMAN_HARRIS"
@@ -109,6 +116,9 @@ class RenderSettings:
         if self.denoising_quality not in DENOISING_QUALITIES:
             raise SettingsError(f"unknown denoising quality {self.denoising_quality!r} "
                                 f"(one of {', '.join(DENOISING_QUALITIES)})")
+        for name in ("diffuse_bounces", "min_light_bounces", "min_transparent_bounces"):
+            if getattr(self, name) < 0:
+                raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         unknown = set(self.passes) - set(PASSES)

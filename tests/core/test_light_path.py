@@ -134,10 +134,19 @@ def test_outputs_without_a_path_are_a_camera_hits_light_samples():
     out = dict(zip(OUTPUTS, outputs(None, 3)))
     assert np.all(out["Ray Depth"] == 1.0) and np.all(out["Ray Length"] == ESTIMATE_LENGTH)
     assert not any(out[k].any() for k in OUTPUTS if k not in ("Ray Depth", "Ray Length"))
-    bounces = np.array([[2 | 4, 3, 2, 1, 4]])
+    bounces = np.array([[2 | 4, 3, 2, 1, 4, 0]])
     seen = dict(zip(OUTPUTS, outputs(RayPath(np.zeros(1, bool), bounces, np.array([2.5])), 1)))
     assert [seen[k][0] for k in ("Is Transmission Ray", "Is Glossy Ray", "Is Reflection Ray", "Ray Depth",
                                  "Glossy Depth", "Transmission Depth", "Transparent Depth", "Ray Length")] == \
         [1.0, 1.0, 0.0, 3.0, 2.0, 1.0, 4.0, 2.5]
     sampled = dict(zip(OUTPUTS, outputs(RayPath.light_samples(bounces, np.array([2.5])), 1)))
     assert sampled["Is Transmission Ray"][0] == 0.0 and sampled["Ray Depth"][0] == 4.0
+
+
+def test_a_diffuse_ray_is_one_with_its_depth():
+    """With diffuse bounces a diffuse lobe spawns rays: Is Diffuse Ray and Diffuse Depth read the
+    kind and depth core.integrator.continuation counts (here after two diffuse reflections)."""
+    bounces = np.array([[1 | 16, 2, 0, 0, 0, 2]])
+    seen = dict(zip(OUTPUTS, outputs(RayPath(np.zeros(1, bool), bounces, np.array([1.0])), 1)))
+    assert [seen[k][0] for k in ("Is Diffuse Ray", "Diffuse Depth", "Is Reflection Ray", "Is Glossy Ray",
+                                 "Ray Depth")] == [1.0, 2.0, 1.0, 0.0, 2.0]

@@ -52,6 +52,17 @@ def test_diffuse_only_scene_traces_no_reflection_refraction_or_transparent_rays(
     assert "reflection rays" in res.stats["plan_summary"]
 
 
+def test_diffuse_rays_only_with_diffuse_bounces():
+    """Diffuse bounces 0 (the default) traces no diffuse ray and says so; with bounces the plan
+    names them, the counter counts them, and a diffuse-only scene traces no other bounce kind."""
+    _, classic = run(floor_scene((DIFFUSE, DIFFUSE), [point(0, 0, 3)], ball=np.eye(4)))
+    assert classic.stats["rays"]["diffuse"] == 0 and "diffuse rays" in classic.stats["plan_summary"]
+    _, bounced = run(floor_scene((DIFFUSE, DIFFUSE), [point(0, 0, 3)], ball=np.eye(4)), diffuse_bounces=2)
+    rays = bounced.stats["rays"]
+    assert rays["diffuse"] > 0 and bounced.stats["plan"]["rays"]["diffuse"]
+    assert rays["reflection"] == rays["refraction"] == rays["transparent"] == 0
+
+
 def test_each_lobe_kind_traces_its_own_ray_kind_and_only_that():
     _, mirror = run(floor_scene((DIFFUSE, MIRROR), [point(0, 0, 3)], ball=np.eye(4)))
     assert mirror.stats["rays"]["reflection"] > 0 and mirror.stats["rays"]["refraction"] == 0

@@ -63,7 +63,7 @@ def set_resolution(scene, width: int, height: int) -> None:
 
 
 def configure_cycles(scene, samples: int, seed: int, threshold: float | None = None) -> None:
-    """Cycles as a distribution ray tracer with DRT's depth, filter and no noise tricks; with a
+    """Cycles as a distribution ray tracer with DRT's depth, diffuse bounces, filter and no noise tricks; with a
     ``threshold``, its adaptive sampling at that noise threshold and automatic min samples
     (the benchmark's "Cycles adaptive")."""
     cycles = scene.cycles
@@ -78,7 +78,9 @@ def configure_cycles(scene, samples: int, seed: int, threshold: float | None = N
         cycles.adaptive_min_samples = 0
     cycles.time_limit = 0.0
     cycles.use_denoising = False
-    cycles.diffuse_bounces = 0
+    cycles.diffuse_bounces = scene.drt.diffuse_bounces
+    cycles.min_light_bounces = scene.drt.min_light_bounces
+    cycles.min_transparent_bounces = scene.drt.min_transparent_bounces
     cycles.glossy_bounces = depth
     cycles.transmission_bounces = depth
     cycles.transparent_max_bounces = depth

@@ -10,6 +10,10 @@
 # lobe kinds and Fresnel kinds
 DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR = 0, 1, 2, 3, 4, 5
 F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
+# which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
+# with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
+# covers every lobe (slot = lobe index) and the diffuse lobes outside the bits get no share
+SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT = 1, 2
 
 # lp: constants per lobe
 P_KIND = 0

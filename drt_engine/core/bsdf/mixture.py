@@ -19,9 +19,10 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
-from .diffuse import diffuse_eval
+from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import DIFFUSE, P_DELTA, P_KIND, P_SAMPLED, REFLECT, TRANSLUCENT, TRANSPARENT
+from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
+                     TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import reflect_eval, reflect_sample
@@ -31,33 +32,54 @@ from .transparent import transparent_sample
 
 
 @kernel(inline="always")
-def selection(lp, lt, hp, r, mu, mu_o, sel, si):
-    """Fill ``sel[si]`` with the probabilities of continuing through each non-diffuse lobe:
-    proportional to their albedos' largest channel, uniform when all are black."""
+def slot(lp, l, diffuse):
+    """Lobe l's place in the lobe choice at a hit whose path may continue through the ``diffuse``
+    lobes (layout.SAMPLE_* bits), -1 where no ray continues through it: with no bits the
+    non-diffuse lobes' P_SAMPLED (as without diffuse bounces), with any the lobe's own index."""
+    if diffuse == 0:
+        return int(lp[l, P_SAMPLED])
+    kind = int(lp[l, P_KIND])
+    if kind == DIFFUSE or kind == OREN_NAYAR:
+        return l if diffuse & SAMPLE_DIFFUSE else -1
+    if kind == TRANSLUCENT:
+        return l if diffuse & SAMPLE_TRANSLUCENT else -1
+    return l
+
+
+@kernel(inline="always")
+def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
+    """Fill ``sel[si]`` with the probabilities of continuing through each lobe a ray may continue
+    through (``slot``): proportional to their albedos' largest channel, uniform when all are
+    black; 0 in a slot of a lobe left out (with ``diffuse`` bits, ``sel`` has one slot per lobe)."""
     j, t = locate(mu, mu_o)
     total = 0.0
     n = 0
     for l in range(lp.shape[0]):
-        k = int(lp[l, P_SAMPLED])
+        k = slot(lp, l, diffuse)
         if k < 0:
+            if diffuse != 0:
+                sel[si, l] = 0.0
             continue
         a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         sel[si, k] = max(max(a0, a1), a2)
         total += sel[si, k]
         n += 1
-    for k in range(n):
+    for k in range(n if diffuse == 0 else lp.shape[0]):
+        if diffuse != 0 and slot(lp, k, diffuse) < 0:
+            continue
         sel[si, k] = sel[si, k] / max(total, TINY) if total > 0.0 else 1.0 / n
 
 
 
 @kernel(inline="always")
-def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si):
+def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse):
     """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
 
     ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
-    back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo. Returns
-    (diffuse part RGB (Lambert, Oren-Nayar and translucent lobes), non-diffuse part RGB, density of continuing toward wi through the
-    non-diffuse lobes).
+    back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo, for the ``diffuse``
+    lobes a path may continue through (``slot``). Returns (the part no ray continues through RGB:
+    the diffuse lobes (Lambert, Oren-Nayar, translucent) left out of the choice, the part rays
+    continue through RGB, density of continuing toward wi through the lobes of the choice).
     """
     j, t = locate(mu, woz)
     fd0 = fd1 = fd2 = fn0 = fn1 = fn2 = pdf = 0.0
@@ -78,6 +100,13 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
             else:
                 d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
+            k = slot(lp, l, diffuse)
+            if k >= 0:  # a lobe paths continue through: weighed against sampling it, as the others
+                fn0 += d0
+                fn1 += d1
+                fn2 += d2
+                pdf += sel[si, k] * abs(wiz) / np.pi
+                continue
             fd0 += d0
             fd1 += d1
             fd2 += d2
@@ -95,7 +124,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
         fn0 += s0 * f0 * ms
         fn1 += s1 * f1 * ms
         fn2 += s2 * f2 * ms
-        pdf += sel[si, int(lp[l, P_SAMPLED])] * p
+        pdf += sel[si, slot(lp, l, diffuse)] * p
     return fd0, fd1, fd2, fn0, fn1, fn2, pdf
 
 
@@ -112,17 +141,18 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
 
 
 @kernel(inline="always")
-def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si):
-    """Continue through one non-diffuse lobe chosen by ``sel[si]`` (``selection`` at wo).
+def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si, diffuse):
+    """Continue through one lobe chosen by ``sel[si]`` (``selection`` at wo with the same
+    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through.
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
-    the transparent lobe was taken). For non-delta lobes the weight and pdf are those of
-    the whole non-diffuse mixture (one-sample MIS over lobes), as multiple importance
-    sampling with light sampling requires.
+    the transparent lobe was taken, diffuse: a diffuse lobe was). For non-delta lobes the weight
+    and pdf are those of the whole mixture of the choice (one-sample MIS over lobes), as multiple
+    importance sampling with light sampling requires.
     """
     n = sel.shape[1]
     if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False
     count = 0
     acc = 0.0
     for k in range(n):
@@ -136,11 +166,19 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     p_choice = sel[si, choice]
     u_re = min(max((u_select - lo) / max(p_choice, TINY), 0.0), 1.0 - 1e-12)
     j, t = locate(mu, woz)
-    l = 0
-    while int(lp[l, P_SAMPLED]) != choice:
-        l += 1
-    wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
-                                                lobe_eta(lp, l, inside))
+    l = choice
+    if diffuse == 0:
+        l = 0
+        while int(lp[l, P_SAMPLED]) != choice:
+            l += 1
+    kind = int(lp[l, P_KIND])
+    if diffuse_kind(kind):  # its weight is the mixture's, below
+        wix, wiy, wiz, _ = cosine_sample(u0, u1, -1.0 if kind == TRANSLUCENT else 1.0)
+        w0 = w1 = w2 = 1.0
+        ok = True
+    else:
+        wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
+                                                    lobe_eta(lp, l, inside))
     s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
     ms = ms_factor(lp, lt, hp, r, j, t, l)
     p = max(p_choice, TINY)
@@ -150,7 +188,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     pdf = 0.0
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
-                                              sel, si)
+                                              sel, si, diffuse)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:
@@ -159,4 +197,4 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     w0 = w0 if np.isfinite(w0) else 0.0
     w1 = w1 if np.isfinite(w1) else 0.0
     w2 = w2 if np.isfinite(w2) else 0.0
-    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, int(lp[l, P_KIND]) == TRANSPARENT
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind)

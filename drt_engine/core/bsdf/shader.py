@@ -75,7 +75,7 @@ class Lobe:
 
     @property
     def diffuse(self) -> bool:
-        """One of the diffuse lobes, which no ray continues through."""
+        """One of the diffuse lobes, which rays continue through only with diffuse bounces on."""
         return self.kind in DIFFUSE_KINDS
 
     @property

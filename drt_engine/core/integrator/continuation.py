@@ -1,5 +1,6 @@
-"""Paths continued through one non-diffuse lobe, for a shader's hits in one kernel call: the lobe
-chosen by its albedo and sampled (core.bsdf.mixture), the new throughput, the direction in the
+"""Paths continued through one lobe, for a shader's hits in one kernel call: the lobe (non-diffuse,
+or diffuse where diffuse bounces let the path, integrator.bounces) chosen by its albedo and
+sampled (core.bsdf.mixture), the new throughput, the direction in the
 world, the check that it leaves through the side of the geometric surface the lobe says, the
 next ray's origin pushed off the surface, and (when a shader program reads Light Path) the path's
 ray kind and depths after the bounce."""
@@ -10,13 +11,15 @@ import numpy as np
 from ..base.jit import kernel
 from ..bsdf.mixture import sample_lobes, selection
 from ..geometry.accel import spawn_point
-from ..shading.lightpath import DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR, TRANSMISSION_DEPTH, TRANSMIT
-from ..shading.lightpath import TRANSPARENT_DEPTH
+from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
+from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
+from .bounces import diffuse_bits
 
 
 @kernel
 def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, wo_l, inside, u_select, u2, throughput, pos, ng, scale,
-                   bounces, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces):
+                   bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf, passthrough,
+                   transmit, next_bounces, diffuse):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
     world direction ``wi``, the path's new throughput ``weight``, the density that sampled the
     direction (``prev_pdf``, inf for a delta lobe), whether the transparent lobe was taken, whether
@@ -24,12 +27,20 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, wo_l, inside, u_selec
     depths of the paths), ``next_bounces``: as Cycles' path_state_next, a transparent lobe keeps
     the kind and counts a transparent bounce; any other sets reflection or transmission, glossy,
     and singular for a delta lobe, and counts a bounce and a glossy (reflected) or transmission
-    one. Shader and hits as core.integrator.direct has them."""
-    sel = np.empty((1, max(n_sampled, 1)))
+    one; a diffuse lobe (allowed by ``diffuse_limit``, the diffuse bounces, on paths that carry
+    their depths) sets reflection or transmission and diffuse, and counts a bounce and a diffuse
+    (reflected) or transmission one; ``diffuse[j]``: a diffuse lobe was taken. With
+    ``min_bounces`` (bounces, transparent bounces; -1: no roulette) a path past them goes on with
+    Cycles' probability min(sqrt(max throughput), 1) (``roulette``), decided by ``u_roulette[j]``.
+    Shader and hits as core.integrator.direct has them."""
+    sel_nd = np.empty((1, max(n_sampled, 1)))
+    sel_all = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0)
+        bits = diffuse_bits(bounces, j, diffuse_limit)
+        sel = sel_nd if bits == 0 else sel_all
+        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
-                         inside[j], sel, 0)
+                         inside[j], sel, 0, bits)
         t0, t1, t2 = throughput[j, 0] * s[3], throughput[j, 1] * s[4], throughput[j, 2] * s[5]
         peak = np.maximum(np.maximum(t0, t1), t2)
         go[j] = False
@@ -43,18 +54,41 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, wo_l, inside, u_selec
         crosses = z < 0
         if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0) != crosses:
             continue
+        if min_bounces[0] >= 0 and len(bounces):
+            p = roulette(bounces, j, s[9], peak, min_bounces)
+            if u_roulette[j] >= p:
+                continue
+            t0, t1, t2 = t0 / p, t1 / p, t2 / p
         go[j] = True
         origin[j, 0], origin[j, 1], origin[j, 2] = spawn_point(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1],
                                                                ng[j, 2], wx, wy, wz, scale[j])
         wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
         weight[j, 0], weight[j, 1], weight[j, 2] = t0, t1, t2
         prev_pdf[j] = np.inf if s[7] else s[6]
-        passthrough[j], transmit[j] = s[9], crosses
+        passthrough[j], transmit[j], diffuse[j] = s[9], crosses, s[10]
         if len(bounces):
             next_bounces[j] = bounces[j]
             if s[9]:
                 next_bounces[j, TRANSPARENT_DEPTH] += 1
+            elif s[10]:
+                next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | DIFFUSE
+                next_bounces[j, DEPTH] += 1
+                next_bounces[j, TRANSMISSION_DEPTH if crosses else DIFFUSE_DEPTH] += 1
             else:
                 next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | GLOSSY | (SINGULAR if s[7] else 0)
                 next_bounces[j, DEPTH] += 1
                 next_bounces[j, TRANSMISSION_DEPTH if crosses else GLOSSY_DEPTH] += 1
+
+
+@kernel(inline="always")
+def roulette(bounces, j, transparent, peak, min_bounces):
+    """The probability that path j goes on after this bounce (Cycles'
+    path_state_continuation_probability): 1 while its bounces (transparent ones through a
+    transparent lobe) are at most the minimum + 1 (Cycles' kernel limit: the setting + 1),
+    min(sqrt(largest channel of the throughput), 1) after."""
+    if transparent:
+        if bounces[j, TRANSPARENT_DEPTH] + 1 <= min_bounces[1] + 1:
+            return 1.0
+    elif bounces[j, DEPTH] + 1 <= min_bounces[0] + 1:
+        return 1.0
+    return min(np.sqrt(peak), 1.0)

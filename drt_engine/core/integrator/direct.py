@@ -16,6 +16,7 @@ from ..bsdf.mixture import eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import UNRESTRICTED
+from .bounces import diffuse_bits
 from .mis import power
 
 TERMINATOR_CUTOFF = 0.1
@@ -61,14 +62,16 @@ def _aim(x, y, z):
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, geo, prim,
-                 u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times, radiance, f_diff,
-                 visibility):
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
+                 diffuse_limit, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times,
+                 radiance, f_diff, visibility):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays traced.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
-    normal rows), wo in that frame, inside, offset scale, throughput, path, and the triangle and
+    normal rows), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
+    the diffuse bounces (the diffuse lobes paths continue through are weighed against sampling
+    them, integrator.bounces; the others are light-sampled alone), and the triangle and
     barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
     (core.geometry.accel.lift).
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
@@ -79,11 +82,14 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     """
     rayhit = embree.new_rayhit()
     scratch = np.empty((2, 3, 4))
-    sel = np.empty((1, max(n_sampled, 1)))
+    sel_nd = np.empty((1, max(n_sampled, 1)))
+    sel_all = np.empty((1, max(lp.shape[0], 1)))
     keep = f_diff.shape[1] > 0
     traced = 0
     for j in range(len(pos)):
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0)
+        bits = diffuse_bits(bounces, j, diffuse_limit)
+        sel = sel_nd if bits == 0 else sel_all
+        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
         time = times[j] if len(times) else 0.5
         hx = hy = hz = 0.0
         if lifted:
@@ -101,7 +107,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0)
+                           inside[j], sel, 0, bits)
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if restrict[k, 0] != UNRESTRICTED:
                 if restrict[k, 0] == 0:

@@ -3,7 +3,8 @@
 Each depth step intersects all live rays at once, adds what they see (emission, lights,
 world, each weighted by multiple importance sampling against light sampling), estimates
 direct light at every hit with one shadow ray per light strategy, and continues each path
-through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo.
+through one non-diffuse lobe (mirror, glossy, glass, transparent) chosen by its albedo, or, with
+diffuse bounces (Cycles' Light Paths), through any lobe while the path has diffuse bounces left.
 Stages pass named records (core.integrator.records); every random number comes from the sampler the
 caller hands to ``trace``, at the dimensions core.sampling.dims lays out.
 
@@ -40,7 +41,8 @@ from .ratio import RatioEstimator
 from .records import PathState, Samples, SurfaceHits
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
-_NO_BOUNCES = camera_bounces(0)  # the continuation kernel's bounces when no program reads Light Path
+_NO_BOUNCES = camera_bounces(0)  # the kernels' bounces when paths carry none
+_NO_ROULETTE = np.full(2, -1, np.int64)
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
         ("IndexOB", "X"), ("IndexMA", "X"))
@@ -51,7 +53,8 @@ class StepSamples:
     """The sample values the hits of one depth step use, one row per hit: ``light`` (N, S, 2, 2),
     per light strategy k the point on the light ``[:, k, 0]`` and the choice of light or
     triangle ``[:, k, 1, 0]``, valid where the material casts shadow rays; ``path`` (N, 2, 2),
-    the lobe direction ``[:, 0]`` and the lobe choice ``[:, 1, 0]``, valid where the path continues."""
+    the lobe direction ``[:, 0]``, the lobe choice ``[:, 1, 0]`` and Russian roulette's
+    ``[:, 1, 1]`` (dims.roulette), valid where the path continues."""
 
     light: np.ndarray
     path: np.ndarray
@@ -63,6 +66,10 @@ class StepSamples:
     @property
     def lobe_choice(self) -> np.ndarray:
         return self.path[:, 1, 0]
+
+    @property
+    def roulette(self) -> np.ndarray:
+        return self.path[:, 1, 1]
 
     def take(self, rows) -> "StepSamples":
         return StepSamples(self.light[rows], self.path[rows])
@@ -113,13 +120,22 @@ class Integrator:
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
         self.ratio = frozenset(plan.ratio)
         # paths carry their ray kind and depths only for a scene whose shader programs read them
+        # or with diffuse bounces (which count them)
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
-        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0}
+        self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
+        self.carried = self.light_path or self.diffuse > 0
+        # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
+        # classic paths, bounded by the depth alone, stay as they were)
+        self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)
+                         if self.diffuse else _NO_ROULETTE)
+        # per material (and none): its hits draw lobe samples; with diffuse bounces, every lit one
+        self.continues = prepared.continues | prepared.lit if self.diffuse else prepared.continues
+        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
         self._rays_lock = threading.Lock()
 
     def _count(self, kind, n):
@@ -188,9 +204,11 @@ class Integrator:
                 if self.mist is not None or out.indexed is not None:
                     self._data_passes(group, shader, out)
                 if light is not None and shader.lobes:
-                    self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out)
+                    # no diffuse ray leaves the last depth: its diffuse light is light sampling's alone
+                    self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out,
+                                 self.diffuse if depth < s.max_depth else 0)
                     start += len(group)
-                if shader.can_continue and depth < s.max_depth:
+                if (shader.can_continue or (self.diffuse and shader.lobes)) and depth < s.max_depth:
                     nxt = self._continue(shader, group, u_g)
                     if nxt is not None:
                         continued.append(nxt)
@@ -216,7 +234,7 @@ class Integrator:
         state = PathState(path=np.arange(n), origins=cam.origins, dirs=cam.directions, tmax=cam.tmax,
                           throughput=np.ones((n, 3)), prev_pdf=np.full(n, np.inf), prev_normal=np.zeros((n, 3)),
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
-                          bounces=camera_bounces(n) if self.light_path else None)
+                          bounces=camera_bounces(n) if self.carried else None)
         return state, cam
 
     # -- what rays see ----------------------------------------------------------------
@@ -349,7 +367,7 @@ class Integrator:
             whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats listing them
             sampler.pairs(pixel, sample, dims, None if whole else lit, light.reshape(n, -1, 2))
         path = np.zeros((n, 2, 2))
-        go = np.flatnonzero(self.prepared.continues[mat]) if bounce else np.zeros(0, np.int64)
+        go = np.flatnonzero(self.continues[mat]) if bounce else np.zeros(0, np.int64)
         if len(go):
             sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
         return StepSamples(light, path)
@@ -403,10 +421,12 @@ class Integrator:
                                       joined([h.time for h in hits]) if self.timed else None,
                                       joined([h.bounces for h in hits]) if self.light_path else None)
 
-    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput):
+    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, diffuse: int):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
-        kernel (core.integrator.direct); what the wave's ratio estimator needs, when there is one,
-        shown to it after (core.integrator.ratio)."""
+        kernel (core.integrator.direct), the diffuse lobes weighed against the diffuse rays these
+        hits may continue through (``diffuse``: the diffuse bounces, 0 where none continue);
+        what the wave's ratio estimator needs, when there is one, shown to it after
+        (core.integrator.ratio)."""
         n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
@@ -417,33 +437,34 @@ class Integrator:
         traced = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
-            _c(group.path), geo.tables, group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
+            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces), diffuse, geo.tables, group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
             visibility)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility)
 
-    # -- continuation through a non-diffuse lobe ------------------------------------
+    # -- continuation through one lobe -------------------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
         """The paths of these hits continued through one sampled lobe (None if none goes on;
         core.integrator.continuation)."""
         n = len(hits)
-        go, passthrough, transmit = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
+        go, passthrough, transmit, diffuse = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
         origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
         bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
         next_bounces = np.empty_like(bounces)
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
-                       _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, go, origin, wi, weight, prev_pdf,
-                       passthrough, transmit, next_bounces)
+                       _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, self.diffuse, _c(u.roulette),
+                       self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse)
         sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
-        passthrough, transmit = passthrough[sel], transmit[sel]
-        self._count("refraction", (transmit & ~passthrough).sum())
-        self._count("reflection", (~transmit).sum())
+        passthrough, transmit, diffuse = passthrough[sel], transmit[sel], diffuse[sel]
+        self._count("diffuse", diffuse.sum())
+        self._count("refraction", (transmit & ~passthrough & ~diffuse).sum())
+        self._count("reflection", (~transmit & ~diffuse).sum())
         self._count("transparent", passthrough.sum())
         return PathState(path=hits.path[sel], origins=origin[sel], dirs=wi[sel], tmax=np.full(len(sel), np.inf),
                          throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],

@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..bsdf.shader import DIFFUSE_KINDS
 from ..geometry.motion import Motion, deforms, moves
 from .ratio import delta_light, ratio_strategies
 
-RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent")
+RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent", "diffuse")
 
 
 @dataclass
@@ -69,7 +70,8 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
             "shadow": lights.strategies > 0 and bool(kinds),
             "reflection": bounces and bool(kinds & {"reflect", "glass"}),
             "refraction": bounces and "glass" in kinds,
-            "transparent": bounces and "transparent" in kinds}
+            "transparent": bounces and "transparent" in kinds,
+            "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS))}
 
     strategies = []
     for light in lights.lights[:lights.light_slots] if not lights.selecting else []:
@@ -92,7 +94,9 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     dropped = len(scene.lights) - len(lights.lights)
     if dropped:
         left_out.append(f"{dropped} lights of zero power")
-    ratio = ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] else []
+    # the ratio estimator takes diffuse direct light as light sampling alone, which with
+    # diffuse bounces is weighed against the diffuse rays (Monte Carlo then)
+    ratio = ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not rays["diffuse"] else []
     by_ratio = settings.shadow_estimator == "RATIO"
     monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
     return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo)

@@ -5,7 +5,8 @@ decision reads decides which decisions are stratified together and which images 
 same when the scene changes. The layout:
 
 - camera: pixel offset (0, 1), lens (2, 3), shutter time (4);
-- path, per depth d from ``PATH + 4 d``: the lobe's direction (2D) and the lobe choice;
+- path, per depth d from ``PATH + 4 d``: the lobe's direction (2D), the lobe choice and Russian
+  roulette's decision (drawn as one pair with the choice);
 - light strategies, per depth: a block of 4 (the point on the light (2D), the choice of a
   light or triangle) at a dimension hashed from the strategy's identity (a light's kind and
   name, "emissive", "world", a selection slot) and the depth, above every path dimension.
@@ -34,6 +35,12 @@ def lobe(depth: int) -> int:
 def lobe_choice(depth: int) -> int:
     """1D: which lobe the path continues through."""
     return PATH + PATH_STRIDE * depth + 2
+
+
+def roulette(depth: int) -> int:
+    """1D: whether the path goes on after this depth's bounce (Russian roulette, with diffuse
+    bounces); the second value of ``lobe_choice``'s pair."""
+    return PATH + PATH_STRIDE * depth + 3
 
 
 def strategy_keys(lights) -> list[str]:

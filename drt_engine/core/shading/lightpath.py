@@ -4,15 +4,15 @@ svm_node_light_falloff compute them, over a batch of shading points.
 What a point needs is the ray that brought it there (``RayPath``): whether the camera sees it
 straight (through transparent surfaces only, which keep a ray's kind in Cycles), the kind of
 lobe that spawned the ray otherwise, the ray's length, and the depths counted along the path:
-ray depth (every bounce but transparent ones), glossy (non-diffuse reflections), transmission
-and transparent. The integrator carries the kind and the depths per path in one small int
+ray depth (every bounce but transparent ones), glossy (non-diffuse reflections), transmission,
+transparent and diffuse (diffuse reflections, with diffuse bounces on). The integrator carries the kind and the depths per path in one small int
 array (``KIND`` bits and depth columns, updated by core.integrator.continuation).
 
 Outputs that are 0 at every point DRT shades, as Cycles' would be for the same path:
 - Is Shadow Ray: DRT's shadow rays are traced inside the direct-light kernel
   (core.integrator.direct) and stop at the first surface, so no shader program runs for them.
-- Is Diffuse Ray and Diffuse Depth: paths continue only through non-diffuse lobes (diffuse light
-  is direct light), so no ray is ever spawned by a diffuse lobe.
+- Is Diffuse Ray and Diffuse Depth with diffuse bounces 0 (the default): paths continue only
+  through non-diffuse lobes (diffuse light is direct light), so no ray is spawned by a diffuse lobe.
 - Is Volume Scatter Ray and Portal Depth (Blender 5): DRT has no volumes and no portals.
 
 Emission evaluated by light sampling and the world (seen by a ray or sampled) are evaluated as
@@ -30,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-REFLECT, TRANSMIT, GLOSSY, SINGULAR = 1, 2, 4, 8
+REFLECT, TRANSMIT, GLOSSY, SINGULAR, DIFFUSE = 1, 2, 4, 8, 16
 """Bits of the ``KIND`` column: the lobe that spawned the ray (Cycles' PATH_RAY_* of the same names)."""
-KIND, DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH, TRANSPARENT_DEPTH = range(5)
-COLUMNS = 5
+KIND, DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH, TRANSPARENT_DEPTH, DIFFUSE_DEPTH = range(6)
+COLUMNS = 6
 BACKGROUND_LENGTH = float(np.finfo(np.float32).max)
 """Ray Length at the world: Cycles' FLT_MAX (shader_setup_from_background; measured with Blender
 5.0's Cycles, for the camera's rays)."""
@@ -88,8 +88,9 @@ def outputs(path: RayPath | None, n: int) -> tuple:
         return ((kind & mask) != 0).astype(float)
 
     depth = b[:, DEPTH] + (1 if path.emission else 0)
-    return (path.camera.astype(float), zero, zero, bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT), zero,
-            np.asarray(path.length, float), depth.astype(float), zero, b[:, GLOSSY_DEPTH].astype(float),
+    return (path.camera.astype(float), zero, bit(DIFFUSE), bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT), zero,
+            np.asarray(path.length, float), depth.astype(float), b[:, DIFFUSE_DEPTH].astype(float),
+            b[:, GLOSSY_DEPTH].astype(float),
             b[:, TRANSPARENT_DEPTH].astype(float), b[:, TRANSMISSION_DEPTH].astype(float), zero)
 
 
