@@ -254,6 +254,7 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
 
 PRESET_CLASSES = (DRT_OT_light_paths_preset, DRT_MT_light_paths_presets)
 """The Light Paths panel's preset menu and what it runs."""
+
 classes = (
     DRT_PT_sampling,
     DRT_PT_sampling_adaptive,

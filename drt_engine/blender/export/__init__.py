@@ -14,8 +14,7 @@ from ...core.errors import RenderCancelled
 from ...core.scene import SceneData
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
-from .left_out import TYPES as LEFT_OUT_TYPES
-from .left_out import LeftOut
+from .left_out import TYPES as LEFT_OUT_TYPES, LeftOut
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key

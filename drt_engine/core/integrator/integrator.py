@@ -54,7 +54,8 @@ class StepSamples:
     per light strategy k the point on the light ``[:, k, 0]`` and the choice of light or
     triangle ``[:, k, 1, 0]``, valid where the material casts shadow rays; ``path`` (N, 2, 2),
     the lobe direction ``[:, 0]``, the lobe choice ``[:, 1, 0]`` and Russian roulette's
-    ``[:, 1, 1]`` (dims.roulette), valid where the path continues."""
+    ``[:, 1, 1]`` (the second value of the lobe choice's pair, core.sampling.dims), valid where the
+    path continues."""
 
     light: np.ndarray
     path: np.ndarray
@@ -119,8 +120,6 @@ class Integrator:
         self.pixel_spread = camera_rays.pixel_spread(self.camera)
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
         self.ratio = frozenset(plan.ratio)
-        # paths carry their ray kind and depths only for a scene whose shader programs read them
-        # or with diffuse bounces (which count them)
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
@@ -128,6 +127,8 @@ class Integrator:
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
+        # paths carry their ray kind and depths only for a scene whose shader programs read them
+        # or with diffuse bounces (which count them)
         self.carried = self.light_path or self.diffuse > 0
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
@@ -437,7 +438,8 @@ class Integrator:
         traced = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
-            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces), diffuse, geo.tables, group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
+            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces), diffuse, geo.tables,
+            group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
             visibility)
         self._count("shadow", traced)

@@ -33,14 +33,9 @@ def lobe(depth: int) -> int:
 
 
 def lobe_choice(depth: int) -> int:
-    """1D: which lobe the path continues through."""
+    """1D: which lobe the path continues through; drawn as a pair whose second value (+3) is
+    Russian roulette's decision (with diffuse bounces)."""
     return PATH + PATH_STRIDE * depth + 2
-
-
-def roulette(depth: int) -> int:
-    """1D: whether the path goes on after this depth's bounce (Russian roulette, with diffuse
-    bounces); the second value of ``lobe_choice``'s pair."""
-    return PATH + PATH_STRIDE * depth + 3
 
 
 def strategy_keys(lights) -> list[str]:
