@@ -19,7 +19,7 @@ import pytest
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
-from tests.support.scenes import top_camera, uv_sphere
+from tests.support.scenes import plane, top_camera, uv_sphere
 
 ALBEDO, E = 0.8, 1.0
 
@@ -58,3 +58,17 @@ def test_russian_roulette_keeps_the_furnace_unbiased():
     albedo = 0.5
     value = mean(furnace(albedo), 128, diffuse_bounces=64, max_depth=64)
     assert value == pytest.approx(closed_form(64, albedo), rel=0.01)
+
+
+def test_the_worlds_diffuse_visibility_left_unread_is_named():
+    """With diffuse bounces, escaping diffuse rays take the world's glossy or transmission
+    visibility: a world whose Diffuse visibility differs says so; none without diffuse bounces."""
+    def warnings(world, bounces):
+        scene = SceneData(top_camera(height=1.0, half_width=0.2, res=4), [plane(4.0)], [Instance(0, np.eye(4))],
+                          [Material("white", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])], [], world)
+        return [w for w in Renderer(scene, RenderSettings(samples=1, threads=1, diffuse_bounces=bounces)).warnings
+                if "Diffuse ray visibility" in w]
+
+    assert len(warnings(World(np.full(3, 0.5), visible_diffuse=False), 2)) == 1
+    assert not warnings(World(np.full(3, 0.5), visible_diffuse=False), 0)
+    assert not warnings(World(np.full(3, 0.5)), 2)
