@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
-from ..bsdf.mixture import eval_lobes, selection
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import UNRESTRICTED
@@ -61,6 +61,15 @@ def _aim(x, y, z):
     return x * inv, y * inv, z * inv, d
 
 
+@kernel(inline="always")
+def unlit_parts(restrict, k):
+    """The BSDF parts strategy k does not light (mixture's ``UNLIT_*`` bits) from its ``restrict`` row."""
+    if restrict[k, 0] == UNRESTRICTED:
+        return 0
+    return ((UNLIT_DIFFUSE if restrict[k, 0] == 0 else 0) | (UNLIT_REFLECTION if restrict[k, 1] == 0 else 0)
+            | (UNLIT_TRANSMISSION if restrict[k, 2] == 0 else 0))
+
+
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
                  diffuse_limit, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times,
@@ -107,13 +116,8 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits)
+                           inside[j], sel, 0, bits, unlit_parts(restrict, k))
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
-            if restrict[k, 0] != UNRESTRICTED:
-                if restrict[k, 0] == 0:
-                    d0 = d1 = d2 = 0.0
-                if restrict[k, 1 if above else 2] == 0:
-                    n0 = n1 = n2 = 0.0
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
             w = power(pdf[k, j], f[6])
