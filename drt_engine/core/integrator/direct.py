@@ -72,15 +72,17 @@ def unlit_parts(restrict, k):
 
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
-                 diffuse_limit, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times,
-                 radiance, f_diff, visibility):
+                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center,
+                 times, radiance, f_diff, visibility):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays traced.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
     normal rows), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
     the diffuse bounces (the diffuse lobes paths continue through are weighed against sampling
-    them, integrator.bounces; the others are light-sampled alone), and the triangle and
+    them, integrator.bounces; the others are light-sampled alone), whether any ray ``continues``
+    from these hits (at the last depth none does: light sampling alone finds all their light,
+    no share is left to rays that are never traced), and the triangle and
     barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
     (core.geometry.accel.lift).
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
@@ -120,7 +122,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
-            w = power(pdf[k, j], f[6])
+            w = power(pdf[k, j], f[6]) if continues else 1.0
             c0 = throughput[j, 0] * v0 * (d0 + n0 * w)
             c1 = throughput[j, 1] * v1 * (d1 + n1 * w)
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
