@@ -5,7 +5,10 @@ normal, their highlights stretched along and across the spheres' meridians.
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002. The same scene rendered isotropic (DRT with
-its anisotropic alphas switched off) must fail that limit: the scene sees the anisotropy."""
+its anisotropic alphas switched off) must fail that limit: the scene sees the anisotropy.
+Measured (64 spp): worst block 0.0463 against a limit of 0.0719 (Cycles' seeds 0.0466); isotropic
+0.909; with alpha_x and alpha_y swapped 0.968, the Glossy's rotation left out 0.900, turned the
+other way 0.516."""
 from __future__ import annotations
 
 import bpy
@@ -49,14 +52,14 @@ def anisotropic_scene():
     tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
     _sphere("Glossy", 1.1, glossy)
     light = bpy.data.objects.new("Area", bpy.data.lights.new("Area", "AREA"))
-    light.data.energy = 400.0
-    light.data.size = 1.5
+    light.data.energy = 150.0
+    light.data.size = 3.0
     ps.aim(light, (1.5, -3.0, 3.0))
     scene.collection.objects.link(light)
     return scene
 
 
-def test_anisotropic_ggx_matches_cycles(tmp_path, monkeypatch):
+def test_anisotropic_ggx_matches_cycles(drt, tmp_path, monkeypatch):
     scene = anisotropic_scene()
     drt, cycles0, cycles1 = ps.parity_renders(scene, tmp_path, "aniso")
     figures = ps.parity(drt.rgb, cycles0.rgb, cycles1.rgb)
