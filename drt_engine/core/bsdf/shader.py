@@ -106,6 +106,8 @@ def anisotropic_alphas(kind: str, roughness: float, anisotropy: float) -> tuple 
     Either way sqrt(alpha_x alpha_y) = r², the alpha Cycles' albedo tables are read at, so the
     lobe's tables are the isotropic ones of its roughness."""
     alpha = _alpha(roughness)
+    if not np.isfinite(anisotropy):
+        return None
     if kind == "PRINCIPLED":
         a = float(np.clip(anisotropy, 0.0, 1.0))
         if not a > 0.0:
