@@ -31,28 +31,13 @@ def _sphere(name, x, material):
     obj.data.materials.append(material)
 
 
-def anisotropic_scene():
+def _lit_scene(camera_location):
+    """A black world, the camera at ``camera_location`` looking at the origin, and a 3 m area
+    light of 150 W above and in front."""
     scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
+    ps.aim(scene.camera, camera_location)
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
-    metal = new_material("Brushed")
-    bsdf = metal.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (0.9, 0.7, 0.4, 1.0)
-    bsdf.inputs["Metallic"].default_value = 1.0
-    bsdf.inputs["Roughness"].default_value = 0.35
-    bsdf.inputs["Anisotropic"].default_value = 0.9
-    _sphere("Principled", -1.1, metal)
-    glossy = new_material("Turned")
-    tree = glossy.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    node = tree.nodes.new("ShaderNodeBsdfAnisotropic")
-    node.inputs["Color"].default_value = (0.5, 0.7, 0.9, 1.0)
-    node.inputs["Roughness"].default_value = 0.4
-    node.inputs["Anisotropy"].default_value = -0.7
-    node.inputs["Rotation"].default_value = 0.125
-    tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
-    _sphere("Glossy", 1.1, glossy)
     light = bpy.data.objects.new("Area", bpy.data.lights.new("Area", "AREA"))
     light.data.energy = 150.0
     light.data.size = 3.0
@@ -61,20 +46,36 @@ def anisotropic_scene():
     return scene
 
 
+def _closure_material(name, bl_idname, **inputs):
+    """A material of one closure node ``bl_idname`` with these input values, and the node."""
+    material = new_material(name)
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    node = tree.nodes.new(bl_idname)
+    for socket, value in inputs.items():
+        node.inputs[socket.replace("_", " ")].default_value = value
+    tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    return material, node
+
+
+def anisotropic_scene():
+    scene = _lit_scene((0.0, -7.0, 1.5))
+    metal, _ = _closure_material("Brushed", "ShaderNodeBsdfPrincipled", Base_Color=(0.9, 0.7, 0.4, 1.0),
+                                 Metallic=1.0, Roughness=0.35, Anisotropic=0.9)
+    _sphere("Principled", -1.1, metal)
+    glossy, _ = _closure_material("Turned", "ShaderNodeBsdfAnisotropic", Color=(0.5, 0.7, 0.9, 1.0),
+                                  Roughness=0.4, Anisotropy=-0.7, Rotation=0.125)
+    _sphere("Glossy", 1.1, glossy)
+    return scene
+
+
 def textured_scene():
     """A Metallic BSDF sphere whose anisotropy rises with height (Generated z, a keyed input),
     turned per hit by a Noise texture, along the UV map's tangent (a Tangent node)."""
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -5.0, 1.0))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
-    material = new_material("Textured")
+    scene = _lit_scene((0.0, -5.0, 1.0))
+    material, node = _closure_material("Textured", "ShaderNodeBsdfMetallic", Base_Color=(0.8, 0.8, 0.85, 1.0),
+                                       Roughness=0.4)
     tree = material.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    node = tree.nodes.new("ShaderNodeBsdfMetallic")
-    node.inputs["Base Color"].default_value = (0.8, 0.8, 0.85, 1.0)
-    node.inputs["Roughness"].default_value = 0.4
-    tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
     coords = tree.nodes.new("ShaderNodeTexCoord")
     xyz = tree.nodes.new("ShaderNodeSeparateXYZ")
     tree.links.new(coords.outputs["Generated"], xyz.inputs["Vector"])
@@ -86,11 +87,6 @@ def textured_scene():
     tangent.direction_type = "UV_MAP"
     tree.links.new(tangent.outputs["Tangent"], node.inputs["Tangent"])
     _sphere("Sphere", 0.0, material)
-    light = bpy.data.objects.new("Area", bpy.data.lights.new("Area", "AREA"))
-    light.data.energy = 150.0
-    light.data.size = 3.0
-    scene.collection.objects.link(light)
-    ps.aim(light, (1.5, -3.0, 3.0))
     return scene
 
 
