@@ -46,6 +46,12 @@ class Closure:
     """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
     multiscatter: bool = True
     """GGX lobes get Cycles' multiple-scattering energy compensation ("Multiscatter GGX")."""
+    anisotropy: float = 0.0
+    """The node's own anisotropy: Principled's Anisotropic (0 to 1, also the Metallic BSDF's), or
+    GLOSSY's Anisotropy (-1 to 1); each maps to alpha_x, alpha_y as Cycles' svm_node_closure_bsdf
+    (core.bsdf.shader.anisotropic_alphas), along the hits' tangent (input "tangent")."""
+    anisotropic_rotation: float = 0.0
+    """Turns of the tangent about the normal."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
     "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``

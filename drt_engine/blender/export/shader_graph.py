@@ -334,6 +334,14 @@ class Compiler:
     def _coord(self, name, uv_map=""):
         return self.program.add("coord", name=name, map=uv_map), 0
 
+    def geometry_tangent(self):
+        """Geometry's Tangent, what Cycles links to an unlinked Tangent socket (ShaderGraph's
+        default_inputs), one program node however many closures read it."""
+        key = "geometry tangent"
+        if key not in self._memo:
+            self._memo[key] = self._coord("tangent")
+        return self._memo[key]
+
     def _node_ShaderNodeTexCoord(self, node, output):
         name = output.identifier
         if self.world:

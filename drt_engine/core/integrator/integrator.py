@@ -377,7 +377,8 @@ class Integrator:
         """(hits, their samples, shader) per material: a slice of
         the hits (sorted by material) for a constant material, index arrays of hits sharing one
         bound shader for a material with varying inputs (see core.shading); a program's normal
-        replaces the shading normal and frame of its hits in the records it yields."""
+        replaces the shading normal and frame of its hits in the records it yields, an anisotropic
+        material's tangent the frame's tangent."""
         starts = np.concatenate([[0], np.flatnonzero(np.diff(surf.mat)) + 1])
         for a, b in zip(starts, np.append(starts[1:], len(surf.mat))):
             g = slice(int(a), int(b))  # the hits of material mat[a]
@@ -391,12 +392,14 @@ class Integrator:
             width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
             ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
                                  self._ray_path(group, hits))
-            groups, normal = shading.bind(ctx)
-            if normal is not None:
-                ng, wo = group.ng, group.wo
-                ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, group.ns)
-                ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
-                frame = Frame.about(ns)
+            groups, normal, tangent = shading.bind(ctx)
+            if normal is not None or tangent is not None:
+                ns, wo = group.ns, group.wo
+                if normal is not None:
+                    ng = group.ng
+                    ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, ns)
+                    ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
+                frame = Frame.about(ns) if tangent is None else Frame.along(ns, tangent)
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
                 yield group.take(sub), u_g.take(sub), shader
