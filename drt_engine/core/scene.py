@@ -87,6 +87,10 @@ class Material:
     see it as the hit's normal."""
     pass_index: int = 0
     """The material's pass index (Material Index pass)."""
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write into the render's shader AOVs (core.integrator.aovs): (AOV
+    name, value), the value RGB (3,) for a colour AOV, a float for a value AOV, or an output
+    ``(node, socket)`` of ``program``."""
 
     @property
     def emission(self) -> np.ndarray:

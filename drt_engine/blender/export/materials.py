@@ -13,6 +13,7 @@ import numpy as np
 
 from ...core.bsdf.microfacet import conductor_f82
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
+from ..properties import view_layer_aovs
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import DISPLACEMENT_MATCHED_FROM, Compiler, ImageTable, is_ref
 
@@ -240,24 +241,55 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     displacement = None if output is None else _displacement(material, output, compiler, issues)
     unread_outputs(material.node_tree, output, issues)
-    varying = any(c.inputs for c in closures) or displacement is not None
+    aovs = aov_outputs(material.node_tree, compiler, layer)
+    varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
-                     pass_index=material.pass_index),
+                     pass_index=material.pass_index, aovs=aovs),
             issues.message(f"Material '{material.name}'"))
+
+
+def aov_outputs(tree, compiler, layer) -> list:
+    """(AOV name, value) of each AOV Output node writing an AOV of the view layer: its Color into a
+    colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode); a node naming no AOV of the
+    view layer writes nothing, as in Cycles."""
+    kinds = dict(view_layer_aovs(layer[1])) if layer is not None else {}
+    out = []
+    for node in tree.nodes:
+        kind = kinds.get(getattr(node, "aov_name", None)) if node.bl_idname == "ShaderNodeOutputAOV" else None
+        if kind == "COLOR":
+            value = compiler.value(node.inputs["Color"], "color")
+            out.append((node.aov_name, value if is_ref(value) else rgb(value)))
+        elif kind == "VALUE":
+            out.append((node.aov_name, compiler.value(node.inputs["Value"], "float")))
+    return out
 
 
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
 
 
-def unread_outputs(tree, output, issues) -> None:
+def unread_outputs(tree, output, issues, world=False) -> None:
     """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
-    Volume socket and AOV Output nodes."""
+    Volume socket, AOV Output nodes inside node groups, and a world's AOV Output nodes."""
     volume = None if output is None else output.inputs.get("Volume")
     if volume is not None and volume.is_linked:
         issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
     for node in tree.nodes:
-        if node.bl_idname == "ShaderNodeOutputAOV":
-            issues.add(f"'{node.name}' (AOV Output: shader AOVs are not written yet)")
+        if node.bl_idname == "ShaderNodeOutputAOV" and world:
+            issues.add(f"'{node.name}' (AOV Output in a world: not written yet)")
+    for node in _group_aov_outputs(tree):
+        issues.add(f"'{node.name}' (AOV Output inside a node group: not written yet)")
+
+
+def _group_aov_outputs(tree, seen=None):
+    """The AOV Output nodes inside the node groups ``tree`` uses, at any depth."""
+    seen = set() if seen is None else seen
+    for node in tree.nodes:
+        group = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
+        if group is None or group.name in seen:
+            continue
+        seen.add(group.name)
+        yield from (n for n in group.nodes if n.bl_idname == "ShaderNodeOutputAOV")
+        yield from _group_aov_outputs(group, seen)
 
 
 def _displacement(material, output, compiler, issues):

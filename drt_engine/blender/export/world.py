@@ -56,7 +56,7 @@ def _background(world, warnings: list[str], images: ImageTable) -> World:
         return [compiler.scale(compiler.mul(weight, color), strength)]
 
     parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
-    unread_outputs(world.node_tree, output, issues)
+    unread_outputs(world.node_tree, output, issues, world=True)
     visibility = _visibility(world)
     message = issues.message(f"World '{world.name}'")
     if message:

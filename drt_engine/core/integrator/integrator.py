@@ -31,8 +31,10 @@ from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
+from ..settings import AOV_CHANNELS
 from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
+from .aovs import ShaderAOVs
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_hits
@@ -86,7 +88,8 @@ class WaveOutput:
     alpha: np.ndarray
     aux: dict
     features: Features | None = None  # the denoising features' walks, when those passes are on
-    indexed: np.ndarray | None = None  # per path: its index passes are final (an opaque enough hit was seen)
+    # per path: its index passes and shader AOVs are final (an opaque enough hit was seen)
+    indexed: np.ndarray | None = None
     ratio: RatioEstimator | None = None
 
     def values(self, clamp: float) -> dict:
@@ -126,6 +129,8 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
+        aovs = ShaderAOVs(prepared.shading, settings.aovs) if settings.aovs else None
+        self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
         # paths carry their ray kind and depths only for a scene whose shader programs read them
         # or with diffuse bounces (which count them)
@@ -150,14 +155,15 @@ class Integrator:
         state, cam = self._camera_rays(samples, sampler)
         times = self.geometry.ray_times(state.time)  # each camera sample's shutter time, down its path
         n = len(state)
-        out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
-                                                        if name in s.passes},
+        aux = {name: np.zeros((n, len(ch))) for name, ch in _AUX if name in s.passes}
+        aux.update((name, np.zeros((n, len(AOV_CHANNELS[kind])))) for name, kind in s.aovs)
+        out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
             out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
-        if "IndexOB" in out.aux or "IndexMA" in out.aux:
+        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None:
             out.indexed = np.zeros(n, bool)
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
             out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
@@ -191,6 +197,8 @@ class Integrator:
             self._emission_seen(surf, state, hits, out)
             if depth == 0:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
+            if self.aovs is not None:
+                self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = list(self._bind_materials(surf, u, hits))
@@ -339,6 +347,16 @@ class Integrator:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
             out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
 
+    def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput):
+        """The materials' AOV Output nodes at the hits the camera sees directly or through
+        transparency, before the data passes close their paths (core.integrator.aovs)."""
+        seen = surf.take(np.flatnonzero(surf.straight & ~out.indexed[surf.path]))
+        if len(seen) == 0:
+            return
+        for g in _material_slices(seen.mat):
+            group = seen.take(g)
+            self.aovs.write(group, lambda: self._context(group, hits), out.aux)
+
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
         aux = out.aux
@@ -378,20 +396,13 @@ class Integrator:
         the hits (sorted by material) for a constant material, index arrays of hits sharing one
         bound shader for a material with varying inputs (see core.shading); a program's normal
         replaces the shading normal and frame of its hits in the records it yields."""
-        starts = np.concatenate([[0], np.flatnonzero(np.diff(surf.mat)) + 1])
-        for a, b in zip(starts, np.append(starts[1:], len(surf.mat))):
-            g = slice(int(a), int(b))  # the hits of material mat[a]
+        for g in _material_slices(surf.mat):
             group, u_g = surf.take(g), u.take(g)
-            shading = self.prepared.shading[surf.mat[a]]
+            shading = self.prepared.shading[surf.mat[g.start]]
             if not shading.varying:
                 yield group, u_g, shading.shader
                 continue
-            hu, hv = hits.u[group.row], hits.v[group.row]
-            bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
-            width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
-            ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
-                                 self._ray_path(group, hits))
-            groups, normal = shading.bind(ctx)
+            groups, normal = shading.bind(self._context(group, hits))
             if normal is not None:
                 ng, wo = group.ng, group.wo
                 ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, group.ns)
@@ -400,6 +411,14 @@ class Integrator:
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
                 yield group.take(sub), u_g.take(sub), shader
+
+    def _context(self, group: SurfaceHits, hits) -> SurfaceContext:
+        """The hits ``group`` as shader programs read them (core.shading.surface)."""
+        hu, hv = hits.u[group.row], hits.v[group.row]
+        bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
+        width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
+        return SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
+                              self._ray_path(group, hits))
 
     @staticmethod
     def _ray_path(group: SurfaceHits, hits, rows=slice(None)) -> RayPath | None:
@@ -472,6 +491,12 @@ class Integrator:
                          throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],
                          prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel])
+
+
+def _material_slices(mat):
+    """The slices of hits sorted by material (``mat``) that share one material."""
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(mat)) + 1])
+    return [slice(int(a), int(b)) for a, b in zip(starts, np.append(starts[1:], len(mat)))]
 
 
 def _c(a):

@@ -17,6 +17,7 @@ from ..base import jit
 from ..errors import SceneError, SettingsError
 from ..film.denoising import PASSES as FEATURE_PASSES, with_features
 from ..film.film import Film
+from ..integrator.aovs import AOV_TRANSPARENCY
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
@@ -83,7 +84,7 @@ class Renderer:
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
-                         halved=FEATURE_PASSES if settings.use_denoising else ())
+                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs)
 
     @property
     def rays(self) -> dict:
@@ -96,14 +97,16 @@ class Renderer:
     def _setting_warnings(self) -> list[str]:
         """What these settings make DRT approximate in this scene: with diffuse bounces, rays leaving a
         diffuse lobe see the world as reflected (glossy) or transmitted rays do, not by its Diffuse
-        ray visibility."""
-        world = self.scene.world
-        if not (self.integrator.diffuse and self.lights.world_seen):
-            return []
-        if world.visible_diffuse == world.visible_glossy == world.visible_transmission:
-            return []
-        return ["the world's Diffuse ray visibility is not read with diffuse bounces yet: diffuse rays see the "
-                "world as its Glossy (reflected) and Transmission (translucent) visibility say"]
+        ray visibility; shader AOVs behind transparency (core.integrator.aovs)."""
+        world, found = self.scene.world, []
+        if self.integrator.aovs is not None and any(c.kind == "TRANSPARENT" for m in self.scene.materials
+                                                    for c in m.closures):
+            found.append(AOV_TRANSPARENCY)
+        if (self.integrator.diffuse and self.lights.world_seen
+                and not world.visible_diffuse == world.visible_glossy == world.visible_transmission):
+            found.append("the world's Diffuse ray visibility is not read with diffuse bounces yet: diffuse rays "
+                         "see the world as its Glossy (reflected) and Transmission (translucent) visibility say")
+        return found
 
     def render(self, progress=None) -> RenderResult:
         """Render progressively (core.render.driver) and return the passes, stats and error log."""

@@ -1,0 +1,57 @@
+"""Shader AOVs as Cycles writes them (kernel/svm/aov.h, kernel/film/aov_passes.h).
+
+A material's AOV Output nodes add their value to the AOV of their name at each hit a camera path
+sees directly or through transparency, up to and including the first hit at least as opaque as the
+view layer's alpha threshold (the index passes' rule: Cycles' PATH_RAY_SINGLE_PASS_DONE). A colour
+AOV's alpha adds 1 per write. The film averages the writes over the samples like any pass; a pixel
+nothing writes keeps 0, and an AOV no material writes is a pass of zeros.
+
+Each write counts 1 in Cycles, its path's throughput unused: behind a partly transparent hit,
+Cycles writes in the share of samples whose path its closure sampling sends through the
+transparent closure, a share that depends on the other closures' colours. DRT's paths carry that
+choice in their throughput, so a hit behind transparency is weighed by the mean of the throughput
+that reaches it (1 at the first hit): the transparent closures' weights, where Cycles' share is
+the transparent closure's sampling weight over all of the hit's (measured in tests/blender/test_shader_aovs_cycles.py).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+AOV_TRANSPARENCY = ("shader AOVs behind partly transparent surfaces are weighed by the transparency, "
+                    "where Cycles counts the share of samples its closure sampling sends through")
+"""The warning of a render with shader AOVs and a partly transparent material."""
+
+
+class ShaderAOVs:
+    """The AOV writes of every material of a prepared scene, for the AOVs one render writes."""
+
+    def __init__(self, shading, aovs):
+        kinds = dict(aovs)
+        self.shading = shading
+        self.writes = [[(name, kinds[name], value) for name, value in s.material.aovs if name in kinds]
+                       for s in shading]
+        """Per material: (AOV name, "COLOR" or "VALUE", constant or program output) it writes."""
+
+    def writes_any(self) -> bool:
+        return any(self.writes)
+
+    def write(self, group, context, aux: dict) -> None:
+        """Add the AOV values of the hits ``group`` (core.integrator.records.SurfaceHits, all of one
+        material, each on its own path) to the wave's passes ``aux``; ``context()`` makes their
+        core.shading.surface.SurfaceContext when a value comes from the material's program."""
+        writes = self.writes[group.mat[0]]
+        if not writes:
+            return
+        n = len(group)
+        refs = [value for _, _, value in writes if isinstance(value, tuple)]
+        outputs = self.shading[group.mat[0]].outputs(context(), refs) if refs else []
+        found = dict(zip(refs, outputs))
+        weight = group.throughput.mean(axis=1)
+        for name, kind, value in writes:
+            v = np.asarray(found[value] if isinstance(value, tuple) else value, float)
+            if kind == "COLOR":
+                rgb = np.broadcast_to(v.reshape(n, -1)[:, :3] if isinstance(value, tuple) else v, (n, 3))
+                aux[name][group.path, :3] += rgb * weight[:, None]
+                aux[name][group.path, 3] += weight
+            else:
+                aux[name][group.path, 0] += np.broadcast_to(v, (n,)) * weight
