@@ -19,6 +19,7 @@ from drt_engine.core.integrator.integrator import Integrator
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support.datablocks import new_material
+from tests.support.export_helpers import render_export
 
 WIDTH, HEIGHT = 48, 32
 SAMPLES = 16
@@ -122,3 +123,27 @@ def test_the_comparisons_fail_without_the_computation(drt, monkeypatch, tmp_path
     off = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="off-drt")
     for name in ("col", "val"):
         assert not ps.parity(off.passes[name], c0.passes[name], c1.passes[name])["ok"], name
+
+
+def test_what_the_export_writes_and_names(drt):
+    """The sphere's AOV Output nodes become its writes (the view layer's AOVs only, a colour AOV from
+    the node's Color, a value AOV from its Value), the floor's come from its program, and neither
+    material is named in a warning; an AOV Output in the world or inside a node group is."""
+    scene = aov_scene()
+    world = scene.world
+    _aov(world.node_tree, "col", color=(1.0, 1.0, 1.0)).name = "World AOV"
+    box = bpy.data.materials["Box"]
+    group = bpy.data.node_groups.new("Grouped", "ShaderNodeTree")
+    _aov(group, "val", value=0.5).name = "Grouped AOV"
+    box.node_tree.nodes.new("ShaderNodeGroup").node_tree = group
+    data = render_export(scene)
+    materials = {m.name: m for m in data.materials}
+    sphere = dict(materials["Sphere"].aovs)
+    assert set(sphere) == {"col", "val"} and np.allclose(sphere["col"], SPHERE_COLOR)
+    assert sphere["val"] == pytest.approx(SPHERE_VALUE)
+    floor = materials["Floor"]
+    assert floor.program is not None and all(isinstance(v, tuple) for _, v in floor.aovs)
+    named = " ".join(data.warnings)
+    assert "'World AOV'" in named and "'Grouped AOV'" in named, data.warnings
+    assert "Material 'Sphere'" not in named and "Material 'Floor'" not in named, data.warnings
+    assert "Material 'Box'" in named
