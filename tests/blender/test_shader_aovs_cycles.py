@@ -11,6 +11,9 @@ away from edges and checker lines) DRT's pixel must be that value.
 """
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import bpy
 import numpy as np
 import pytest
@@ -147,3 +150,31 @@ def test_what_the_export_writes_and_names(drt):
     assert "'World AOV'" in named and "'Grouped AOV'" in named, data.warnings
     assert "Material 'Sphere'" not in named and "Material 'Floor'" not in named, data.warnings
     assert "Material 'Box'" in named
+
+
+def test_the_cli_writes_them_and_its_merged_parts_equal_the_single_render(drt, tmp_path):
+    """The CLI's EXR (Blender's render result) holds the AOVs, and two sample ranges merged (the
+    farm's path: parts, merge, the merged EXR) give the single render's AOVs."""
+    blend = tmp_path / "aovs.blend"
+    aov_scene().render.engine = "DRT"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend), copy=True)
+    options = ["--samples", "6", "--seed", "2", "--engine-threads", "1"]
+
+    def cli(out, *extra):
+        result = subprocess.run([sys.executable, "-m", "drt_engine", "render", str(blend), "-o", str(out), *options,
+                                 *extra], cwd=rh.ROOT, capture_output=True, text=True, timeout=300)
+        assert result.returncode == 0, result.stderr
+        return out
+
+    single = rh.read_channels(cli(tmp_path / "single.exr"))
+    parts = [cli(tmp_path / f"part{i}.exr", "--sample-range", r) for i, r in enumerate(("0:2", "2:6"))]
+    merged = subprocess.run([sys.executable, "-m", "drt_engine", "merge", *map(str, parts), "-o",
+                             str(tmp_path / "merged.exr")], cwd=rh.ROOT, capture_output=True, text=True, timeout=300)
+    assert merged.returncode == 0, merged.stderr
+    merged = rh.read_channels(tmp_path / "merged.exr")
+    names = [f"ViewLayer.{name}.{c}" for name, kind in AOVS for c in ("RGBA" if kind == "COLOR" else "X")]
+    assert set(names) <= set(single) and set(names) <= set(merged), sorted(single)
+    assert single["ViewLayer.col.A"].max() == 1.0 and single["ViewLayer.val.X"].max() > 0.5
+    for name in names:
+        scale = np.maximum(np.abs(single[name]), np.abs(merged[name]))
+        assert np.all(np.abs(single[name] - merged[name]) <= 1e-6 * scale), name
