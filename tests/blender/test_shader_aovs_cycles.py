@@ -2,7 +2,8 @@
 has a colour AOV "col", a value AOV "val" and a value AOV "unused" no material writes. The sphere
 writes constants into both (and into "elsewhere", an AOV the view layer does not have, which Cycles
 ignores); the floor writes a Checker texture's colour into "col" and a Noise texture's Fac into
-"val"; the box writes nothing.
+"val"; the box writes nothing; a pane 30% opaque in front writes constants, and so does what its
+pixels see through it, in the share of Cycles' samples its closure sampling sends through.
 
 Each AOV follows the node parity's rule (procedural_scenes.parity): DRT's worst 4x4-block
 difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and 1, plus 0.002. Where
@@ -18,6 +19,7 @@ import bpy
 import numpy as np
 import pytest
 
+from drt_engine.core.integrator import integrator as integrator_module
 from drt_engine.core.integrator.integrator import Integrator
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
@@ -28,6 +30,7 @@ WIDTH, HEIGHT = 48, 32
 SAMPLES = 16
 AOVS = (("col", "COLOR"), ("val", "VALUE"), ("unused", "VALUE"))
 SPHERE_COLOR, SPHERE_VALUE = (0.2, 0.6, 0.3), 0.8
+VEIL_ALPHA = 0.3  # under the view layer's alpha threshold: what is behind writes too
 
 
 def _aov(tree, name, color=None, value=None):
@@ -80,6 +83,11 @@ def aov_scene():
     _add(bpy.ops.mesh.primitive_plane_add, floor, size=12.0)
     _add(bpy.ops.mesh.primitive_uv_sphere_add, sphere, radius=1.0, location=(-1.2, 0.0, 1.0))
     _add(bpy.ops.mesh.primitive_cube_add, box, size=1.4, location=(1.5, 0.5, 0.7))
+    veil = _material("Veil", (0.2, 0.7, 0.2))
+    veil.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = VEIL_ALPHA
+    _aov(veil.node_tree, "col", color=(0.9, 0.9, 0.2))
+    _aov(veil.node_tree, "val", value=0.1)
+    _add(bpy.ops.mesh.primitive_plane_add, veil, size=1.6, location=(0.0, -2.5, 1.2), rotation=(1.2, 0.0, 0.0))
     layer = scene.view_layers[0]
     for name, kind in AOVS:
         aov = layer.aovs.add()
@@ -128,6 +136,16 @@ def test_the_comparisons_fail_without_the_computation(drt, monkeypatch, tmp_path
         assert not ps.parity(off.passes[name], c0.passes[name], c1.passes[name])["ok"], name
 
 
+def test_behind_the_pane_fails_in_the_throughput_share(drt, monkeypatch, tmp_path):
+    """What is seen through the pane weighed by the transparency DRT's throughput carries (no
+    correction to Cycles' share) fails the comparison."""
+    scene = aov_scene()
+    _, c0, c1 = renders(scene, tmp_path, "share")
+    monkeypatch.setattr(integrator_module, "reach_scale", lambda shader, group, rows: np.ones(len(rows)))
+    wrong = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="share-drt")
+    assert not ps.parity(wrong.passes["col"], c0.passes["col"], c1.passes["col"])["ok"]
+
+
 def test_what_the_export_writes_and_names(drt):
     """The sphere's AOV Output nodes become its writes (the view layer's AOVs only, a colour AOV from
     the node's Color, a value AOV from its Value), the floor's come from its program, and neither
@@ -174,7 +192,7 @@ def test_the_cli_writes_them_and_its_merged_parts_equal_the_single_render(drt, t
     merged = rh.read_channels(tmp_path / "merged.exr")
     names = [f"ViewLayer.{name}.{c}" for name, kind in AOVS for c in ("RGBA" if kind == "COLOR" else "X")]
     assert set(names) <= set(single) and set(names) <= set(merged), sorted(single)
-    assert single["ViewLayer.col.A"].max() == 1.0 and single["ViewLayer.val.X"].max() > 0.5
+    assert single["ViewLayer.col.A"].max() > 1.5 and single["ViewLayer.val.X"].max() > 0.5  # through the pane too
     for name in names:
         scale = np.maximum(np.abs(single[name]), np.abs(merged[name]))
         assert np.all(np.abs(single[name] - merged[name]) <= 1e-6 * scale), name

@@ -101,9 +101,14 @@ def test_no_aovs_no_passes_no_work():
     assert renderer.plan.passes == ["Combined"]
 
 
+SHARE = 0.75 / (0.75 + 0.25 * 0.5)
+"""Cycles' share of samples through B a quarter opaque: its transparent closure's sampling weight
+over its closures' (the diffuse's its weight times its colour, 0.5)."""
+
+
 @pytest.mark.parametrize("transparency, expected", [
     (0.25, [*B_COLOR, 1.0]),  # three quarters opaque: at least the alpha threshold, B alone
-    (0.75, [*(B_COLOR + 0.75 * A_COLOR), 1.75]),  # a quarter opaque: B, and A weighed by B's transparency
+    (0.75, [*(B_COLOR + SHARE * A_COLOR), 1.0 + SHARE]),  # a quarter opaque: B, and A in Cycles' share
 ])
 def test_writes_go_on_through_transparency_to_the_alpha_threshold(transparency, expected):
     _, b, _ = columns(render(scene(transparency), settings())[1].passes["col"])

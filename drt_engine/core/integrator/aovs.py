@@ -8,18 +8,27 @@ nothing writes keeps 0, and an AOV no material writes is a pass of zeros.
 
 Each write counts 1 in Cycles, its path's throughput unused: behind a partly transparent hit,
 Cycles writes in the share of samples whose path its closure sampling sends through the
-transparent closure, a share that depends on the other closures' colours. DRT's paths carry that
-choice in their throughput, so a hit behind transparency is weighed by the mean of the throughput
-that reaches it (1 at the first hit): the transparent closures' weights, where Cycles' share is
-the transparent closure's sampling weight over all of the hit's (measured in tests/blender/test_shader_aovs_cycles.py).
+transparent closure, the transparent closure's sampling weight over all of the hit's closures'
+(each its weight times its colour, averaged over RGB). DRT's paths choose their lobes otherwise and
+carry the choice in their throughput, so a write is weighed by the mean throughput that reaches
+it times, for each hit passed, 1 over that hit's summed lobe albedos (``reach_scale``): the
+transparency Cycles' share is, over the transparency DRT's throughput carries (measured in
+tests/blender/test_shader_aovs_cycles.py).
 """
 from __future__ import annotations
 
 import numpy as np
 
-AOV_TRANSPARENCY = ("shader AOVs behind partly transparent surfaces are weighed by the transparency, "
-                    "where Cycles counts the share of samples its closure sampling sends through")
-"""The warning of a render with shader AOVs and a partly transparent material."""
+AOV_TRANSPARENCY = ("shader AOVs behind partly transparent surfaces: Cycles' share of samples passing "
+                    "through is estimated from DRT's lobe albedos (close, not exact)")
+"""The warning of a render with shader AOVs and a transparent material."""
+
+
+def reach_scale(shader, group, rows) -> np.ndarray:
+    """Per hit ``rows`` of ``group`` (one bound shader): 1 over the summed albedos of its lobes, which
+    times the transparency DRT's throughput carries past the hit is Cycles' share of samples through."""
+    diffuse, specular, _ = shader.denoising_albedos(group.wo_l[rows, 2], group.inside[rows], rows)
+    return 1.0 / np.maximum((diffuse + specular).mean(axis=1), 1e-12)
 
 
 class ShaderAOVs:
@@ -35,9 +44,10 @@ class ShaderAOVs:
     def writes_any(self) -> bool:
         return any(self.writes)
 
-    def write(self, group, context, aux: dict) -> None:
+    def write(self, group, context, aux: dict, reach: np.ndarray) -> None:
         """Add the AOV values of the hits ``group`` (core.integrator.records.SurfaceHits, all of one
-        material, each on its own path) to the wave's passes ``aux``; ``context()`` makes their
+        material, each on its own path) to the wave's passes ``aux``, weighed by their throughput
+        times ``reach`` (``reach_scale`` of the hits passed); ``context()`` makes their
         core.shading.surface.SurfaceContext when a value comes from the material's program."""
         writes = self.writes[group.mat[0]]
         if not writes:
@@ -46,7 +56,7 @@ class ShaderAOVs:
         refs = [value for _, _, value in writes if isinstance(value, tuple)]
         outputs = self.shading[group.mat[0]].outputs(context(), refs) if refs else []
         found = dict(zip(refs, outputs))
-        weight = group.throughput.mean(axis=1)
+        weight = group.throughput.mean(axis=1) * reach
         for name, kind, value in writes:
             v = np.asarray(found[value] if isinstance(value, tuple) else value, float)
             if kind == "COLOR":

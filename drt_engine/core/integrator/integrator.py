@@ -34,7 +34,7 @@ from ..sampling import dims as D
 from ..settings import AOV_CHANNELS
 from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
-from .aovs import ShaderAOVs
+from .aovs import ShaderAOVs, reach_scale
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_hits
@@ -90,6 +90,9 @@ class WaveOutput:
     features: Features | None = None  # the denoising features' walks, when those passes are on
     # per path: its index passes and shader AOVs are final (an opaque enough hit was seen)
     indexed: np.ndarray | None = None
+    # per path, with shader AOVs: the share of Cycles' samples that reach its next hit over its
+    # throughput's (core.integrator.aovs)
+    aov_reach: np.ndarray | None = None
     ratio: RatioEstimator | None = None
 
     def values(self, clamp: float) -> dict:
@@ -165,6 +168,8 @@ class Integrator:
             out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
         if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None:
             out.indexed = np.zeros(n, bool)
+        if self.aovs is not None:
+            out.aov_reach = np.ones(n)
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
             out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
         if not cam.valid.all():  # no ray outside a fisheye's circle: black and opaque, as Cycles leaves it
@@ -345,6 +350,8 @@ class Integrator:
                 out.aux["IndexOB"][path, 0] = self.object_index[self.geometry.source_of(group.prim[rows])[:, 0]]
             if "IndexMA" in out.aux:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
+            if out.aov_reach is not None:
+                out.aov_reach[path] *= reach_scale(shader, group, rows)
             out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
 
     def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput):
@@ -355,7 +362,7 @@ class Integrator:
             return
         for g in _material_slices(seen.mat):
             group = seen.take(g)
-            self.aovs.write(group, lambda: self._context(group, hits), out.aux)
+            self.aovs.write(group, lambda: self._context(group, hits), out.aux, out.aov_reach[group.path])
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
