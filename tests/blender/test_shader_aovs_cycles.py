@@ -148,15 +148,20 @@ def test_behind_the_pane_fails_in_the_throughput_share(drt, monkeypatch, tmp_pat
 
 def test_what_the_export_writes_and_names(drt):
     """The sphere's AOV Output nodes become its writes (the view layer's AOVs only, a colour AOV from
-    the node's Color, a value AOV from its Value), the floor's come from its program, and neither
-    material is named in a warning; an AOV Output in the world or inside a node group is."""
+    the node's Color, a value AOV from its Value), the floor's come from its program, the box's from
+    inside a node group (its Value from the group node's input), and no material is named in a
+    warning; an AOV Output in the world is (Cycles writes it where the camera sees the world)."""
     scene = aov_scene()
     world = scene.world
     _aov(world.node_tree, "col", color=(1.0, 1.0, 1.0)).name = "World AOV"
     box = bpy.data.materials["Box"]
     group = bpy.data.node_groups.new("Grouped", "ShaderNodeTree")
-    _aov(group, "val", value=0.5).name = "Grouped AOV"
-    box.node_tree.nodes.new("ShaderNodeGroup").node_tree = group
+    group.interface.new_socket("Amount", in_out="INPUT", socket_type="NodeSocketFloat")
+    grouped = _aov(group, "val", value=0.5)
+    group.links.new(group.nodes.new("NodeGroupInput").outputs["Amount"], grouped.inputs["Value"])
+    user = box.node_tree.nodes.new("ShaderNodeGroup")
+    user.node_tree = group
+    user.inputs["Amount"].default_value = 0.25
     data = render_export(scene)
     materials = {m.name: m for m in data.materials}
     sphere = dict(materials["Sphere"].aovs)
@@ -164,10 +169,9 @@ def test_what_the_export_writes_and_names(drt):
     assert sphere["val"] == pytest.approx(SPHERE_VALUE)
     floor = materials["Floor"]
     assert floor.program is not None and all(isinstance(v, tuple) for _, v in floor.aovs)
+    assert materials["Box"].aovs == [("val", pytest.approx(0.25))]
     named = " ".join(data.warnings)
-    assert "'World AOV'" in named and "'Grouped AOV'" in named, data.warnings
-    assert "Material 'Sphere'" not in named and "Material 'Floor'" not in named, data.warnings
-    assert "Material 'Box'" in named
+    assert "'World AOV'" in named and "Material" not in named, data.warnings
 
 
 def test_the_cli_writes_them_and_its_merged_parts_equal_the_single_render(drt, tmp_path):

@@ -249,19 +249,29 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
 
 
 def aov_outputs(tree, compiler, layer) -> list:
-    """(AOV name, value) of each AOV Output node writing an AOV of the view layer: its Color into a
-    colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode); a node naming no AOV of the
-    view layer writes nothing, as in Cycles."""
+    """(AOV name, value) of each AOV Output node writing an AOV of the view layer, in the tree or its
+    node groups: its Color into a colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode);
+    a node naming no AOV of the view layer writes nothing, as in Cycles."""
     kinds = dict(view_layer_aovs(layer[1])) if layer is not None else {}
     out = []
-    for node in tree.nodes:
-        kind = kinds.get(getattr(node, "aov_name", None)) if node.bl_idname == "ShaderNodeOutputAOV" else None
+    for node, groups in _aov_nodes(tree):
+        kind = kinds.get(node.aov_name)
         if kind == "COLOR":
-            value = compiler.value(node.inputs["Color"], "color")
+            value = compiler.value(node.inputs["Color"], "color", groups)
             out.append((node.aov_name, value if is_ref(value) else rgb(value)))
         elif kind == "VALUE":
-            out.append((node.aov_name, compiler.value(node.inputs["Value"], "float")))
+            out.append((node.aov_name, compiler.value(node.inputs["Value"], "float", groups)))
     return out
+
+
+def _aov_nodes(tree, groups=()):
+    """(AOV Output node, the group nodes it sits inside, outermost first) in ``tree`` and, at any
+    depth, the node groups it uses (each use of a group its own nodes, as Cycles inlines them)."""
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeOutputAOV":
+            yield node, list(groups)
+        elif node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None and not node.mute:
+            yield from _aov_nodes(node.node_tree, groups + (node,))
 
 
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
@@ -269,27 +279,13 @@ VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+
 
 def unread_outputs(tree, output, issues, world=False) -> None:
     """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
-    Volume socket, AOV Output nodes inside node groups, and a world's AOV Output nodes."""
+    Volume socket, and a world's AOV Output nodes."""
     volume = None if output is None else output.inputs.get("Volume")
     if volume is not None and volume.is_linked:
         issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
-    for node in tree.nodes:
-        if node.bl_idname == "ShaderNodeOutputAOV" and world:
+    if world:
+        for node, _ in _aov_nodes(tree):
             issues.add(f"'{node.name}' (AOV Output in a world: not written yet)")
-    for node in _group_aov_outputs(tree):
-        issues.add(f"'{node.name}' (AOV Output inside a node group: not written yet)")
-
-
-def _group_aov_outputs(tree, seen=None):
-    """The AOV Output nodes inside the node groups ``tree`` uses, at any depth."""
-    seen = set() if seen is None else seen
-    for node in tree.nodes:
-        group = getattr(node, "node_tree", None) if node.bl_idname == "ShaderNodeGroup" else None
-        if group is None or group.name in seen:
-            continue
-        seen.add(group.name)
-        yield from (n for n in group.nodes if n.bl_idname == "ShaderNodeOutputAOV")
-        yield from _group_aov_outputs(group, seen)
 
 
 def _displacement(material, output, compiler, issues):
