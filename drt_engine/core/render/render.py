@@ -95,18 +95,12 @@ class Renderer:
         return self.prepared.warnings + self._setting_warnings()
 
     def _setting_warnings(self) -> list[str]:
-        """What these settings make DRT approximate in this scene: with diffuse bounces, rays leaving a
-        diffuse lobe see the world as reflected (glossy) or transmitted rays do, not by its Diffuse
-        ray visibility; shader AOVs behind transparency (core.integrator.aovs)."""
-        world, found = self.scene.world, []
+        """What these settings make DRT approximate in this scene: shader AOVs behind transparency
+        (core.integrator.aovs)."""
         if self.integrator.aovs is not None and any(c.kind == "TRANSPARENT" for m in self.scene.materials
                                                     for c in m.closures):
-            found.append(AOV_TRANSPARENCY)
-        if (self.integrator.diffuse and self.lights.world_seen
-                and not world.visible_diffuse == world.visible_glossy == world.visible_transmission):
-            found.append("the world's Diffuse ray visibility is not read with diffuse bounces yet: diffuse rays "
-                         "see the world as its Glossy (reflected) and Transmission (translucent) visibility say")
-        return found
+            return [AOV_TRANSPARENCY]
+        return []
 
     def render(self, progress=None) -> RenderResult:
         """Render progressively (core.render.driver) and return the passes, stats and error log."""
