@@ -297,6 +297,9 @@ class World:
     visible_diffuse: bool = True
     visible_glossy: bool = True
     visible_transmission: bool = True
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write where the camera sees it (core.integrator.aovs): (AOV name,
+    constant), RGB (3,) for a colour AOV, a float for a value AOV."""
     mist_start: float = 0.0
     mist_depth: float = 100.0
     mist_falloff: float = 1.0

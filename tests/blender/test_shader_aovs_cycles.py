@@ -2,8 +2,9 @@
 has a colour AOV "col", a value AOV "val" and a value AOV "unused" no material writes. The sphere
 writes constants into both (and into "elsewhere", an AOV the view layer does not have, which Cycles
 ignores); the floor writes a Checker texture's colour into "col" and a Noise texture's Fac into
-"val"; the box writes nothing; a pane 30% opaque in front writes constants, and so does what its
-pixels see through it, in the share of Cycles' samples its closure sampling sends through.
+"val"; the box writes nothing; the (black) world writes a colour into "col"; a pane 30% opaque in
+front writes constants, and so does what its pixels see through it, in the share of Cycles' samples
+its closure sampling sends through.
 
 Each AOV follows the node parity's rule (procedural_scenes.parity): DRT's worst 4x4-block
 difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and 1, plus 0.002. Where
@@ -31,6 +32,7 @@ SAMPLES = 16
 AOVS = (("col", "COLOR"), ("val", "VALUE"), ("unused", "VALUE"))
 SPHERE_COLOR, SPHERE_VALUE = (0.2, 0.6, 0.3), 0.8
 VEIL_ALPHA = 0.3  # under the view layer's alpha threshold: what is behind writes too
+WORLD_COLOR = (0.05, 0.1, 0.15)
 
 
 def _aov(tree, name, color=None, value=None):
@@ -88,6 +90,7 @@ def aov_scene():
     _aov(veil.node_tree, "col", color=(0.9, 0.9, 0.2))
     _aov(veil.node_tree, "val", value=0.1)
     _add(bpy.ops.mesh.primitive_plane_add, veil, size=1.6, location=(0.0, -2.5, 1.2), rotation=(1.2, 0.0, 0.0))
+    _aov(scene.world.node_tree, "col", color=WORLD_COLOR)
     layer = scene.view_layers[0]
     for name, kind in AOVS:
         aov = layer.aovs.add()
@@ -150,10 +153,10 @@ def test_what_the_export_writes_and_names(drt):
     """The sphere's AOV Output nodes become its writes (the view layer's AOVs only, a colour AOV from
     the node's Color, a value AOV from its Value), the floor's come from its program, the box's from
     inside a node group (its Value from the group node's input), and no material is named in a
-    warning; an AOV Output in the world is (Cycles writes it where the camera sees the world)."""
+    warning; the world's constant is its write, its textured one is named (not written yet)."""
     scene = aov_scene()
-    world = scene.world
-    _aov(world.node_tree, "col", color=(1.0, 1.0, 1.0)).name = "World AOV"
+    tree = scene.world.node_tree
+    _aov(tree, "val", value=tree.nodes.new("ShaderNodeTexNoise").outputs["Fac"])
     box = bpy.data.materials["Box"]
     group = bpy.data.node_groups.new("Grouped", "ShaderNodeTree")
     group.interface.new_socket("Amount", in_out="INPUT", socket_type="NodeSocketFloat")
@@ -170,8 +173,9 @@ def test_what_the_export_writes_and_names(drt):
     floor = materials["Floor"]
     assert floor.program is not None and all(isinstance(v, tuple) for _, v in floor.aovs)
     assert materials["Box"].aovs == [("val", pytest.approx(0.25))]
+    assert [name for name, _ in data.world.aovs] == ["col"] and np.allclose(data.world.aovs[0][1], WORLD_COLOR)
     named = " ".join(data.warnings)
-    assert "'World AOV'" in named and "Material" not in named, data.warnings
+    assert "AOV Output of 'val' from a texture in a world" in named and "Material" not in named, data.warnings
 
 
 def test_the_cli_writes_them_and_its_merged_parts_equal_the_single_render(drt, tmp_path):

@@ -20,6 +20,7 @@ from tests.support.scenes import translation
 RES = 16
 AOVS = (("col", "COLOR"), ("val", "VALUE"), ("unwritten", "VALUE"))
 A_COLOR, B_COLOR = np.array([0.2, 0.5, 0.8]), np.array([1.0, 0.0, 0.0])
+WORLD_COLOR = np.array([0.05, 0.1, 0.15])
 CHECKER_SCALE = 4.0  # cells 0.25 wide: two pixels of the 2 x 2 window's 16
 
 
@@ -39,8 +40,9 @@ def checker_program():
     return program, (checker, 1)
 
 
-def scene(transparency=0.0):
-    """B's material ``transparency`` transparent; A also writes an AOV no render asks for."""
+def scene(transparency=0.0, film_transparent=False):
+    """B's material ``transparency`` transparent; A also writes an AOV no render asks for; the world
+    writes a colour where the camera sees it."""
     cam = Camera(translation(0, 0, 10)[None], (-1, 1, -1, 1), (RES, RES), type="ORTHO")
     b_closures = [Closure("DIFFUSE", weight=np.full(3, 1 - transparency), color=(0.5, 0.5, 0.5))]
     if transparency:
@@ -50,7 +52,8 @@ def scene(transparency=0.0):
                  aovs=[("col", A_COLOR), ("val", fac), ("not in the view layer", 1.0)])
     b = Material("b", b_closures, aovs=[("col", B_COLOR)])
     return SceneData(cam, [quad(-2, 0.5, 0, 0), quad(0, 0.5, 4, 1)], [Instance(0, np.eye(4)), Instance(1, np.eye(4))],
-                     [a, b], [], World(np.full(3, 0.1)))
+                     [a, b], [], World(np.full(3, 0.1), aovs=[("col", WORLD_COLOR)]),
+                     film_transparent=film_transparent)
 
 
 def settings(samples=8, start=0, end=0, aovs=AOVS):
@@ -82,11 +85,17 @@ def test_a_constant_colour_and_a_textured_value_at_the_first_hits():
     a, b, bg = columns(p["col"])
     assert p["col"].shape == (RES, RES, 4) and p["val"].shape == (RES, RES, 1)
     assert np.allclose(a, [*A_COLOR, 1.0], atol=1e-6) and np.allclose(b, [*B_COLOR, 1.0], atol=1e-6)
-    assert np.all(bg == 0.0)  # nothing writes the background's pixels
+    assert np.allclose(bg, [*WORLD_COLOR, 1.0], atol=1e-6)  # the world's
     val_a, val_b, val_bg = columns(p["val"][..., 0])
     fac = checker_fac()
     assert 0.3 < fac.mean() < 0.7  # both kinds of cell under A
     assert np.allclose(val_a, fac, atol=1e-6) and np.all(val_b == 0.0) and np.all(val_bg == 0.0)
+
+
+def test_a_transparent_film_leaves_the_world_unwritten():
+    """As Cycles, which does not evaluate the background a transparent film shows."""
+    _, _, bg = columns(render(scene(film_transparent=True), settings())[1].passes["col"])
+    assert np.all(bg == 0.0)
 
 
 def test_an_aov_no_material_writes_is_zeros_and_costs_no_work():

@@ -241,18 +241,18 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     displacement = None if output is None else _displacement(material, output, compiler, issues)
     unread_outputs(material.node_tree, output, issues)
-    aovs = aov_outputs(material.node_tree, compiler, layer)
+    aovs = aov_outputs(material.node_tree, compiler, None if layer is None else layer[1])
     varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
                      pass_index=material.pass_index, aovs=aovs),
             issues.message(f"Material '{material.name}'"))
 
 
-def aov_outputs(tree, compiler, layer) -> list:
+def aov_outputs(tree, compiler, view_layer) -> list:
     """(AOV name, value) of each AOV Output node writing an AOV of the view layer, in the tree or its
     node groups: its Color into a colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode);
     a node naming no AOV of the view layer writes nothing, as in Cycles."""
-    kinds = dict(view_layer_aovs(layer[1])) if layer is not None else {}
+    kinds = dict(view_layer_aovs(view_layer)) if view_layer is not None else {}
     out = []
     for node, groups in _aov_nodes(tree):
         kind = kinds.get(node.aov_name)
@@ -277,15 +277,12 @@ def _aov_nodes(tree, groups=()):
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
 
 
-def unread_outputs(tree, output, issues, world=False) -> None:
+def unread_outputs(tree, output, issues) -> None:
     """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
-    Volume socket, and a world's AOV Output nodes."""
+    Volume socket."""
     volume = None if output is None else output.inputs.get("Volume")
     if volume is not None and volume.is_linked:
         issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
-    if world:
-        for node, _ in _aov_nodes(tree):
-            issues.add(f"'{node.name}' (AOV Output in a world: not written yet)")
 
 
 def _displacement(material, output, compiler, issues):

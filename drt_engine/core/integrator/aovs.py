@@ -4,7 +4,8 @@ A material's AOV Output nodes add their value to the AOV of their name at each h
 sees directly or through transparency, up to and including the first hit at least as opaque as the
 view layer's alpha threshold (the index passes' rule: Cycles' PATH_RAY_SINGLE_PASS_DONE). A colour
 AOV's alpha adds 1 per write. The film averages the writes over the samples like any pass; a pixel
-nothing writes keeps 0, and an AOV no material writes is a pass of zeros.
+nothing writes keeps 0, and an AOV no material writes is a pass of zeros. The world's AOV Output
+nodes write where a camera path escapes by the same rule (constants only, so far).
 
 Each write counts 1 in Cycles, its path's throughput unused: behind a partly transparent hit,
 Cycles writes in the share of samples whose path its closure sampling sends through the
@@ -34,15 +35,29 @@ def reach_scale(shader, group, rows) -> np.ndarray:
 class ShaderAOVs:
     """The AOV writes of every material of a prepared scene, for the AOVs one render writes."""
 
-    def __init__(self, shading, aovs):
+    def __init__(self, shading, world, film_transparent, aovs):
         kinds = dict(aovs)
         self.shading = shading
         self.writes = [[(name, kinds[name], value) for name, value in s.material.aovs if name in kinds]
                        for s in shading]
         """Per material: (AOV name, "COLOR" or "VALUE", constant or program output) it writes."""
+        # the world's, where the camera sees it: as Cycles, not with a transparent film (which
+        # leaves the background unevaluated) nor a world hidden from the camera
+        seen = world.visible_camera and not film_transparent
+        self.world = [(name, kinds[name], value) for name, value in world.aovs if name in kinds] if seen else []
 
     def writes_any(self) -> bool:
-        return any(self.writes)
+        return any(self.writes) or bool(self.world)
+
+    def write_world(self, path, throughput, aux: dict, reach: np.ndarray) -> None:
+        """Add the world's AOV values for the escaped camera rays of ``path`` (as ``write``)."""
+        weight = throughput.mean(axis=1) * reach
+        for name, kind, value in self.world:
+            if kind == "COLOR":
+                aux[name][path, :3] += np.asarray(value, float) * weight[:, None]
+                aux[name][path, 3] += weight
+            else:
+                aux[name][path, 0] += float(value) * weight
 
     def write(self, group, context, aux: dict, reach: np.ndarray) -> None:
         """Add the AOV values of the hits ``group`` (core.integrator.records.SurfaceHits, all of one

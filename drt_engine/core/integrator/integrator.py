@@ -132,7 +132,8 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
-        aovs = ShaderAOVs(prepared.shading, settings.aovs) if settings.aovs else None
+        aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
+            else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
         # paths carry their ray kind and depths only for a scene whose shader programs read them
@@ -265,7 +266,7 @@ class Integrator:
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
 
     def _escaped(self, rays: PathState, out: WaveOutput):
-        """Escaped rays see the world (and, after a bounce, the suns)."""
+        """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
         if len(rays) == 0:
             return
         lights = self.lights
@@ -273,6 +274,9 @@ class Integrator:
         path = None if rays.bounces is None else RayPath(st, rays.bounces, np.full(len(rays), BACKGROUND_LENGTH),
                                                          emission=True)
         world = lights.world_radiance(rays.dirs, st, rays.prev_normal, path)
+        if self.aovs is not None and self.aovs.world:
+            seen = np.flatnonzero(st & ~out.indexed[rays.path])
+            self.aovs.write_world(rays.path[seen], rays.throughput[seen], out.aux, out.aov_reach[rays.path[seen]])
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
         if self.film_transparent:
