@@ -92,9 +92,12 @@ def test_a_constant_colour_and_a_textured_value_at_the_first_hits():
     assert np.allclose(val_a, fac, atol=1e-6) and np.all(val_b == 0.0) and np.all(val_bg == 0.0)
 
 
-def test_a_transparent_film_leaves_the_world_unwritten():
-    """As Cycles, which does not evaluate the background a transparent film shows."""
-    _, _, bg = columns(render(scene(film_transparent=True), settings())[1].passes["col"])
+@pytest.mark.parametrize("film_transparent, visible", [(True, True), (False, False)])
+def test_a_transparent_film_or_a_hidden_world_leaves_it_unwritten(film_transparent, visible):
+    """As Cycles, which evaluates no background that a transparent film shows or the camera does not see."""
+    data = scene(film_transparent=film_transparent)
+    data.world.visible_camera = visible
+    _, _, bg = columns(render(data, settings())[1].passes["col"])
     assert np.all(bg == 0.0)
 
 
