@@ -93,6 +93,10 @@ class Material:
     see it as the hit's normal."""
     pass_index: int = 0
     """The material's pass index (Material Index pass)."""
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write into the render's shader AOVs (core.integrator.aovs): (AOV
+    name, value), the value RGB (3,) for a colour AOV, a float for a value AOV, or an output
+    ``(node, socket)`` of ``program``."""
 
     @property
     def emission(self) -> np.ndarray:
@@ -299,6 +303,9 @@ class World:
     visible_diffuse: bool = True
     visible_glossy: bool = True
     visible_transmission: bool = True
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write where the camera sees it (core.integrator.aovs): (AOV name,
+    constant), RGB (3,) for a colour AOV, a float for a value AOV."""
     mist_start: float = 0.0
     mist_depth: float = 100.0
     mist_falloff: float = 1.0

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...core.bsdf.microfacet import conductor_f82
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
+from ..properties import view_layer_aovs
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import DISPLACEMENT_MATCHED_FROM, Compiler, ImageTable, is_ref
 
@@ -255,9 +256,10 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     displacement = None if output is None else _displacement(material, output, compiler, issues)
     unread_outputs(material.node_tree, output, issues)
     _one_tangent(closures, issues)
-    varying = any(c.inputs for c in closures) or displacement is not None
+    aovs = aov_outputs(material.node_tree, compiler, None if layer is None else layer[1])
+    varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
-                     pass_index=material.pass_index),
+                     pass_index=material.pass_index, aovs=aovs),
             issues.message(f"Material '{material.name}'"))
 
 
@@ -270,18 +272,41 @@ def _one_tangent(closures, issues) -> None:
         issues.add("anisotropic shaders with different tangents or rotations (rendered with the first one's)")
 
 
+def aov_outputs(tree, compiler, view_layer) -> list:
+    """(AOV name, value) of each AOV Output node writing an AOV of the view layer, in the tree or its
+    node groups: its Color into a colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode);
+    a node naming no AOV of the view layer writes nothing, as in Cycles."""
+    kinds = dict(view_layer_aovs(view_layer)) if view_layer is not None else {}
+    out = []
+    for node, groups in _aov_nodes(tree):
+        kind = kinds.get(node.aov_name)
+        if kind == "COLOR":
+            value = compiler.value(node.inputs["Color"], "color", groups)
+            out.append((node.aov_name, value if is_ref(value) else rgb(value)))
+        elif kind == "VALUE":
+            out.append((node.aov_name, compiler.value(node.inputs["Value"], "float", groups)))
+    return out
+
+
+def _aov_nodes(tree, groups=()):
+    """(AOV Output node, the group nodes it sits inside, outermost first) in ``tree`` and, at any
+    depth, the node groups it uses (each use of a group its own nodes, as Cycles inlines them)."""
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeOutputAOV":
+            yield node, list(groups)
+        elif node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None and not node.mute:
+            yield from _aov_nodes(node.node_tree, groups + (node,))
+
+
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
 
 
 def unread_outputs(tree, output, issues) -> None:
     """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
-    Volume socket and AOV Output nodes."""
+    Volume socket."""
     volume = None if output is None else output.inputs.get("Volume")
     if volume is not None and volume.is_linked:
         issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
-    for node in tree.nodes:
-        if node.bl_idname == "ShaderNodeOutputAOV":
-            issues.add(f"'{node.name}' (AOV Output: shader AOVs are not written yet)")
 
 
 def _displacement(material, output, compiler, issues):

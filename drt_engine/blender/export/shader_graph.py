@@ -254,11 +254,12 @@ class Compiler:
         return self.op("math", (self.ref(1.0), a, self.ref(0.0)), operation="SUBTRACT"), 0
 
     # -- sockets ----------------------------------------------------------------------
-    def value(self, socket, kind=None):
-        """Constant or reference for an input socket, in ``kind`` ("float", "color", "vector")."""
+    def value(self, socket, kind=None, groups=None):
+        """Constant or reference for an input socket, in ``kind`` ("float", "color", "vector"); ``groups``:
+        the group nodes (outermost first) the socket's node sits inside, when not those being inlined."""
         kind = kind or _socket_kind(socket)
         default = _fit(_const(socket.default_value), kind) if hasattr(socket, "default_value") else None
-        source = follow(socket, self._groups)
+        source = follow(socket, self._groups if groups is None else groups)
         if source is None:
             return default
         node, output, stack = source

@@ -442,6 +442,12 @@ class MaterialShading:
             total += w * e
         return total
 
+    def outputs(self, ctx: SurfaceContext, refs) -> list:
+        """The program outputs ``refs`` at the hits of ``ctx``, after the displacement's bump (as the
+        closures' inputs see them)."""
+        ev = Evaluator(self.material.program, self._displaced(ctx), self.textures)
+        return [ev(ref) for ref in refs]
+
     def bind(self, ctx: SurfaceContext):
         """[(hit indices, shader bound to them)], the per-hit shading normal (or None) and the
         per-hit tangent of an anisotropic material (or None; ``tangent``)."""
