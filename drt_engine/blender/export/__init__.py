@@ -14,7 +14,7 @@ from ...core.errors import RenderCancelled
 from ...core.scene import SceneData
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
-from .left_out import TYPES as LEFT_OUT_TYPES, LeftOut
+from .left_out import LeftOut
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key
@@ -57,14 +57,14 @@ def export_scene(
         if not instance.show_self:
             continue
         obj = instance.object
-        left_out.look_at(obj, instance.is_instance)
+        rendered = left_out.look_at(obj, instance.is_instance)
         matrix = np.array(instance.matrix_world, dtype=np.float64)
         if obj.type == "LIGHT":
             light = export_light(obj, matrix, warnings)
             if light is not None:
                 lights.append(light)
                 light_keys.append(instance_key(instance))
-        elif obj.type not in LEFT_OUT_TYPES:
+        elif rendered:
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
     geometry.finish()

@@ -37,13 +37,15 @@ class LeftOut:
         self._objects: dict[str, str] = {}  # object name -> what of it is not rendered
         self._names: dict[str, list[str]] = {}
 
-    def look_at(self, obj, instanced: bool) -> None:
+    def look_at(self, obj, instanced: bool) -> bool:
         """Note what of ``obj`` DRT leaves out (once per object; ``instanced``: seen as an instance,
-        whose particle systems are its instancer's)."""
-        name = obj.name
-        if name in self._seen:
-            return
-        self._seen.add(name)
+        whose particle systems are its instancer's); False for an object DRT does not render at all."""
+        if obj.name not in self._seen:
+            self._seen.add(obj.name)
+            self._note(obj, obj.name, instanced)
+        return obj.type not in TYPES
+
+    def _note(self, obj, name: str, instanced: bool) -> None:
         if obj.type in TYPES:
             self._objects[name] = TYPES[obj.type]
         elif obj.type == "MESH" and not instanced and self._shows_hair(obj):
