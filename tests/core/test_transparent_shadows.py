@@ -1,0 +1,63 @@
+"""Transparent shadows: light reaching a point through a surface of transparency t is t times the
+unblocked light; an opaque surface and Max Transparent Bounces block it (Cycles' rule: a path's
+shadow rays pass max(limit - its transparent bounces - 1, 0) surfaces)."""
+import numpy as np
+import pytest
+
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData
+from drt_engine.core.settings import RenderSettings
+from tests.support.scenes import plane, top_camera, translation
+
+FLOOR = Material("floor", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])
+TINT = np.array([0.6, 0.3, 0.15])
+SHEET = Material("sheet", [Closure("TRANSPARENT", color=TINT)])
+OPAQUE = Material("opaque", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])
+RES = 16
+"""The camera, 3 m above the floor, sees 0.6 m either side of the middle: a 0.2 m sheet 1.5 m up
+and 0.5 m under a point light covers the middle 4 of its 16 pixels and shadows 0.4 m either side
+of the middle, the middle 10 pixels; the ring between shows the floor in the sheet's shadow."""
+
+
+def render(sheet=SHEET, **settings):
+    meshes = [plane(10.0), plane(0.2, 1.5, material=1)] if sheet is not None else [plane(10.0)]
+    scene = SceneData(top_camera(3.0, 0.2, RES), meshes, [Instance(k, np.eye(4)) for k in range(len(meshes))],
+                      [FLOOR, sheet or OPAQUE], [Light("POINT", translation(0, 0, 2.0), intensity=np.full(3, 40.0))])
+    r = Renderer(scene, RenderSettings(**{"samples": 4, "threads": 1, "filter_type": "BOX", "filter_size": 1.0,
+                                          **settings}))
+    return r.render().passes["Combined"][..., :3], r
+
+
+def ring(image):
+    """The floor pixels in the sheet's shadow that see the floor directly."""
+    y, x = np.mgrid[:RES, :RES] - (RES - 1) / 2
+    far = np.maximum(abs(x), abs(y))
+    return image[(far > 2.5) & (far < 4.5)]
+
+
+def test_light_through_a_transparent_sheet_is_its_transparency_times_the_unblocked_light():
+    open_, _ = render(sheet=None)
+    through, r = render()
+    assert r.plan.see_through == ["sheet"]
+    np.testing.assert_allclose(ring(through), ring(open_) * TINT, rtol=1e-6)
+
+
+def test_an_opaque_sheet_blocks_and_no_material_no_transparent_shadows():
+    blocked, r = render(sheet=OPAQUE)
+    assert ring(blocked).max() == 0.0
+    assert r.plan.see_through == [] and "transparent shadows" in r.plan.left_out
+
+
+@pytest.mark.parametrize("limit, passes", [(1, False), (2, True)])
+def test_max_transparent_bounces_blocks_past_the_limit(limit, passes):
+    """A camera hit's shadow rays pass limit - 1 surfaces; a path through the sheet already took one
+    transparent bounce, so the floor seen through it takes light only from a limit of 3 up."""
+    open_, _ = render(sheet=None)
+    image, _ = render(max_transparent_bounces=limit)
+    np.testing.assert_allclose(ring(image), ring(open_) * TINT if passes else 0.0, rtol=1e-6)
+    middle = image[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1]
+    assert middle.max() == 0.0  # through the sheet the path took its one bounce: limit - 2 < 1 surface
+    deeper, _ = render(max_transparent_bounces=3)
+    middle = deeper[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1]
+    np.testing.assert_allclose(middle, open_[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1] * TINT ** 2,
+                               rtol=1e-6)
