@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData
+from drt_engine.core.scene import Closure, Instance, Light, Material, Program, SceneData
+from drt_engine.core.shading.lightpath import OUTPUTS
 from drt_engine.core.settings import RenderSettings
 from tests.support.scenes import plane, top_camera, translation
 
@@ -61,3 +62,23 @@ def test_max_transparent_bounces_blocks_past_the_limit(limit, passes):
     middle = deeper[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1]
     np.testing.assert_allclose(middle, open_[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1] * TINT ** 2,
                                rtol=1e-6)
+
+
+def _shadowless() -> Material:
+    """Diffuse to every ray but shadow rays, which it lets through: a Mix Shader of a Diffuse and
+    a Transparent BSDF by Light Path's Is Shadow Ray (a common way to keep an object's shadow out)."""
+    prog = Program()
+    shadow = prog.add("light_path"), OUTPUTS.index("Is Shadow Ray")
+    one = prog.add("const", value=np.asarray(1.0)), 0
+    rest = prog.add("math", [one, shadow, shadow], operation="SUBTRACT"), 0
+    return Material("shadowless", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5), inputs={"weight": rest}),
+                                   Closure("TRANSPARENT", color=(1.0, 1.0, 1.0), inputs={"weight": shadow})],
+                    program=prog)
+
+
+def test_is_shadow_ray_is_one_at_the_surfaces_shadow_rays_pass():
+    open_, _ = render(sheet=None)
+    image, _ = render(sheet=_shadowless())
+    np.testing.assert_allclose(ring(image), ring(open_), rtol=1e-6)
+    middle = image[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1]
+    assert middle.min() > 0 and not np.allclose(middle, open_[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1])

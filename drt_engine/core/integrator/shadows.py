@@ -125,28 +125,24 @@ class TransparentShadows:
         geo = self.geometry
         while len(rays):
             n = len(rays)
-            f, i = rays.f, rays.i
-            prim, u, v, dirs = i[:, 1], f[:, 11], f[:, 12], np.ascontiguousarray(f[:, 6:9])
-            times = geo.time_values(f[:, 10] if timed else None)
-            pos, ng, frame, wo_l = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3))
-            inside, scale, normal = np.empty(n, bool), np.empty(n), np.empty((n, 3))
-            surface_hits(geo.tables, prim, u, v, times, np.arange(n), dirs, pos, ng, frame, wo_l, inside, scale,
-                         normal)
-            mat = geo.material_of(prim)
-            order = np.argsort(mat, kind="stable")
+            mat = geo.material_of(rays.i[:, 1])
+            order = np.argsort(mat, kind="stable")  # each material's hits one slice, as for camera hits
             rays, mat = rays.take(order), mat[order]
             f, i = rays.f, rays.i
-            pos, ng, frame, wo_l, inside, scale, normal = (a[order] for a in (pos, ng, frame, wo_l, inside, scale,
-                                                                               normal))
+            pos, ng, frame, wo_l = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3))
+            inside, scale, normal = np.empty(n, bool), np.empty(n), np.empty((n, 3))
+            prim, u, v, dirs = (np.ascontiguousarray(a) for a in (i[:, 1], f[:, 11], f[:, 12], f[:, 6:9]))
+            surface_hits(geo.tables, prim, u, v, geo.time_values(f[:, 10] if timed else None), np.arange(n), dirs,
+                         pos, ng, frame, wo_l, inside, scale, normal)
             # the shadow path's depths at this hit: no ray kind, the surfaces passed counted on
             bounces = rays.bounces.copy()
             bounces[:, KIND] = 0
             bounces[:, TRANSPARENT_DEPTH] += i[:, 3]
-            surf = SurfaceHits(path=i[:, 0], row=np.arange(n), prim=i[:, 1], mat=mat, pos=pos, ng=ng,
-                               frame=Frame(frame), wo=-f[:, 6:9], wo_l=wo_l, inside=inside, scale=scale,
+            surf = SurfaceHits(path=i[:, 0], row=np.arange(n), prim=prim, mat=mat, pos=pos, ng=ng,
+                               frame=Frame(frame), wo=-dirs, wo_l=wo_l, inside=inside, scale=scale,
                                throughput=f[:, 0:3], straight=np.zeros(n, bool), time=f[:, 10], normal=normal,
                                bounces=bounces)
-            hits = Hits(t=f[:, 13], prim=i[:, 1], u=f[:, 11], v=f[:, 12])
+            hits = Hits(t=f[:, 13], prim=prim, u=u, v=v)
             seen = np.zeros((n, 3))
             for rows, group, shader in self.bind(surf, hits, shadow=True):
                 seen[rows] = shader.transparency(group.wo_l[:, 2])
