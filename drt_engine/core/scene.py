@@ -87,6 +87,9 @@ class Material:
     see it as the hit's normal."""
     pass_index: int = 0
     """The material's pass index (Material Index pass)."""
+    transparent_shadow: bool = True
+    """Shadow rays may pass it where it is transparent (Blender's Transparent Shadows, read by
+    Cycles): off, its surfaces block them."""
 
     @property
     def emission(self) -> np.ndarray:

@@ -1,6 +1,8 @@
 """Transparent shadows: light reaching a point through a surface of transparency t is t times the
 unblocked light; an opaque surface and Max Transparent Bounces block it (Cycles' rule: a path's
 shadow rays pass max(limit - its transparent bounces - 1, 0) surfaces)."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -43,8 +45,11 @@ def test_light_through_a_transparent_sheet_is_its_transparency_times_the_unblock
     np.testing.assert_allclose(ring(through), ring(open_) * TINT, rtol=1e-6)
 
 
-def test_an_opaque_sheet_blocks_and_no_material_no_transparent_shadows():
-    blocked, r = render(sheet=OPAQUE)
+@pytest.mark.parametrize("sheet", [OPAQUE, replace(SHEET, transparent_shadow=False)], ids=["opaque", "shadows off"])
+def test_an_opaque_sheet_blocks_and_no_material_no_transparent_shadows(sheet):
+    """An opaque sheet, or a transparent one whose Transparent Shadows are off (Cycles: opaque to
+    shadow rays), blocks the light; the plan then leaves transparent shadows out."""
+    blocked, r = render(sheet=sheet)
     assert ring(blocked).max() == 0.0
     assert r.plan.see_through == [] and "transparent shadows" in r.plan.left_out
 

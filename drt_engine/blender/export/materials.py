@@ -242,7 +242,8 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     unread_outputs(material.node_tree, output, issues)
     varying = any(c.inputs for c in closures) or displacement is not None
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
-                     pass_index=material.pass_index),
+                     pass_index=material.pass_index,
+                     transparent_shadow=bool(getattr(material, "use_transparent_shadow", True))),
             issues.message(f"Material '{material.name}'"))
 
 
