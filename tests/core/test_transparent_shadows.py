@@ -87,3 +87,30 @@ def test_is_shadow_ray_is_one_at_the_surfaces_shadow_rays_pass():
     np.testing.assert_allclose(ring(image), ring(open_), rtol=1e-6)
     middle = image[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1]
     assert middle.min() > 0 and not np.allclose(middle, open_[RES // 2 - 1:RES // 2 + 1, RES // 2 - 1:RES // 2 + 1])
+
+
+def test_light_found_through_a_sheet_is_weighed_once():
+    """A glossy floor under an area light finds its light by both strategies; through a sheet of
+    transparency t both reach it (the BSDF's ray passes the sheet keeping the floor's pdf, as
+    Cycles keeps its MIS state through transparent bounces), so the floor in the sheet's shadow is
+    t times as bright, sample for sample. Counting the BSDF's share through the sheet at full
+    weight (the sheet taken for the ray's last bounce) made it brighter."""
+    floor = Material("glossy floor", [Closure("GLOSSY", color=(0.8, 0.8, 0.8), roughness=0.4)])
+    light = Light("AREA", translation(0, 0, 2.0), radiance=np.full(3, 20.0), size_x=0.2, size_y=0.2)
+    res, camera = 16, top_camera(3.0, 0.32, 16)
+
+    def image(with_sheet):
+        meshes = [plane(10.0)] + ([plane(0.6, 1.5, material=1)] if with_sheet else [])
+        scene = SceneData(camera, meshes, [Instance(k, np.eye(4)) for k in range(len(meshes))], [floor, SHEET],
+                          [light])
+        settings = RenderSettings(samples=16, threads=1, filter_type="BOX", filter_size=1.0)
+        return Renderer(scene, settings).render().passes["Combined"][..., :3]
+
+    # pixels that see the floor where the whole light lies behind the sheet (the umbra reaches
+    # 0.9 m from the middle, the sheet hides 0.2 of the camera's 0.32 half-width)
+    y, x = np.mgrid[:res, :res] - (res - 1) / 2
+    far = np.maximum(abs(x), abs(y))
+    ring_ = (far > 5.0) & (far < 7.0)
+    open_, through = image(False), image(True)
+    assert open_[ring_].min() > 0
+    np.testing.assert_allclose(through[ring_], open_[ring_] * TINT, rtol=1e-4)
