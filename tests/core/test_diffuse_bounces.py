@@ -60,15 +60,19 @@ def test_russian_roulette_keeps_the_furnace_unbiased():
     assert value == pytest.approx(closed_form(64, albedo), rel=0.01)
 
 
-def test_the_worlds_diffuse_visibility_left_unread_is_named():
-    """With diffuse bounces, escaping diffuse rays take the world's glossy or transmission
-    visibility: a world whose Diffuse visibility differs says so; none without diffuse bounces."""
-    def warnings(world, bounces):
-        scene = SceneData(top_camera(height=1.0, half_width=0.2, res=4), [plane(4.0)], [Instance(0, np.eye(4))],
-                          [Material("white", [Closure("DIFFUSE", color=(0.5, 0.5, 0.5))])], [], world)
-        return [w for w in Renderer(scene, RenderSettings(samples=1, threads=1, diffuse_bounces=bounces)).warnings
-                if "Diffuse ray visibility" in w]
-
-    assert len(warnings(World(np.full(3, 0.5), visible_diffuse=False), 2)) == 1
-    assert not warnings(World(np.full(3, 0.5), visible_diffuse=False), 0)
-    assert not warnings(World(np.full(3, 0.5)), 2)
+@pytest.mark.parametrize("hidden", ["visible_diffuse", "visible_glossy", "visible_transmission"])
+def test_diffuse_rays_see_the_world_by_its_diffuse_visibility(hidden):
+    """A diffuse plane open to a uniform world of radiance L reflects albedo x L, found by light
+    samples and escaping diffuse rays weighted against each other: none of it with the world
+    hidden from diffuse rays (as Cycles' background shader), all of it with the world hidden
+    from glossy or transmitted ones (a diffuse ray taking their visibility loses its share)."""
+    albedo, radiance = 0.5, 0.8
+    world = World(np.full(3, radiance))
+    setattr(world, hidden, False)
+    scene = SceneData(top_camera(height=1.0, half_width=0.2, res=4), [plane(4.0)], [Instance(0, np.eye(4))],
+                      [Material("white", [Closure("DIFFUSE", color=np.full(3, albedo))])], [], world)
+    value = mean(scene, 64, diffuse_bounces=2)
+    if hidden == "visible_diffuse":
+        assert value == 0.0
+    else:
+        assert value == pytest.approx(albedo * radiance, rel=0.02)

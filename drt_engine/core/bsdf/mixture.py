@@ -30,6 +30,10 @@ from .tables import lobe_albedo, lobe_scale, locate, ms_factor
 from .translucent import translucent_eval
 from .transparent import transparent_sample
 
+UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION = 1, 2, 4
+"""``eval_lobes``' parts a light does not reach: the diffuse lobes (translucent too, as Cycles
+counts it for lights), the others' reflection and their transmission."""
+
 
 @kernel(inline="always")
 def slot(lp, l, diffuse):
@@ -72,19 +76,24 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 
 
 @kernel(inline="always")
-def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse):
+def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit):
     """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
 
     ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
     back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo, for the ``diffuse``
-    lobes a path may continue through (``slot``). Returns (the part no ray continues through RGB:
-    the diffuse lobes (Lambert, Oren-Nayar, translucent) left out of the choice, the part rays
-    continue through RGB, density of continuing toward wi through the lobes of the choice).
+    lobes a path may continue through (``slot``). ``unlit`` (``UNLIT_*`` bits): parts a light
+    does not reach (the world's ray visibility): their BSDF is left out, their density kept, so
+    that the rays the lobes send weigh against this light sample as they would. Returns (the part
+    no ray continues through RGB: the diffuse lobes (Lambert, Oren-Nayar, translucent) left out
+    of the choice, the part rays continue through RGB, density of continuing toward wi through
+    the lobes of the choice).
     """
     j, t = locate(mu, woz)
     fd0 = fd1 = fd2 = fn0 = fn1 = fn2 = pdf = 0.0
     refl = above and wiz > 0.0
     trans = (not above) and wiz < 0.0
+    lit = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else 1.0
+    lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else 1.0
     for l in range(lp.shape[0]):
         if lp[l, P_DELTA] != 0.0:
             continue
@@ -100,6 +109,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
             else:
                 d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
+            d0, d1, d2 = d0 * lit_diffuse, d1 * lit_diffuse, d2 * lit_diffuse
             k = slot(lp, l, diffuse)
             if k >= 0:  # a lobe paths continue through: weighed against sampling it, as the others
                 fn0 += d0
@@ -121,9 +131,9 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 continue
         s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
         ms = ms_factor(lp, lt, hp, r, j, t, l)
-        fn0 += s0 * f0 * ms
-        fn1 += s1 * f1 * ms
-        fn2 += s2 * f2 * ms
+        fn0 += s0 * f0 * ms * lit
+        fn1 += s1 * f1 * ms * lit
+        fn2 += s2 * f2 * ms * lit
         pdf += sel[si, slot(lp, l, diffuse)] * p
     return fd0, fd1, fd2, fn0, fn1, fn2, pdf
 
@@ -188,7 +198,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     pdf = 0.0
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
-                                              sel, si, diffuse)
+                                              sel, si, diffuse, 0)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:

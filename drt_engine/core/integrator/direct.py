@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
-from ..bsdf.mixture import eval_lobes, selection
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import UNRESTRICTED
@@ -62,10 +62,19 @@ def _aim(x, y, z):
     return x * inv, y * inv, z * inv, d
 
 
+@kernel(inline="always")
+def unlit_parts(restrict, k):
+    """The BSDF parts strategy k does not light (mixture's ``UNLIT_*`` bits) from its ``restrict`` row."""
+    if restrict[k, 0] == UNRESTRICTED:
+        return 0
+    return ((UNLIT_DIFFUSE if restrict[k, 0] == 0 else 0) | (UNLIT_REFLECTION if restrict[k, 1] == 0 else 0)
+            | (UNLIT_TRANSMISSION if restrict[k, 2] == 0 else 0))
+
+
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
-                 diffuse_limit, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center, times,
-                 radiance, f_diff, visibility, clear, allowed, qf, qi):
+                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center,
+                 times, radiance, f_diff, visibility, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
     traced and the rows queued.
 
@@ -73,7 +82,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
     normal rows), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
     the diffuse bounces (the diffuse lobes paths continue through are weighed against sampling
-    them, integrator.bounces; the others are light-sampled alone), and the triangle and
+    them, integrator.bounces; the others are light-sampled alone), whether any ray ``continues``
+    from these hits (at the last depth none does: light sampling alone finds all their light,
+    no share is left to rays that are never traced), and the triangle and
     barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
     (core.geometry.accel.lift).
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
@@ -114,16 +125,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits)
+                           inside[j], sel, 0, bits, unlit_parts(restrict, k))
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
-            if restrict[k, 0] != UNRESTRICTED:
-                if restrict[k, 0] == 0:
-                    d0 = d1 = d2 = 0.0
-                if restrict[k, 1 if above else 2] == 0:
-                    n0 = n1 = n2 = 0.0
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
-            w = power(pdf[k, j], f[6])
+            w = power(pdf[k, j], f[6]) if continues else 1.0
             c0 = throughput[j, 0] * v0 * (d0 + n0 * w)
             c1 = throughput[j, 1] * v1 * (d1 + n1 * w)
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)

@@ -213,9 +213,9 @@ class Integrator:
                 if self.mist is not None or out.indexed is not None:
                     self._data_passes(group, shader, out)
                 if light is not None and shader.lobes:
-                    # no diffuse ray leaves the last depth: its diffuse light is light sampling's alone
+                    # no ray leaves the last depth: its light is light sampling's alone
                     queue = self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out,
-                                         self.diffuse if depth < s.max_depth else 0)
+                                         depth < s.max_depth)
                     if queue is not None:
                         queued.append(queue)
                     start += len(group)
@@ -440,10 +440,10 @@ class Integrator:
                                       joined([h.time for h in hits]) if self.timed else None,
                                       joined([h.bounces for h in hits]) if self.light_path else None)
 
-    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, diffuse: int):
+    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, continues: bool):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
-        kernel (core.integrator.direct), the diffuse lobes weighed against the diffuse rays these
-        hits may continue through (``diffuse``: the diffuse bounces, 0 where none continue);
+        kernel (core.integrator.direct), weighed against the rays these hits may continue
+        through (the diffuse lobes' within the diffuse bounces), where any ``continues``;
         what the wave's ratio estimator needs, when there is one, shown to it after
         (core.integrator.ratio). Returns the shadow rays stopped on see-through surfaces (None:
         none, core.integrator.shadows)."""
@@ -461,7 +461,8 @@ class Integrator:
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
-            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces), diffuse, geo.tables,
+            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
+            self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
             visibility, clear, allowed, qf, qi)

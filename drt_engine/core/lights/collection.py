@@ -27,7 +27,7 @@ from ..base.jit import kernel
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
-from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, reads_light_path
+from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
@@ -80,6 +80,7 @@ Block noise measured on the environment-map Cycles comparison (64 x 48, 128 spp)
 the map alone, 0.47% at 0.75, 0.53% at 0.5, 0.95% at 0.25."""
 _NO_MAP = (np.zeros(2), np.zeros((1, 2)), np.zeros((1, 1)), 1.0, np.zeros(5))
 """Stand-in map tables for the world kernels when the world is uniform (never read)."""
+_NO_KINDS = np.zeros(0, np.int32)  # rays that carry no kind: the world's visibility by the side they leave
 
 
 class Lights:
@@ -352,12 +353,13 @@ class Lights:
     def world_radiance(self, dirs, straight, prev_normal, path=None):
         """Radiance of the world seen along ``dirs`` by camera rays (``straight``), or by rays
         reflected or refracted at a surface of geometric normal ``prev_normal`` (toward where
-        the ray came from), as the world's ray visibility allows; ``path`` the rays, for Light Path."""
+        the ray came from), as the world's ray visibility allows; ``path`` the rays (their kinds
+        decide the visibility, as Cycles' ray flags do, and Light Path reads them)."""
         n = len(dirs)
         if not self.world_seen:
             return np.zeros((n, 3))
-        camera, _, glossy, transmission = self.world_visibility
-        shown = world_shown_batch(dirs, straight, prev_normal, camera, glossy, transmission)
+        kinds = np.ascontiguousarray(path.bounces[:, KIND]) if path is not None else _NO_KINDS
+        shown = world_shown_batch(dirs, straight, prev_normal, kinds, *self.world_visibility)
         if self.environment is not None:
             value = np.zeros((n, 3))
             k = np.flatnonzero(shown)

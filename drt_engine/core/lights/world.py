@@ -11,6 +11,7 @@ import numpy as np
 from ..base.jit import kernel
 from ..base.vectors import basis
 from ..base.warps import concentric_disk
+from ..shading.lightpath import DIFFUSE, GLOSSY, REFLECT, TRANSMIT
 from .environment import map_direction, map_pdf
 
 
@@ -55,13 +56,21 @@ def pdf_world_batch(normal, dirs, share, cell, cell_area, sun):
 
 
 @kernel
-def world_shown_batch(dirs, straight, normal, camera, glossy, transmission):
-    """Whether the world is seen along each ray: by the camera, or through reflection
-    (d on the normal's side) or refraction, as its ray visibility says."""
+def world_shown_batch(dirs, straight, normal, kinds, camera, diffuse, glossy, transmission):
+    """Whether the world is seen along each ray, as its ray visibility says: by the camera; with
+    ``kinds`` (the rays' kind bits, core.shading.lightpath), as Cycles' background shader does:
+    hidden from a diffuse ray by Diffuse, from a glossy reflection by Glossy, from any
+    transmission (a translucent one too) by Transmission; without them (no ray took a diffuse
+    lobe) a ray reflected (d on the normal's side) is a glossy one, any other a transmission."""
     out = np.empty(len(dirs), np.bool_)
     for j in range(len(dirs)):
         if straight[j]:
             out[j] = camera
+        elif len(kinds):
+            k = kinds[j]
+            out[j] = not (((k & DIFFUSE) != 0 and not diffuse)
+                          or ((k & (GLOSSY | REFLECT)) == (GLOSSY | REFLECT) and not glossy)
+                          or ((k & TRANSMIT) != 0 and not transmission))
         elif dirs[j, 0] * normal[j, 0] + dirs[j, 1] * normal[j, 1] + dirs[j, 2] * normal[j, 2] >= 0:
             out[j] = glossy
         else:

@@ -91,19 +91,7 @@ class Renderer:
 
     @property
     def warnings(self) -> list:
-        return self.prepared.warnings + self._setting_warnings()
-
-    def _setting_warnings(self) -> list[str]:
-        """What these settings make DRT approximate in this scene: with diffuse bounces, rays leaving a
-        diffuse lobe see the world as reflected (glossy) or transmitted rays do, not by its Diffuse
-        ray visibility."""
-        world = self.scene.world
-        if not (self.integrator.diffuse and self.lights.world_seen):
-            return []
-        if world.visible_diffuse == world.visible_glossy == world.visible_transmission:
-            return []
-        return ["the world's Diffuse ray visibility is not read with diffuse bounces yet: diffuse rays see the "
-                "world as its Glossy (reflected) and Transmission (translucent) visibility say"]
+        return self.prepared.warnings
 
     def render(self, progress=None) -> RenderResult:
         """Render progressively (core.render.driver) and return the passes, stats and error log."""
