@@ -92,10 +92,10 @@ def outputs(path: RayPath | None, n: int) -> tuple:
 
     depth = b[:, DEPTH] + (1 if path.emission else 0)
     shadow = np.full(n, 1.0 if path.shadow else 0.0)
-    return (path.camera.astype(float), shadow, bit(DIFFUSE), bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT), zero,
-            np.asarray(path.length, float), depth.astype(float), b[:, DIFFUSE_DEPTH].astype(float),
-            b[:, GLOSSY_DEPTH].astype(float),
-            b[:, TRANSPARENT_DEPTH].astype(float), b[:, TRANSMISSION_DEPTH].astype(float), zero)
+    return (path.camera.astype(float), shadow, bit(DIFFUSE), bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT),
+            zero, np.asarray(path.length, float), depth.astype(float), b[:, DIFFUSE_DEPTH].astype(float),
+            b[:, GLOSSY_DEPTH].astype(float), b[:, TRANSPARENT_DEPTH].astype(float),
+            b[:, TRANSMISSION_DEPTH].astype(float), zero)
 
 
 def falloff(strength, smooth, path: RayPath | None, n: int) -> tuple:
