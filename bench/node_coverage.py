@@ -35,8 +35,8 @@ def block() -> str:
         f"- **Evaluated** ({len([n for n in names if n in done])}): {listed(n for n in names if n in done)}.",
         f"- **Walked through:** {listed(coverage.STRUCTURE)}.",
         f"- **Left out, named in the warning where used** ({len(left)}): {listed(left)}. A closure renders "
-        "default grey, any other node leaves the socket it feeds its own value; a volume shader and AOV "
-        "Output are named too.",
+        "default grey, any other node leaves the socket it feeds its own value; a volume shader and a world's "
+        "AOV Output fed by a texture are named too.",
         f"- **Not rendered by Cycles either:** {listed(n for n in coverage.NOT_IN_CYCLES if n in names)}.", ""])
 
 

@@ -3,7 +3,7 @@ previews) and viewport.py (Rendered shading)."""
 import bpy
 
 from .final import render as final_render
-from .properties import pass_layout, registered_passes, result_pass_name
+from .properties import pass_layout, registered_passes, result_pass_name, view_layer_aovs
 from .viewport import ViewportSession
 
 
@@ -32,8 +32,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self._viewport.draw(self, context, depsgraph)
 
     def update_render_passes(self, scene=None, renderlayer=None):
+        aovs = view_layer_aovs(renderlayer)
         for name in registered_passes(scene, renderlayer):
-            self.register_pass(scene, renderlayer, result_pass_name(name), *pass_layout(name))
+            self.register_pass(scene, renderlayer, result_pass_name(name), *pass_layout(name, aovs))
 
 
 classes = (DRTRenderEngine,)

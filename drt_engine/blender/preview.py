@@ -18,5 +18,5 @@ preview, of the same preview scene, so the second reuses the first's prepared sc
 def preview_settings(settings):
     """Settings for a material or light preview: small and fast, Combined only, not denoised."""
     return dataclasses.replace(settings, samples=min(settings.samples, PREVIEW_SAMPLES),
-                               max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",),
+                               max_depth=min(settings.max_depth, PREVIEW_MAX_DEPTH), passes=("Combined",), aovs=(),
                                sample_start=0, sample_end=0, use_denoising=False)

@@ -13,7 +13,7 @@ from bpy.props import (
     PointerProperty,
 )
 
-from ..core.settings import NOISY_IMAGE, PASS_CHANNELS, PASSES, RenderSettings
+from ..core.settings import NOISY_IMAGE, PASSES, RenderSettings, pass_channels
 from .oidn import oidn_library
 
 BLENDER_PASS_TOGGLES = {
@@ -64,6 +64,12 @@ def enabled_passes(view_layer) -> tuple[str, ...]:
     return tuple(name for name in PASSES if pass_enabled(view_layer, name))
 
 
+def view_layer_aovs(view_layer) -> tuple[tuple[str, str], ...]:
+    """The view layer's shader AOVs, (name, "COLOR" or "VALUE"): passes of their names, as Cycles
+    registers them; an AOV Blender marks not valid (its name empty, repeated or a pass's) is none."""
+    return tuple((aov.name, aov.type) for aov in getattr(view_layer, "aovs", ()) if aov.is_valid)
+
+
 def denoising_active(scene) -> bool:
     """Whether final renders of ``scene`` are denoised: asked for, and this Blender has OIDN."""
     return bool(scene.drt.use_denoising) and oidn_library() is not None
@@ -72,12 +78,13 @@ def denoising_active(scene) -> bool:
 def registered_passes(scene, view_layer) -> tuple[str, ...]:
     """The passes a render of this view layer writes: the enabled ones, and Noisy Image when denoising."""
     extra = (NOISY_IMAGE,) if scene is not None and denoising_active(scene) else ()
-    return enabled_passes(view_layer) + extra
+    return enabled_passes(view_layer) + tuple(name for name, _ in view_layer_aovs(view_layer)) + extra
 
 
-def pass_layout(name: str) -> tuple[int, str, str]:
-    """(channel count, channel ids, Blender pass type) for ``RenderEngine.register_pass``."""
-    chan_id = PASS_CHANNELS[name]
+def pass_layout(name: str, aovs=()) -> tuple[int, str, str]:
+    """(channel count, channel ids, Blender pass type) for ``RenderEngine.register_pass`` (``aovs``:
+    the view layer's shader AOVs)."""
+    chan_id = pass_channels(name, aovs)
     return len(chan_id), chan_id, _PASS_TYPES[chan_id]
 
 
@@ -98,6 +105,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         filter_type=drt.filter_type,
         filter_size=scene.render.filter_size,
         passes=enabled_passes(view_layer),
+        aovs=view_layer_aovs(view_layer),
         use_adaptive_sampling=drt.use_adaptive_sampling,
         adaptive_threshold=drt.adaptive_threshold,
         adaptive_min_samples=drt.adaptive_min_samples,

@@ -253,6 +253,25 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer.drt, "use_pass_noise")
 
 
+class DRT_PT_passes_aov(DRTButtonsPanel, bpy.types.Panel):
+    """The view layer's shader AOVs: passes the materials' AOV Output nodes write (as Cycles' panel)."""
+
+    bl_label = "Shader AOV"
+    bl_context = "view_layer"
+    bl_parent_id = "DRT_PT_passes"
+
+    def draw(self, context):
+        view_layer = context.view_layer
+        row = split(self.layout).row()
+        row.template_list("VIEWLAYER_UL_aov", "aovs", view_layer, "aovs", view_layer, "active_aov_index", rows=3)
+        buttons = row.column(align=True)
+        buttons.operator("scene.view_layer_add_aov", icon="ADD", text="")
+        buttons.operator("scene.view_layer_remove_aov", icon="REMOVE", text="")
+        aov = view_layer.active_aov
+        if aov is not None and not aov.is_valid:
+            self.layout.label(text="Conflicts with another render pass with the same name", icon="ERROR")
+
+
 PRESET_CLASSES = (DRT_OT_light_paths_preset, DRT_MT_light_paths_presets)
 """The Light Paths panel's preset menu and what it runs."""
 
@@ -266,6 +285,7 @@ classes = (
     DRT_PT_motion_blur,
     DRT_PT_performance,
     DRT_PT_passes,
+    DRT_PT_passes_aov,
 )
 
 

@@ -51,7 +51,7 @@ STOP_TIMEOUT = 5.0
 def viewport_settings(settings, preview_samples: int):
     """Settings for Rendered shading: the viewport samples, Combined only, no stop rules, no final-render
     denoising (``use_denoising``; the viewport denoises its own images through ViewDenoise)."""
-    return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",),
+    return dataclasses.replace(settings, samples=preview_samples, passes=("Combined",), aovs=(),
                                use_adaptive_sampling=False, time_limit=0.0, target_error=0.0,
                                sample_start=0, sample_end=0, use_denoising=False)
 

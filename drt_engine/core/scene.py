@@ -46,6 +46,12 @@ class Closure:
     """Emitted radiance, W/(m² sr) per channel: emission colour times strength."""
     multiscatter: bool = True
     """GGX lobes get Cycles' multiple-scattering energy compensation ("Multiscatter GGX")."""
+    anisotropy: float = 0.0
+    """The node's own anisotropy: Principled's Anisotropic (0 to 1, also the Metallic BSDF's), or
+    GLOSSY's Anisotropy (-1 to 1); each maps to alpha_x, alpha_y as Cycles' svm_node_closure_bsdf
+    (core.bsdf.shader.anisotropic_alphas), along the hits' tangent (input "tangent")."""
+    anisotropic_rotation: float = 0.0
+    """Turns of the tangent about the normal."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
     "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``
@@ -87,6 +93,10 @@ class Material:
     see it as the hit's normal."""
     pass_index: int = 0
     """The material's pass index (Material Index pass)."""
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write into the render's shader AOVs (core.integrator.aovs): (AOV
+    name, value), the value RGB (3,) for a colour AOV, a float for a value AOV, or an output
+    ``(node, socket)`` of ``program``."""
     transparent_shadow: bool = True
     """Shadow rays may pass it where it is transparent (Blender's Transparent Shadows, read by
     Cycles): off, its surfaces block them."""
@@ -296,6 +306,9 @@ class World:
     visible_diffuse: bool = True
     visible_glossy: bool = True
     visible_transmission: bool = True
+    aovs: list = field(default_factory=list)
+    """What its AOV Output nodes write where the camera sees it (core.integrator.aovs): (AOV name,
+    constant), RGB (3,) for a colour AOV, a float for a value AOV."""
     mist_start: float = 0.0
     mist_depth: float = 100.0
     mist_falloff: float = 1.0

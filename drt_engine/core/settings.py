@@ -50,6 +50,17 @@ FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
 """Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
 mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
 writes these at sample 0 only, core.film.film)."""
+AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
+"""Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
+writes: 1 per sample whose camera path wrote the AOV)."""
+
+
+def pass_channels(name: str, aovs=()) -> str:
+    """The channel ids of pass ``name``: a built-in pass's, or of one of the shader AOVs ``aovs``
+    ((name, type) pairs, ``RenderSettings.aovs``)."""
+    return PASS_CHANNELS.get(name) or AOV_CHANNELS[dict(aovs)[name]]
+
+
 NOISY_IMAGE = "Noisy Image"
 """With denoising on, the Combined image as rendered, before OIDN (Cycles' pass of that name); not
 one of ``PASSES``: the render adds it, no setting asks for it."""
@@ -81,6 +92,9 @@ class RenderSettings:
     filter_type: str = "BLACKMAN_HARRIS"
     filter_size: float = 1.5
     passes: tuple[str, ...] = ("Combined",)
+    # the view layer's shader AOVs, (name, "COLOR" or "VALUE") each: passes of those names, written
+    # by the materials' AOV Output nodes (core.integrator.aovs); each name is also one of ``passes``
+    aovs: tuple[tuple[str, str], ...] = ()
     use_adaptive_sampling: bool = False
     adaptive_threshold: float = 0.01
     adaptive_min_samples: int = 0
@@ -124,9 +138,12 @@ class RenderSettings:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
-        unknown = set(self.passes) - set(PASSES)
+        self.aovs = tuple((str(name), str(kind)) for name, kind in self.aovs)
+        self._check_aovs()
+        unknown = set(self.passes) - set(PASSES) - {name for name, _ in self.aovs}
         if unknown:
             raise ValueError(f"unknown passes {sorted(unknown)}")
+        self.passes = tuple(self.passes) + tuple(name for name, _ in self.aovs if name not in self.passes)
         if "Combined" not in self.passes:
             self.passes = ("Combined",) + tuple(self.passes)
         start, end = self.sample_range()
@@ -135,6 +152,15 @@ class RenderSettings:
         if self.partial and (self.use_adaptive_sampling or self.time_limit > 0 or self.target_error > 0):
             raise SettingsError("a sample range needs a fixed sample count: turn off adaptive sampling, "
                                 "the time limit and the target error")
+
+    def _check_aovs(self):
+        names = [name for name, _ in self.aovs]
+        for name, kind in self.aovs:
+            if kind not in AOV_CHANNELS:
+                raise SettingsError(f"AOV '{name}' has type {kind!r}, not one of {', '.join(AOV_CHANNELS)}")
+            if not name or name in PASS_CHANNELS or names.count(name) > 1:
+                raise SettingsError(f"AOV '{name}': an AOV needs a name of its own, not empty, another AOV's "
+                                    "or a pass's")
 
     def sample_range(self) -> tuple[int, int]:
         """The sample ids this render traces, start to end - 1, of the full set of ``samples``."""

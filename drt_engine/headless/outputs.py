@@ -34,7 +34,7 @@ def write_output(output: Path, merger) -> None:
     images = merger.images(merge_denoiser(merger))
     try:
         output.parent.mkdir(parents=True, exist_ok=True)
-        merge.write_exr(output, images, merger.first.header["view_layer"])
+        merge.write_exr(output, images, merger.first.header["view_layer"], merger.first.settings().aovs)
     except OSError as error:
         raise CLIError(f"cannot write {output}: {error.strerror or error}") from None
 

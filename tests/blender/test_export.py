@@ -366,6 +366,55 @@ def test_translucent_and_rough_diffuse_export_as_their_closures():
         assert data.warnings == []
 
 
+def _added(tree, output, *nodes):
+    """The nodes' first outputs summed by Add Shaders into the material output."""
+    out = nodes[0].outputs[0]
+    for node in nodes[1:]:
+        add = tree.nodes.new("ShaderNodeAddShader")
+        tree.links.new(out, add.inputs[0])
+        tree.links.new(node.outputs[0], add.inputs[1])
+        out = add.outputs[0]
+    tree.links.new(out, output.inputs["Surface"])
+
+
+def test_anisotropy_exports_with_its_tangent_and_rotation():
+    """Principled's Anisotropic, the Metallic BSDF's and Glossy's Anisotropy export with their
+    rotation and a tangent, Geometry's where the Tangent socket is unlinked (one program node for
+    all of them), a linked Tangent node's otherwise, without a warning; an isotropic shader has no
+    tangent. Anisotropic shaders with different tangents in one material are named (a hit has one
+    shading frame, along the first one's tangent)."""
+    empty_scene()
+    brushed, tree, output = _new_node_material("Brushed")
+    principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    principled.inputs["Anisotropic"].default_value = 0.8
+    principled.inputs["Anisotropic Rotation"].default_value = 0.25
+    metallic = tree.nodes.new("ShaderNodeBsdfMetallic")
+    metallic.inputs["Anisotropy"].default_value = 0.3
+    metallic.inputs["Rotation"].default_value = 0.25
+    plain = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    _added(tree, output, principled, metallic, plain)
+    turned, tree, output = _new_node_material("Turned")
+    glossy = tree.nodes.new("ShaderNodeBsdfAnisotropic")
+    glossy.inputs["Anisotropy"].default_value = -0.5
+    tangent = tree.nodes.new("ShaderNodeTangent")
+    tangent.direction_type, tangent.axis = "RADIAL", "X"
+    tree.links.new(tangent.outputs[0], glossy.inputs["Tangent"])
+    second = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    second.inputs["Anisotropic"].default_value = 0.5
+    _added(tree, output, glossy, second)
+    scene = _material_scene(brushed)
+    add_object(scene, "Other", cube_mesh()).data.materials.append(turned)
+    data = render_export(scene)
+    p, m, iso = _closures(data, "Brushed")
+    assert (p.anisotropy, p.anisotropic_rotation) == pytest.approx((0.8, 0.25))
+    assert (m.anisotropy, m.anisotropic_rotation) == pytest.approx((0.3, 0.25))
+    assert p.inputs["tangent"] == m.inputs["tangent"] and "tangent" not in iso.inputs
+    g, second = _closures(data, "Turned")
+    assert g.anisotropy == pytest.approx(-0.5) and g.inputs["tangent"] != second.inputs["tangent"]
+    (warning,) = data.warnings
+    assert "'Turned'" in warning and "different tangents" in warning, warning
+
+
 def test_muted_mix_shader_passes_its_first_shader_through():
     empty_scene()
     material, tree, output = _new_node_material("Muted")

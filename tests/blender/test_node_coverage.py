@@ -14,8 +14,8 @@ from tests.support.export_helpers import add_object, cube_mesh, empty_scene, ren
 
 def _used(node_type: str):
     """A cube whose material uses a node of ``node_type`` as Cycles would read it: a shader into
-    Surface (a volume shader into Volume), any other output into an Emission's Color, an AOV
-    Output as it stands; the node's name, or None for a node with nothing to connect."""
+    Surface (a volume shader into Volume), any other output into an Emission's Color; the node's
+    name, or None for a node with nothing to connect."""
     scene = empty_scene()
     material = new_material(node_type)
     tree = material.node_tree
@@ -31,7 +31,7 @@ def _used(node_type: str):
         emission = tree.nodes.new("ShaderNodeEmission")
         tree.links.new(node.outputs[0], emission.inputs["Color"])
         tree.links.new(emission.outputs[0], out.inputs["Surface"])
-    elif node_type != "ShaderNodeOutputAOV":
+    else:
         return scene, None
     add_object(scene, "Cube", cube_mesh()).data.materials.append(material)
     return scene, node.name

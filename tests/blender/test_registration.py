@@ -172,6 +172,15 @@ class RecordingLayout:
         assert name in data.bl_rna.properties, f"{type(data).__name__} has no property {name!r}"
         self.drawn.add(name)
 
+    def template_list(self, list_type, list_id, data, name, active_data, active_name, **kwargs):
+        assert hasattr(bpy.types, list_type), f"no UI list {list_type}"
+        self.prop(data, name)
+        self.prop(active_data, active_name)
+
+    def operator(self, idname, **kwargs):
+        module, name = idname.split(".")
+        assert name in dir(getattr(bpy.ops, module)), f"no operator {idname}"
+
     def separator(self, **kwargs):
         pass
 
@@ -193,5 +202,6 @@ def test_drt_panels_draw_existing_properties(drt):
     scene_settings = set(properties.DRTSceneSettings.bl_rna.properties.keys()) - {"rna_type", "name"}
     assert scene_settings <= drawn
     assert set(properties.BLENDER_PASS_TOGGLES.values()) | set(properties.DRT_PASS_TOGGLES.values()) <= drawn
+    assert "aovs" in drawn  # the Shader AOV list
     assert {"use_motion_blur", "motion_blur_shutter", "motion_blur_position", "filter_size",
             "film_transparent"} <= drawn

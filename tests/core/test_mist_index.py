@@ -7,10 +7,11 @@ import pytest
 
 from drt_engine.core.film import parts
 from drt_engine.core.integrator.integrator import Integrator
-from drt_engine.core.render import merge, report
+from drt_engine.core.render import merge
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData, World
 from drt_engine.core.settings import RenderSettings
+from tests.support.core_cases import rendered_part
 from tests.support.scenes import translation
 
 RES = 16
@@ -113,11 +114,7 @@ def test_parts_merge_into_the_whole_render(tmp_path):
     data = scene(transparency=0.75)
 
     def part(start, end):
-        s = settings(start=start, end=end)
-        renderer, result = render(data, s)
-        summary = report.report_dict(s, result.stats, result.log, report.scene_summary(data))
-        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data), "report": summary}
-        return parts.from_film(renderer.film, s, header), result
+        return rendered_part(data, settings(start=start, end=end))
 
     _, whole = part(0, 0)
     pieces = [part(a, b)[0] for a, b in ((3, 8), (1, 3), (0, 1))]

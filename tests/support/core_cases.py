@@ -15,7 +15,7 @@ from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Sc
 from drt_engine.core.settings import PASSES, RenderSettings
 
 __all__ = ["render", "Camera", "Closure", "Instance", "Light", "Material", "SceneData", "World", "PASSES",
-           "diffuse", "ortho_camera"]
+           "diffuse", "ortho_camera", "rendered_part"]
 
 
 def render(scene: SceneData, samples=4, seed=0, passes=PASSES, determinism=True, **settings):
@@ -40,3 +40,16 @@ def diffuse(albedo=0.5, name="white") -> Material:
 
 def ortho_camera(matrix, half=1e-3, res=4, **kw) -> Camera:
     return Camera(np.asarray(matrix)[None], (-half, half, -half, half), (res, res), type="ORTHO", **kw)
+
+
+def rendered_part(data, settings):
+    """(the part a render of ``settings``' sample range leaves, with a header as the CLI writes it,
+    the render's result)."""
+    from drt_engine.core.film import parts
+    from drt_engine.core.render import report
+
+    renderer = Renderer(data, settings)
+    result = renderer.render()
+    summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(data))
+    header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data), "report": summary}
+    return parts.from_film(renderer.film, settings, header), result

@@ -106,7 +106,8 @@ def configure_drt(scene, samples: int, seed: int) -> None:
 
 
 def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name="render") -> Render:
-    """Render ``scene`` with ``engine`` ('DRT' or 'CYCLES') to a multilayer EXR and read it back."""
+    """Render ``scene`` with ``engine`` ('DRT' or 'CYCLES') to a multilayer EXR and read it back, with
+    the view layer's shader AOVs (by name, channels as Cycles registers them)."""
     if engine == "CYCLES":
         configure_cycles(scene, samples, seed)
     else:
@@ -126,6 +127,8 @@ def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name
     images = {"Combined": _pass(channels, view_layer.name, "Combined", "RGBA")}
     for pass_name in passes:
         images[pass_name] = _pass(channels, view_layer.name, pass_name, PASS_TOGGLES[pass_name][1])
+    for aov in view_layer.aovs:
+        images[aov.name] = _pass(channels, view_layer.name, aov.name, "RGBA" if aov.type == "COLOR" else "X")
     return Render(images, seconds, samples)
 
 

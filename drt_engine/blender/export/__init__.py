@@ -77,7 +77,7 @@ def export_scene(
         instances=geometry.instances,
         materials=materials.materials,
         lights=lights,
-        world=export_world(world, warnings, images),
+        world=export_world(world, warnings, images, depsgraph.view_layer),
         images=images.images,
         film_transparent=scene.render.film_transparent,
         warnings=warnings,

@@ -14,8 +14,9 @@ from .shader_graph import Compiler
 from .world import EMITTERS
 
 STRUCTURE = ("ShaderNodeMixShader", "ShaderNodeAddShader", "ShaderNodeOutputMaterial", "ShaderNodeOutputWorld",
-             "ShaderNodeOutputLight")
-"""Nodes the export walks through rather than evaluates."""
+             "ShaderNodeOutputLight", "ShaderNodeOutputAOV")
+"""Nodes the export walks through rather than evaluates (a material's AOV Output: its inputs become the
+material's AOV writes, export.materials.aov_outputs)."""
 
 NOT_IN_CYCLES = ("ShaderNodeEeveeSpecular", "ShaderNodeShaderToRGB", "ShaderNodeOutputLineStyle",
                  "ShaderNodeUVAlongStroke", "ShaderNodeCustomGroup")

@@ -13,6 +13,7 @@ import numpy as np
 
 from ...core.bsdf.microfacet import conductor_f82
 from ...core.scene import DEFAULT_MATERIAL, Closure, Material
+from ..properties import view_layer_aovs
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import DISPLACEMENT_MATCHED_FROM, Compiler, ImageTable, is_ref
 
@@ -40,7 +41,7 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal")
+           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -72,6 +73,20 @@ class _Inputs:
             if is_ref(value):
                 self.varying["normal"] = value
 
+    def anisotropy(self, closure, name, rotation_name):
+        """The closure's anisotropy, its rotation and, when it is anisotropic, its tangent: the
+        Tangent socket's, or Geometry's Tangent where it is unlinked (as Cycles links it)."""
+        closure.anisotropy = self(0.0, name, field="anisotropy", kind="float")
+        closure.anisotropic_rotation = self(0.0, rotation_name, field="anisotropic_rotation", kind="float")
+        if closure.anisotropy == 0.0 and "anisotropy" not in self.varying:
+            self.varying.pop("anisotropic_rotation", None)
+            return
+        socket = find_input(self.node, "Tangent")
+        value = self.compiler.value(socket, "vector") if socket is not None and socket.is_linked else None
+        if value is None:
+            value = self.compiler.geometry_tangent()
+        self.varying["tangent"] = self.compiler.ref(value, "vector")
+
 
 def _weighted(closure, weight, inputs):
     """The closure with its (constant or varying) weight and varying inputs."""
@@ -90,7 +105,6 @@ def _principled(node, weight, issues, compiler):
     for feature, names in (
         ("Subsurface", ("Subsurface Weight", "Subsurface")),
         ("Sheen", ("Sheen Weight", "Sheen")),
-        ("Anisotropic", ("Anisotropic",)),
         ("Thin Film", ("Thin Film Thickness",)),
     ):
         if value(0.0, *names) > 0.0:
@@ -111,6 +125,7 @@ def _principled(node, weight, issues, compiler):
         diffuse_roughness=value(0.0, "Diffuse Roughness", field="diffuse_roughness", kind="float"),
         multiscatter=_multiscatter(node, issues),
     )
+    value.anisotropy(principled, "Anisotropic", "Anisotropic Rotation")
     _oren_nayar_version(node, principled, value, issues)
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
     value.normal()
@@ -139,8 +154,8 @@ def _bsdf(kind):
             closure.multiscatter = _multiscatter(node, issues)
         if kind in ("GLASS", "REFRACTION"):
             closure.ior = value(1.5, "IOR", field="ior", kind="float")
-        if kind == "GLOSSY" and value(0.0, "Anisotropy") > 0.0:
-            issues.add(f"'{node.name}' anisotropy")
+        if kind == "GLOSSY":
+            value.anisotropy(closure, "Anisotropy", "Rotation")
         if kind != "TRANSPARENT":
             value.normal()
         return [_weighted(closure, weight, value.varying)]
@@ -190,9 +205,8 @@ def _metallic(node, weight, issues, compiler):
     so a Principled closure of metallic 1; Physical Conductor's IOR and extinction go through their
     F82-tint fit (core.bsdf.microfacet.conductor_f82), named in the warning."""
     value = _Inputs(node, compiler, issues)
-    for feature, name in (("anisotropy", "Anisotropy"), ("thin film", "Thin Film Thickness")):
-        if value(0.0, name) > 0.0:
-            issues.add(f"'{node.name}' {feature}")
+    if value(0.0, "Thin Film Thickness") > 0.0:
+        issues.add(f"'{node.name}' thin film")
     if getattr(node, "fresnel_type", "F82") == "PHYSICAL_CONDUCTOR":
         color, tint = conductor_f82(rgb(value(np.ones(3), "IOR")), rgb(value(np.zeros(3), "Extinction")))
         issues.add(f"'{node.name}' Physical Conductor (rendered through the F82-tint fit of its IOR and extinction)")
@@ -202,6 +216,7 @@ def _metallic(node, weight, issues, compiler):
     closure = Closure("PRINCIPLED", color=color, metallic=1.0, specular_tint=tint,
                       roughness=value(0.5, "Roughness", field="roughness", kind="float"),
                       multiscatter=_multiscatter(node, issues))
+    value.anisotropy(closure, "Anisotropy", "Rotation")
     value.normal()
     return [_weighted(closure, weight, value.varying)]
 
@@ -240,11 +255,48 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     closures = [] if output is None else flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     displacement = None if output is None else _displacement(material, output, compiler, issues)
     unread_outputs(material.node_tree, output, issues)
-    varying = any(c.inputs for c in closures) or displacement is not None
+    _one_tangent(closures, issues)
+    aovs = aov_outputs(material.node_tree, compiler, None if layer is None else layer[1])
+    varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
-                     pass_index=material.pass_index,
+                     pass_index=material.pass_index, aovs=aovs,
                      transparent_shadow=bool(getattr(material, "use_transparent_shadow", True))),
             issues.message(f"Material '{material.name}'"))
+
+
+def _one_tangent(closures, issues) -> None:
+    """Name anisotropic closures whose tangents or rotations differ: a hit has one shading frame,
+    along the first one's tangent (core.shading.surface), which the others are rendered with."""
+    tangents = {(c.inputs["tangent"], c.inputs.get("anisotropic_rotation", c.anisotropic_rotation))
+                for c in closures if "tangent" in c.inputs}
+    if len(tangents) > 1:
+        issues.add("anisotropic shaders with different tangents or rotations (rendered with the first one's)")
+
+
+def aov_outputs(tree, compiler, view_layer) -> list:
+    """(AOV name, value) of each AOV Output node writing an AOV of the view layer, in the tree or its
+    node groups: its Color into a colour AOV, its Value into a value AOV (as Cycles' OutputAOVNode);
+    a node naming no AOV of the view layer writes nothing, as in Cycles."""
+    kinds = dict(view_layer_aovs(view_layer)) if view_layer is not None else {}
+    out = []
+    for node, groups in _aov_nodes(tree):
+        kind = kinds.get(node.aov_name)
+        if kind == "COLOR":
+            value = compiler.value(node.inputs["Color"], "color", groups)
+            out.append((node.aov_name, value if is_ref(value) else rgb(value)))
+        elif kind == "VALUE":
+            out.append((node.aov_name, compiler.value(node.inputs["Value"], "float", groups)))
+    return out
+
+
+def _aov_nodes(tree, groups=()):
+    """(AOV Output node, the group nodes it sits inside, outermost first) in ``tree`` and, at any
+    depth, the node groups it uses (each use of a group its own nodes, as Cycles inlines them)."""
+    for node in tree.nodes:
+        if node.bl_idname == "ShaderNodeOutputAOV":
+            yield node, list(groups)
+        elif node.bl_idname == "ShaderNodeGroup" and node.node_tree is not None and not node.mute:
+            yield from _aov_nodes(node.node_tree, groups + (node,))
 
 
 VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+ bumps it"
@@ -252,13 +304,10 @@ VERSION_BUMP = "this Blender's bump of the displacement: rendered as Cycles 4.5+
 
 def unread_outputs(tree, output, issues) -> None:
     """Name what Cycles renders from outside the Surface socket and DRT does not yet: a linked
-    Volume socket and AOV Output nodes."""
+    Volume socket."""
     volume = None if output is None else output.inputs.get("Volume")
     if volume is not None and volume.is_linked:
         issues.add(f"'{volume.links[0].from_node.name}' (a volume shader: volumes are not rendered yet)")
-    for node in tree.nodes:
-        if node.bl_idname == "ShaderNodeOutputAOV":
-            issues.add(f"'{node.name}' (AOV Output: shader AOVs are not written yet)")
 
 
 def _displacement(material, output, compiler, issues):

@@ -254,11 +254,12 @@ class Compiler:
         return self.op("math", (self.ref(1.0), a, self.ref(0.0)), operation="SUBTRACT"), 0
 
     # -- sockets ----------------------------------------------------------------------
-    def value(self, socket, kind=None):
-        """Constant or reference for an input socket, in ``kind`` ("float", "color", "vector")."""
+    def value(self, socket, kind=None, groups=None):
+        """Constant or reference for an input socket, in ``kind`` ("float", "color", "vector"); ``groups``:
+        the group nodes (outermost first) the socket's node sits inside, when not those being inlined."""
         kind = kind or _socket_kind(socket)
         default = _fit(_const(socket.default_value), kind) if hasattr(socket, "default_value") else None
-        source = follow(socket, self._groups)
+        source = follow(socket, self._groups if groups is None else groups)
         if source is None:
             return default
         node, output, stack = source
@@ -333,6 +334,14 @@ class Compiler:
 
     def _coord(self, name, uv_map=""):
         return self.program.add("coord", name=name, map=uv_map), 0
+
+    def geometry_tangent(self):
+        """Geometry's Tangent, what Cycles links to an unlinked Tangent socket (ShaderGraph's
+        default_inputs), one program node however many closures read it."""
+        key = "geometry tangent"
+        if key not in self._memo:
+            self._memo[key] = self._coord("tangent")
+        return self._memo[key]
 
     def _node_ShaderNodeTexCoord(self, node, output):
         name = output.identifier

@@ -13,11 +13,23 @@ from dataclasses import replace
 import numpy as np
 
 from ...core.scene import World
-from .materials import unread_outputs, uses_nodes
+from .materials import aov_outputs, unread_outputs, uses_nodes
 from .nodes import Issues, find_input, flatten, rgb
 from .shader_graph import Compiler, ImageTable, is_ref
 
 EMITTERS = ("ShaderNodeBackground", "ShaderNodeEmission")
+
+
+def _constant_aovs(tree, compiler, view_layer, issues) -> list:
+    """The world's AOV Output writes (export.materials.aov_outputs) of constant values; one fed by a
+    texture is named in the warning and not written."""
+    out = []
+    for name, value in aov_outputs(tree, compiler, view_layer):
+        if is_ref(value):
+            issues.add(f"AOV Output of '{name}' from a texture in a world (not written yet)")
+        else:
+            out.append((name, value))
+    return out
 
 
 def _visibility(world) -> dict:
@@ -30,15 +42,15 @@ MIST_FALLOFF = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}
 """Blender's mist falloff as the exponent Cycles raises the mist ramp to."""
 
 
-def export_world(world, warnings: list[str], images: ImageTable) -> World:
+def export_world(world, warnings: list[str], images: ImageTable, view_layer=None) -> World:
     if world is None:
         return World()
     mist = world.mist_settings
-    return replace(_background(world, warnings, images), mist_start=float(mist.start), mist_depth=float(mist.depth),
-                   mist_falloff=MIST_FALLOFF[mist.falloff])
+    return replace(_background(world, warnings, images, view_layer), mist_start=float(mist.start),
+                   mist_depth=float(mist.depth), mist_falloff=MIST_FALLOFF[mist.falloff])
 
 
-def _background(world, warnings: list[str], images: ImageTable) -> World:
+def _background(world, warnings: list[str], images: ImageTable, view_layer=None) -> World:
     if not uses_nodes(world):
         return World(radiance=world.color[:3])
     output = world.node_tree.get_output_node("CYCLES")
@@ -57,7 +69,7 @@ def _background(world, warnings: list[str], images: ImageTable) -> World:
 
     parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     unread_outputs(world.node_tree, output, issues)
-    visibility = _visibility(world)
+    visibility = dict(_visibility(world), aovs=_constant_aovs(world.node_tree, compiler, view_layer, issues))
     message = issues.message(f"World '{world.name}'")
     if message:
         warnings.append(message)

@@ -67,6 +67,19 @@ class Frame:
         t, b = orthonormal_basis(n)
         return cls(np.stack([t, b, n], axis=1))
 
+    @classmethod
+    def along(cls, n, tangent) -> "Frame":
+        """The frame about each unit row of ``n`` whose tangent is ``tangent`` made perpendicular
+        to it (Cycles' make_orthonormals_tangent: b = n x tangent normalised, t = b x n), the
+        frame of an anisotropic lobe; ``about``'s where the tangent is (nearly) along n or zero."""
+        b = np.cross(n, tangent)
+        length = norm(b)
+        ok = length > 1e-9
+        b = b / np.where(ok, length, 1.0)[:, None]
+        t = np.cross(b, n)
+        fallback = cls.about(n).m
+        return cls(np.where(ok[:, None, None], np.stack([t, b, n], axis=1), fallback))
+
     @property
     def t(self) -> np.ndarray:
         return self.m[:, 0]

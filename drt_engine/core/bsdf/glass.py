@@ -56,8 +56,8 @@ def glass_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     fr = mf.fresnel_dielectric1(c, eta)
     p_reflect = 0.0 if lp[l, P_REFRACT_ONLY] != 0.0 else fr
     if u_choice < p_reflect:  # the Fresnel factor cancels against the choice probability
-        g = masking(lp, lt, l, j, t, woz, rz)
+        g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz)
         return rx, ry, rz, hp[r, l, H_TINT_R] * g, hp[r, l, H_TINT_R + 1] * g, hp[r, l, H_TINT_R + 2] * g, rz > 0.0
     tx, ty, tz, ok = mf.refract(wox, woy, woz, hx, hy, hz, eta)
-    g = masking(lp, lt, l, j, t, woz, tz) / eta ** 2  # radiance scales by 1/eta² crossing
+    g = masking(lp, lt, l, j, t, wox, woy, woz, tx, ty, tz) / eta ** 2  # radiance scales by 1/eta² crossing
     return tx, ty, tz, hp[r, l, H_TINT_T] * g, hp[r, l, H_TINT_T + 1] * g, hp[r, l, H_TINT_T + 2] * g, ok and tz < 0.0

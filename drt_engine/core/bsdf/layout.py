@@ -35,7 +35,10 @@ P_WEIGHT = 22  # (3) constant weight
 P_A_AVG = 25  # (3) cosine averages of A and B (affine multiscatter)
 P_B_AVG = 28
 P_SIGMA = 31  # Oren-Nayar roughness sigma
-P = 32
+P_ANISO = 32  # 1: anisotropic GGX (reflect lobes), alpha_x along the frame's tangent, alpha_y along its bitangent
+P_ALPHA_X = 33
+P_ALPHA_Y = 34
+P = 35
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice

@@ -56,11 +56,31 @@ def ggx_g2(cos_o, cos_i, alpha):
 
 
 @kernel
-def sample_visible_normal(wx, wy, wz, alpha, u0, u1):
-    """Heitz 2018: a microfacet normal from the distribution of normals visible from w."""
+def ggx_d_aniso(hx, hy, hz, alpha_x, alpha_y):
+    """Anisotropic GGX D(h), roughness alpha_x along the frame's x and alpha_y along its y
+    (Cycles' bsdf_aniso_D); zero below the surface."""
+    if not hz > 0.0:
+        return 0.0
+    x, y = hx / alpha_x, hy / alpha_y
+    s = x * x + y * y + hz * hz
+    return 1.0 / (np.pi * alpha_x * alpha_y * max(s * s, TINY))
+
+
+@kernel
+def ggx_lambda_aniso(wx, wy, wz, alpha_x, alpha_y):
+    """Smith Lambda of anisotropic GGX toward w (either side): the isotropic form with
+    alpha² tan² replaced by (alpha_x² x² + alpha_y² y²) / z²."""
+    x, y = alpha_x * wx, alpha_y * wy
+    return 0.5 * (np.sqrt(1.0 + (x * x + y * y) / max(wz * wz, TINY)) - 1.0)
+
+
+@kernel
+def sample_visible_normal(wx, wy, wz, alpha_x, alpha_y, u0, u1):
+    """Heitz 2018: a microfacet normal from the distribution of normals visible from w
+    (anisotropic: the view stretched by alpha_x, alpha_y onto the hemisphere configuration)."""
     if wz < 0.0:
         wx, wy, wz = -wx, -wy, -wz
-    vx, vy, vz = unit(alpha * wx, alpha * wy, wz)
+    vx, vy, vz = unit(alpha_x * wx, alpha_y * wy, wz)
     lensq = vx * vx + vy * vy
     if lensq > 0.0:
         inv = 1.0 / np.sqrt(max(lensq, TINY))
@@ -78,7 +98,7 @@ def sample_visible_normal(wx, wy, wz, alpha, u0, u1):
     nx = p1 * t1x + p2 * t2x + p3 * vx
     ny = p1 * t1y + p2 * t2y + p3 * vy
     nz = p1 * t1z + p2 * t2z + p3 * vz
-    return unit(alpha * nx, alpha * ny, max(nz, 1e-12))
+    return unit(alpha_x * nx, alpha_y * ny, max(nz, 1e-12))
 
 
 @kernel
@@ -185,7 +205,7 @@ def _albedo_samples(mu, u, alpha, cos_oh, weight):
     for k in range(len(mu)):
         wx, wz = np.sqrt(1.0 - mu[k] * mu[k]), mu[k]
         for j in range(m):
-            hx, hy, hz = sample_visible_normal(wx, 0.0, wz, alpha, u[j, 0], u[j, 1])
+            hx, hy, hz = sample_visible_normal(wx, 0.0, wz, alpha, alpha, u[j, 0], u[j, 1])
             c = wx * hx + wz * hz
             i = k * m + j
             cos_oh[i] = c

@@ -2,6 +2,9 @@
 
 The reflected half of sampling (``reflected``: a microfacet normal and wo mirrored about it)
 and the masking weight are shared with glass, whose reflection is this lobe's.
+An anisotropic lobe (``P_ANISO``, Cycles' alpha_x along the shading frame's tangent, alpha_y
+along its bitangent) takes the anisotropic D and Lambda; an isotropic one today's isotropic
+arithmetic, so adding anisotropy changed no isotropic result.
 """
 from __future__ import annotations
 
@@ -9,8 +12,8 @@ from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_DELTA, P_ETA_F, P_F82, P_FRESNEL,
-                     P_KIND, T_WHITE)
+from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y, P_ANISO, P_DELTA,
+                     P_ETA_F, P_F82, P_FRESNEL, P_KIND, T_WHITE)
 from .tables import at
 
 
@@ -34,15 +37,23 @@ def reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
     alpha = lp[l, P_ALPHA]
     hx, hy, hz = vec.unit(wox + wix, woy + wiy, woz + wiz)
     cos_oh = min(max(wox * hx + woy * hy + woz * hz, 0.0), 1.0)
-    d = mf.ggx_d(hz, alpha)
-    c = d * mf.ggx_g2(woz, wiz, alpha) / (4.0 * max(woz, TINY))
+    if lp[l, P_ANISO] != 0.0:
+        ax, ay = lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y]
+        d = mf.ggx_d_aniso(hx, hy, hz, ax, ay)
+        lambda_o = mf.ggx_lambda_aniso(wox, woy, woz, ax, ay)
+        g2 = 1.0 / (1.0 + lambda_o + mf.ggx_lambda_aniso(wix, wiy, wiz, ax, ay))
+        g1 = 1.0 / (1.0 + lambda_o)
+    else:
+        d = mf.ggx_d(hz, alpha)
+        g2 = mf.ggx_g2(woz, wiz, alpha)
+        g1 = mf.ggx_g1(woz, alpha)
+    c = d * g2 / (4.0 * max(woz, TINY))
     f0, f1, f2 = fresnel(lp, hp, r, l, cos_oh)
-    return f0 * c, f1 * c, f2 * c, mf.ggx_g1(woz, alpha) * d / (4.0 * max(woz, TINY))
-
+    return f0 * c, f1 * c, f2 * c, g1 * d / (4.0 * max(woz, TINY))
 
 
 @kernel(inline="always")
-def masking(lp, lt, l, j, t, woz, wiz):
+def masking(lp, lt, l, j, t, wox, woy, woz, wix, wiy, wiz):
     """Sampling weight G2/G1 of visible-normal sampling toward wi.
 
     A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
@@ -52,6 +63,10 @@ def masking(lp, lt, l, j, t, woz, wiz):
     """
     alpha = lp[l, P_ALPHA]
     if lp[l, P_DELTA] == 0.0:
+        if lp[l, P_ANISO] != 0.0:
+            ax, ay = lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y]
+            lambda_o = mf.ggx_lambda_aniso(wox, woy, woz, ax, ay)
+            return (1.0 + lambda_o) / (1.0 + lambda_o + mf.ggx_lambda_aniso(wix, wiy, wiz, ax, ay))
         return mf.ggx_g2(woz, abs(wiz), alpha) / mf.ggx_g1(woz, alpha)
     if wiz > 0.0:
         return at(lt, l, T_WHITE, j, t)
@@ -65,8 +80,10 @@ def reflected(lp, l, wox, woy, woz, u0, u1):
     lobe, else sampled among the normals visible from wo."""
     if lp[l, P_DELTA] != 0.0:
         hx, hy, hz = 0.0, 0.0, 1.0
+    elif lp[l, P_ANISO] != 0.0:
+        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y], u0, u1)
     else:
-        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA], u0, u1)
+        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA], lp[l, P_ALPHA], u0, u1)
     c = wox * hx + woy * hy + woz * hz
     rx, ry, rz = 2.0 * c * hx - wox, 2.0 * c * hy - woy, 2.0 * c * hz - woz
     return hx, hy, hz, c, rx, ry, rz
@@ -77,5 +94,5 @@ def reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1):
     """Sample the lobe alone: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
     _, _, _, c, rx, ry, rz = reflected(lp, l, wox, woy, woz, u0, u1)
     f0, f1, f2 = fresnel(lp, hp, r, l, min(max(c, 0.0), 1.0))
-    g = masking(lp, lt, l, j, t, woz, rz)
+    g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz)
     return rx, ry, rz, f0 * g, f1 * g, f2 * g, rz > 0.0

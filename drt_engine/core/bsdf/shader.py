@@ -58,6 +58,7 @@ class Lobe:
     source: int = 0  # index of the closure the lobe comes from
     role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent" | "translucent"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
+    alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
 
     @property
     def delta(self) -> bool:
@@ -72,6 +73,11 @@ class Lobe:
         if self.kind == "glass" and self.alpha_t < mf.DELTA_ALPHA:
             return True
         return self.kind in ("reflect", "glass") and self.alpha < mf.DELTA_ALPHA
+
+    @property
+    def anisotropic(self) -> bool:
+        """An anisotropic GGX lobe (a delta lobe is sampled as a mirror whatever its alphas)."""
+        return self.alpha_xy is not None and not self.delta
 
     @property
     def diffuse(self) -> bool:
@@ -89,6 +95,31 @@ DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent")
 
 def _alpha(roughness: float) -> float:
     return float(np.clip(roughness, 0.0, 1.0)) ** 2
+
+
+def anisotropic_alphas(kind: str, roughness: float, anisotropy: float) -> tuple | None:
+    """(alpha_x, alpha_y) as Cycles' svm_node_closure_bsdf sets them, None when isotropic.
+
+    Principled (and the Metallic BSDF): Anisotropic clamped to [0, 1], aspect sqrt(1 - 0.9 a),
+    alpha_x = r² / aspect, alpha_y = r² aspect. Glossy: Anisotropy clamped to [-0.99, 0.99], isotropic
+    within 1e-4 of 0, alpha_x = r² (1 - a), alpha_y = r² / (1 - a) (for a < 0: r² / (1 + a), r² (1 + a)).
+    Either way sqrt(alpha_x alpha_y) = r², the alpha Cycles' albedo tables are read at, so the
+    lobe's tables are the isotropic ones of its roughness."""
+    alpha = _alpha(roughness)
+    if not np.isfinite(anisotropy):
+        return None
+    if kind == "PRINCIPLED":
+        a = float(np.clip(anisotropy, 0.0, 1.0))
+        if not a > 0.0:
+            return None
+        aspect = np.sqrt(1.0 - 0.9 * a)
+        return alpha / aspect, alpha * aspect
+    a = float(np.clip(anisotropy, -0.99, 0.99))
+    if abs(a) <= 1e-4:
+        return None
+    if a < 0.0:
+        return alpha / (1.0 + a), alpha * (1.0 + a)
+    return alpha * (1.0 - a), alpha / (1.0 - a)
 
 
 def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
@@ -296,6 +327,7 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
         metal = _reflect_lobe(w * metallic, alpha, _f82_fresnel(base, f82), base_layers, c.multiscatter, tables,
                               _key("f82", base, f82), table=table, fresnel_kind=layout.F_F82, f0=base)
         metal.role, metal.f82 = "metal", f82
+        metal.alpha_xy = anisotropic_alphas("PRINCIPLED", c.roughness, c.anisotropy)
         lobes.append(metal)
     dielectric = 1.0 - metallic
     ior = max(float(c.ior), 1e-5)  # IOR below 1 is a valid medium (a bubble), as in Cycles
@@ -314,6 +346,7 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
                                  c.multiscatter, tables, _key("dielectric", eta, np.ones(3)), spec_tint,
                                  fresnel_kind=layout.F_DIELECTRIC, fresnel_eta=eta)
             spec.role = "spec"
+            spec.alpha_xy = anisotropic_alphas("PRINCIPLED", c.roughness, c.anisotropy)
             lobes.append(spec)
             diffuse_layers.append(_layer_under(spec))
         lobes.append(_diffuse_lobe(w * opaque, base, c.diffuse_roughness, diffuse_layers))
@@ -348,6 +381,7 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
             new = [_reflect_lobe(c.weight, _alpha(c.roughness), lambda x: np.ones((len(x), 3)),
                                  multiscatter=c.multiscatter, tables=tables, key=("unit rgb",), tint=tint)]
             new[0].role = "glossy"
+            new[0].alpha_xy = anisotropic_alphas("GLOSSY", c.roughness, c.anisotropy)
         elif c.kind in ("GLASS", "REFRACTION"):
             tint = np.clip(c.color, 0, 1)
             new = [Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1e-5),
@@ -388,6 +422,9 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_ALPHA], row[layout.P_ALPHA_T], row[layout.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
         row[layout.P_REFRACT_ONLY] = lobe.refract_only
         row[layout.P_SIGMA] = lobe.sigma
+        if lobe.anisotropic:
+            row[layout.P_ANISO] = 1.0
+            row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
         row[layout.P_FRESNEL], row[layout.P_ETA_F] = lobe.fresnel_kind, lobe.fresnel_eta
         row[layout.P_F82:layout.P_F82 + 3] = 1.0 if lobe.f82 is None else lobe.f82
         row[layout.P_LAYERS] = len(lobe.layers)

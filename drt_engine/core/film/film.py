@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..settings import FIRST_SAMPLE_PASSES, PASS_CHANNELS
+from ..settings import FIRST_SAMPLE_PASSES, pass_channels
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 
 _TABLE = 1024
@@ -185,15 +185,17 @@ class Film:
     (core.integrator.ratio), and Combined is read resolved: its diffuse direct part of the lights
     with a closed form is U N / D. The passes ``halved`` are also summed over class A (``sums_a``):
     a denoiser guided by them denoises each half with its own half's features (core.render.denoise).
+    ``aovs``: the shader AOVs among the passes (``RenderSettings.aovs``).
     """
 
     def __init__(self, width: int, height: int, passes: tuple[str, ...], track_range: bool = False,
-                 ratio: bool = False, halved: tuple[str, ...] = ()):
+                 ratio: bool = False, halved: tuple[str, ...] = (), aovs: tuple = ()):
         self.width, self.height = width, height
         self.n = width * height
         self.passes = passes
+        self.channels = {name: len(pass_channels(name, aovs)) for name in passes}
         self.count = np.zeros(self.n)
-        self.sums = {name: np.zeros((self.n, len(PASS_CHANNELS[name])))
+        self.sums = {name: np.zeros((self.n, self.channels[name]))
                      for name in passes if name not in ("Sample Count", "Noise")}
         if ratio:
             self.sums[RATIO] = np.zeros((self.n, FILM_CHANNELS))
@@ -286,7 +288,7 @@ class Film:
         """
         out = {}
         for name in self.passes if names is None else [n for n in self.passes if n in names]:
-            img = np.empty((self.n, len(PASS_CHANNELS[name])), np.float32)
+            img = np.empty((self.n, self.channels[name]), np.float32)
             for span in self.blocks():
                 img[span] = self._pass_block(name, span)
             out[name] = img.reshape(self.height, self.width, -1)

@@ -69,6 +69,7 @@ def compared_settings(settings: RenderSettings) -> dict:
     for name in _NOT_COMPARED:
         values.pop(name, None)
     values["passes"] = list(values["passes"])
+    values["aovs"] = [list(aov) for aov in values["aovs"]]
     return values
 
 

@@ -32,8 +32,10 @@ from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
+from ..settings import AOV_CHANNELS
 from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
+from .aovs import ShaderAOVs, reach_scale
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_hits
@@ -89,7 +91,11 @@ class WaveOutput:
     alpha: np.ndarray
     aux: dict
     features: Features | None = None  # the denoising features' walks, when those passes are on
-    indexed: np.ndarray | None = None  # per path: its index passes are final (an opaque enough hit was seen)
+    # per path: its index passes and shader AOVs are final (an opaque enough hit was seen)
+    indexed: np.ndarray | None = None
+    # per path, with shader AOVs: the share of Cycles' samples that reach its next hit over its
+    # throughput's (core.integrator.aovs)
+    aov_reach: np.ndarray | None = None
     ratio: RatioEstimator | None = None
 
     def values(self, clamp: float) -> dict:
@@ -129,6 +135,9 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
+        aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
+            else None
+        self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
         # transparent shadows when some material lets shadow rays through (the plan lists them)
         self.shadows = None
@@ -158,15 +167,18 @@ class Integrator:
         state, cam = self._camera_rays(samples, sampler)
         times = self.geometry.ray_times(state.time)  # each camera sample's shutter time, down its path
         n = len(state)
-        out = WaveOutput(np.zeros((n, 3)), np.ones(n), {name: np.zeros((n, len(ch))) for name, ch in _AUX
-                                                        if name in s.passes},
+        aux = {name: np.zeros((n, len(ch))) for name, ch in _AUX if name in s.passes}
+        aux.update((name, np.zeros((n, len(AOV_CHANNELS[kind])))) for name, kind in s.aovs)
+        out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
             out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
-        if "IndexOB" in out.aux or "IndexMA" in out.aux:
+        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None:
             out.indexed = np.zeros(n, bool)
+        if self.aovs is not None:
+            out.aov_reach = np.ones(n)
         if "Denoising Albedo" in out.aux or "Denoising Normal" in out.aux:
             out.features = Features(n, self.camera, out.aux, s.weighted_denoising_normal)
         if not cam.valid.all():  # no ray outside a fisheye's circle: black and opaque, as Cycles leaves it
@@ -199,6 +211,8 @@ class Integrator:
             self._emission_seen(surf, state, hits, out)
             if depth == 0:
                 self._first_hit_passes(surf, cam, hits.t[rows], out)
+            if self.aovs is not None:
+                self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
@@ -265,7 +279,7 @@ class Integrator:
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
 
     def _escaped(self, rays: PathState, out: WaveOutput):
-        """Escaped rays see the world (and, after a bounce, the suns)."""
+        """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
         if len(rays) == 0:
             return
         lights = self.lights
@@ -273,6 +287,9 @@ class Integrator:
         path = None if rays.bounces is None else RayPath(st, rays.bounces, np.full(len(rays), BACKGROUND_LENGTH),
                                                          emission=True)
         world = lights.world_radiance(rays.dirs, st, rays.prev_normal, path)
+        if self.aovs is not None and self.aovs.world:
+            seen = np.flatnonzero(st & ~out.indexed[rays.path])
+            self.aovs.write_world(rays.path[seen], rays.throughput[seen], out.aux, out.aov_reach[rays.path[seen]])
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
         if self.film_transparent:
@@ -354,7 +371,19 @@ class Integrator:
                 out.aux["IndexOB"][path, 0] = self.object_index[self.geometry.source_of(group.prim[rows])[:, 0]]
             if "IndexMA" in out.aux:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
+            if out.aov_reach is not None:
+                out.aov_reach[path] *= reach_scale(shader, group, rows)
             out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
+
+    def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput):
+        """The materials' AOV Output nodes at the hits the camera sees directly or through
+        transparency, before the data passes close their paths (core.integrator.aovs)."""
+        seen = surf.take(np.flatnonzero(surf.straight & ~out.indexed[surf.path]))
+        if len(seen) == 0:
+            return
+        for g in _material_slices(seen.mat):
+            group = seen.take(g)
+            self.aovs.write(group, lambda: self._context(group, hits), out.aux, out.aov_reach[group.path])
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
@@ -394,30 +423,34 @@ class Integrator:
         """(rows of ``surf``, those hits, shader) per material: a slice of the hits (sorted by
         material) for a constant material, index arrays of hits sharing one bound shader for a
         material with varying inputs (see core.shading); a program's normal replaces the shading
-        normal and frame of its hits in the records it yields. ``shadow``: shadow rays reached
-        the hits (Light Path's Is Shadow Ray)."""
-        starts = np.concatenate([[0], np.flatnonzero(np.diff(surf.mat)) + 1])
-        for a, b in zip(starts, np.append(starts[1:], len(surf.mat))):
-            g = slice(int(a), int(b))  # the hits of material mat[a]
+        normal and frame of its hits in the records it yields, an anisotropic material's tangent
+        the frame's tangent. ``shadow``: shadow rays reached the hits (Light Path's Is Shadow Ray)."""
+        for g in _material_slices(surf.mat):
             group = surf.take(g)
-            shading = self.prepared.shading[surf.mat[a]]
+            shading = self.prepared.shading[surf.mat[g.start]]
             if not shading.varying:
                 yield g, group, shading.shader
                 continue
-            hu, hv = hits.u[group.row], hits.v[group.row]
-            bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
-            width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
-            ctx = SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
-                                 self._ray_path(group, hits, shadow=shadow))
-            groups, normal = shading.bind(ctx)
-            if normal is not None:
-                ng, wo = group.ng, group.wo
-                ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, group.ns)
-                ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
-                frame = Frame.about(ns)
+            groups, normal, tangent = shading.bind(self._context(group, hits, shadow))
+            if normal is not None or tangent is not None:
+                ns, wo = group.ns, group.wo
+                if normal is not None:
+                    ng = group.ng
+                    ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, ns)
+                    ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
+                frame = Frame.about(ns) if tangent is None else Frame.along(ns, tangent)
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
-                yield a + sub, group.take(sub), shader
+                yield g.start + sub, group.take(sub), shader
+
+    def _context(self, group: SurfaceHits, hits, shadow: bool = False) -> SurfaceContext:
+        """The hits ``group`` as shader programs read them (core.shading.surface); ``shadow``:
+        shadow rays reached them."""
+        hu, hv = hits.u[group.row], hits.v[group.row]
+        bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
+        width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
+        return SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
+                              self._ray_path(group, hits, shadow=shadow))
 
     @staticmethod
     def _ray_path(group: SurfaceHits, hits, rows=slice(None), shadow=False) -> RayPath | None:
@@ -505,6 +538,12 @@ class Integrator:
                          throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin)
+
+
+def _material_slices(mat):
+    """The slices of hits sorted by material (``mat``) that share one material."""
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(mat)) + 1])
+    return [slice(int(a), int(b)) for a, b in zip(starts, np.append(starts[1:], len(mat)))]
 
 
 def _c(a):

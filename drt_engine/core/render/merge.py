@@ -13,7 +13,7 @@ import numpy as np
 
 from ..film import parts as parts_mod
 from ..film.film import Film
-from ..settings import PASS_CHANNELS
+from ..settings import pass_channels
 from .denoise import denoise_film, denoised_passes, figures
 from .report import ErrorLog, report_dict
 
@@ -37,7 +37,8 @@ class Merger:
         if self.first is None:
             self.first = part
             self.film = Film(part.width, part.height, tuple(part.header["passes"]),
-                             ratio=parts_mod.RATIO in part.header["channels"], halved=tuple(part.header["halved"]))
+                             ratio=parts_mod.RATIO in part.header["channels"], halved=tuple(part.header["halved"]),
+                             aovs=part.settings().aovs)
         else:
             parts_mod.check_same(self.first, part, "the first part", name)
         if part.sample_range not in self.ranges:
@@ -115,12 +116,12 @@ def merge_parts(parts: list[parts_mod.Part], names: list[str]) -> Merger:
     return merger
 
 
-def write_exr(path, images: dict, view_layer: str) -> None:
+def write_exr(path, images: dict, view_layer: str, aovs=()) -> None:
     """Every pass of ``images`` ((h, w, channels), rows from the bottom) as Blender's multilayer EXR
-    names it (``layer.pass.channel``), float32, top row first."""
+    names it (``layer.pass.channel``), float32, top row first; ``aovs``: the shader AOVs among them."""
     import OpenImageIO as oiio
 
-    names = [f"{view_layer}.{name}.{c}" for name in images for c in PASS_CHANNELS[name]]
+    names = [f"{view_layer}.{name}.{c}" for name in images for c in pass_channels(name, aovs)]
     pixels = np.concatenate([image[::-1] for image in images.values()], axis=2)
     spec = oiio.ImageSpec(pixels.shape[1], pixels.shape[0], len(names), oiio.FLOAT)
     spec.channelnames = tuple(names)

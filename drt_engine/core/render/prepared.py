@@ -134,8 +134,9 @@ class PreparedScene:
         self.lit = np.array([bool(sh.lobes) or m.varying for sh, m in zip(self.shaders, self.shading)] + [False])
         self.continues = np.array([sh.can_continue or m.varying for sh, m in zip(self.shaders, self.shading)]
                                   + [False])
-        varying = any(s.varying for s in self.shading)
-        self.attributes = SurfaceAttributes(self.scene, self.geometry) if varying else None
+        # what shader programs read at hits: a varying material's, or the AOVs' of any with a program
+        programs = any(s.material.program is not None for s in self.shading)
+        self.attributes = SurfaceAttributes(self.scene, self.geometry) if programs else None
 
     def _lights_done(self) -> None:
         self.lights = Lights(self.scene, self.geometry, self.shading, self.textures)

@@ -17,6 +17,7 @@ from ..base import jit
 from ..errors import SceneError, SettingsError
 from ..film.denoising import PASSES as FEATURE_PASSES, with_features
 from ..film.film import Film
+from ..integrator.aovs import AOV_TRANSPARENCY
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
@@ -83,7 +84,7 @@ class Renderer:
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
-                         halved=FEATURE_PASSES if settings.use_denoising else ())
+                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs)
 
     @property
     def rays(self) -> dict:
@@ -91,7 +92,15 @@ class Renderer:
 
     @property
     def warnings(self) -> list:
-        return self.prepared.warnings
+        return self.prepared.warnings + self._setting_warnings()
+
+    def _setting_warnings(self) -> list[str]:
+        """What these settings make DRT approximate in this scene: shader AOVs behind transparency
+        (core.integrator.aovs)."""
+        if self.integrator.aovs is not None and any(c.kind == "TRANSPARENT" for m in self.scene.materials
+                                                    for c in m.closures):
+            return [AOV_TRANSPARENCY]
+        return []
 
     def render(self, progress=None) -> RenderResult:
         """Render progressively (core.render.driver) and return the passes, stats and error log."""

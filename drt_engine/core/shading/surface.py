@@ -24,7 +24,9 @@ from .nodes import Evaluator
 from .textures import Texture
 
 LINEAR_INPUTS = ("weight", "color")
-"""Inputs that enter the lobes per hit; the others key a cached shader."""
+"""Inputs that enter the lobes per hit; the others key a cached shader, but for ``PER_HIT_INPUTS``."""
+PER_HIT_INPUTS = ("normal", "emission", "tangent", "anisotropic_rotation")
+"""Inputs read per hit outside the lobes: the shading frame's normal and tangent, emission."""
 QUANTUM = 256.0
 MIN_QUANTUM = 8.0
 MAX_GROUPS = 64
@@ -408,6 +410,9 @@ class MaterialShading:
         self.displaced = material.program is not None and material.displacement is not None
         self.varying = material.program is not None and (any(c.inputs for c in material.closures) or self.displaced)
         self.normal_ref = next((c.inputs["normal"] for c in material.closures if "normal" in c.inputs), None)
+        self.tangent_of = next((c for c in material.closures if "tangent" in c.inputs), None)
+        """The anisotropic closure whose tangent, turned about the normal, the hits' shading frame
+        takes (export names any other anisotropic closure whose tangent differs)."""
         self.emitters = [c for c in material.closures if c.kind in ("EMISSION", "PRINCIPLED")
                          and ("emission" in c.inputs or ("weight" in c.inputs and np.any(c.emission > 0)))]
         self.varying_emission = material.program is not None and bool(self.emitters)
@@ -437,18 +442,26 @@ class MaterialShading:
             total += w * e
         return total
 
+    def outputs(self, ctx: SurfaceContext, refs) -> list:
+        """The program outputs ``refs`` at the hits of ``ctx``, after the displacement's bump (as the
+        closures' inputs see them)."""
+        ev = Evaluator(self.material.program, self._displaced(ctx), self.textures)
+        return [ev(ref) for ref in refs]
+
     def bind(self, ctx: SurfaceContext):
-        """[(hit indices, shader bound to them)] and the per-hit shading normal (or None)."""
+        """[(hit indices, shader bound to them)], the per-hit shading normal (or None) and the
+        per-hit tangent of an anisotropic material (or None; ``tangent``)."""
         if not self.varying:
-            return [(np.arange(ctx.n), self.shader)], None
+            return [(np.arange(ctx.n), self.shader)], None, None
         ctx = self._displaced(ctx)
         ev = Evaluator(self.material.program, ctx, self.textures)
         normal = ev(self.normal_ref) if self.normal_ref is not None else ctx.normal if self.displaced else None
+        tangent = None if self.tangent_of is None else self.tangent(ev, ctx.normal if normal is None else normal)
         linear = {}
         keyed = []
         for i, c in enumerate(self.material.closures):
             for name, ref in c.inputs.items():
-                if name in ("normal", "emission"):
+                if name in PER_HIT_INPUTS:
                     continue
                 value = np.asarray(ev(ref), float)
                 if name in LINEAR_INPUTS:
@@ -467,7 +480,21 @@ class MaterialShading:
             shader = self._shader_for(key, keyed, linear)
             values = {i: {name: v[rows] for name, v in d.items()} for i, d in linear.items()}
             out.append((rows, shader.bind(values) if values else shader))
-        return out, normal
+        return out, normal, tangent
+
+    def tangent(self, ev, normal):
+        """(N, 3) world tangents of the anisotropic closure: its Tangent input turned about the
+        normal by its rotation (turns), as Cycles' rotate_around_axis (Rodrigues' formula)."""
+        c = self.tangent_of
+        t = np.asarray(ev(c.inputs["tangent"]), float)
+        turns = ev(c.inputs["anisotropic_rotation"]) if "anisotropic_rotation" in c.inputs else c.anisotropic_rotation
+        turns = np.broadcast_to(np.asarray(turns, float).reshape(-1), (len(t),))
+        if not np.any(turns != 0.0):
+            return t
+        n = vec.normalize(np.asarray(normal, float), 1e-300)
+        angle = (2.0 * np.pi * turns)[:, None]
+        cos, sin = np.cos(angle), np.sin(angle)
+        return t * cos + np.cross(n, t) * sin + n * vec.dot(n, t)[:, None] * (1.0 - cos)
 
     def _displaced(self, ctx: SurfaceContext) -> SurfaceContext:
         """The hits with their normal bumped by the material's displacement, as Cycles evaluates
