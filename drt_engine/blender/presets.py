@@ -4,10 +4,12 @@ import bpy
 
 PRESETS = {
     "DIRECT": ("Direct light (DRT)", "Diffuse surfaces take direct light only: the classic image",
-               {"max_depth": 8, "diffuse_bounces": 0, "min_light_bounces": 0, "min_transparent_bounces": 0}),
+               {"max_depth": 8, "diffuse_bounces": 0, "min_light_bounces": 0, "min_transparent_bounces": 0,
+                "max_transparent_bounces": 8}),
     "FULL_GI": ("Full global illumination", "Light bounces off every surface, paths ended by Russian "
                 "roulette (Cycles' preset of that name)",
-                {"max_depth": 128, "diffuse_bounces": 128, "min_light_bounces": 3, "min_transparent_bounces": 8}),
+                {"max_depth": 128, "diffuse_bounces": 128, "min_light_bounces": 3, "min_transparent_bounces": 8,
+                 "max_transparent_bounces": 128}),
 }
 
 

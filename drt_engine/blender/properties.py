@@ -99,6 +99,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         diffuse_bounces=drt.diffuse_bounces,
         min_light_bounces=drt.min_light_bounces,
         min_transparent_bounces=drt.min_transparent_bounces,
+        max_transparent_bounces=drt.max_transparent_bounces,
         clamp=drt.clamp,
         threads=drt.threads,
         filter_type=drt.filter_type,
@@ -191,6 +192,9 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     min_transparent_bounces: IntProperty(**_bounces(
         "Min Transparent Bounces", "Transparent bounces before Russian roulette may end a path (Cycles' Min "
         "Transparent Bounces); only with diffuse bounces"))
+    max_transparent_bounces: IntProperty(**_bounces(
+        "Transparent", "Transparent surfaces a shadow ray may pass through, counted on from its path's "
+        "transparent bounces; one more blocks it (Cycles' Max Transparent Bounces)", default=8))
     clamp: FloatProperty(
         name="Clamp",
         description="Largest radiance one sample may contribute, to tame fireflies at the "

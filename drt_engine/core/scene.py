@@ -97,6 +97,9 @@ class Material:
     """What its AOV Output nodes write into the render's shader AOVs (core.integrator.aovs): (AOV
     name, value), the value RGB (3,) for a colour AOV, a float for a value AOV, or an output
     ``(node, socket)`` of ``program``."""
+    transparent_shadow: bool = True
+    """Shadow rays may pass it where it is transparent (Blender's Transparent Shadows, read by
+    Cycles): off, its surfaces block them."""
 
     @property
     def emission(self) -> np.ndarray:

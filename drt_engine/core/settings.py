@@ -84,6 +84,9 @@ class RenderSettings:
     # them (only with diffuse bounces; core.integrator.continuation.roulette)
     min_light_bounces: int = 0
     min_transparent_bounces: int = 0
+    # Cycles' Max Transparent Bounces: transparent surfaces a shadow ray goes through, counted on
+    # from its path's own transparent bounces; one more blocks it (core.integrator.shadows)
+    max_transparent_bounces: int = 8
     clamp: float = 0.0
     threads: int = 0
     filter_type: str = "BLACKMAN_HARRIS"
@@ -130,7 +133,7 @@ class RenderSettings:
         if self.denoising_quality not in DENOISING_QUALITIES:
             raise SettingsError(f"unknown denoising quality {self.denoising_quality!r} "
                                 f"(one of {', '.join(DENOISING_QUALITIES)})")
-        for name in ("diffuse_bounces", "min_light_bounces", "min_transparent_bounces"):
+        for name in ("diffuse_bounces", "min_light_bounces", "min_transparent_bounces", "max_transparent_bounces"):
             if getattr(self, name) < 0:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
         if self.samples < 1:

@@ -259,7 +259,8 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     aovs = aov_outputs(material.node_tree, compiler, None if layer is None else layer[1])
     varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
-                     pass_index=material.pass_index, aovs=aovs),
+                     pass_index=material.pass_index, aovs=aovs,
+                     transparent_shadow=bool(getattr(material, "use_transparent_shadow", True))),
             issues.message(f"Material '{material.name}'"))
 
 

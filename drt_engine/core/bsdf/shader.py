@@ -396,6 +396,14 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     return lobes
 
 
+def see_through(material: Material) -> bool:
+    """Whether shadow rays may pass the material (Cycles' SD_HAS_TRANSPARENT_SHADOW): its
+    Transparent Shadows are on and it has a Transparent closure of some weight, constant or
+    computed by its program (a Principled Alpha, a mix, a texture)."""
+    weighted = [bool(c.inputs) or bool(np.any(c.weight > 0)) for c in material.closures if c.kind == "TRANSPARENT"]
+    return material.transparent_shadow and any(weighted)
+
+
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
           "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR}
 

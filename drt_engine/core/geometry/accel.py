@@ -282,6 +282,10 @@ class Geometry:
     def material_of(self, prim: np.ndarray) -> np.ndarray:
         return self._tri_material[self.locate(prim)[1]]
 
+    def of_triangles(self, per_material: np.ndarray) -> np.ndarray:
+        """A value per material as one per row of the mesh triangle tables (what kernels index)."""
+        return np.ascontiguousarray(per_material[self._tri_material])
+
     def materials_used(self) -> np.ndarray:
         """The materials of the triangles rays can hit, each once."""
         return np.unique(self._tri_material)

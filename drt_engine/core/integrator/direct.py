@@ -18,6 +18,7 @@ from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import UNRESTRICTED
 from .bounces import diffuse_bits
 from .mis import power
+from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
 TERMINATOR_CUTOFF = 0.1
 """Cosine below which shadow rays leave from the smooth surface (Cycles' default shadow
@@ -73,8 +74,9 @@ def unlit_parts(restrict, k):
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
                  diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center,
-                 times, radiance, f_diff, visibility):
-    """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays traced.
+                 times, radiance, f_diff, visibility, clear, allowed, qf, qi):
+    """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
+    traced and the rows queued.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
@@ -90,13 +92,18 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     (``restrict``). ``times``: each hit's shutter time (empty when nothing moves).
     ``f_diff`` and ``visibility`` (strategy by hit) are filled when they have rows (the ratio
     estimator reads them): the diffuse part toward each sample and what became of its ray.
+    With transparent shadows (``clear``, per mesh triangle row: its material can be transparent;
+    empty: none can, and shadow rays are occlusion queries), a ray stopped by such a surface is
+    queued in (``qf``, ``qi``) with its contribution, if hit j's rays may pass ``allowed[j]`` > 0
+    surfaces (core.integrator.shadows).
     """
     rayhit = embree.new_rayhit()
     scratch = np.empty((2, 3, 4))
     sel_nd = np.empty((1, max(n_sampled, 1)))
     sel_all = np.empty((1, max(lp.shape[0], 1)))
     keep = f_diff.shape[1] > 0
-    traced = 0
+    see_through = len(clear) > 0
+    traced = queued = 0
     for j in range(len(pos)):
         bits = diffuse_bits(bounces, j, diffuse_limit)
         sel = sel_nd if bits == 0 else sel_all
@@ -139,7 +146,16 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
                                      pos[j, 2] + wz * dist[k, j] - oz)
                 tmax = max(d * (1.0 - 1e-6) - stop[k, j], 0.0)
             traced += 1
-            hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time)
+            if see_through:
+                what, hit, t, hu, hv = first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, wx, wy, wz,
+                                                     tmax, time)
+                hidden = what != OPEN
+                if what == SEE_THROUGH and allowed[j] > 0:
+                    enqueue(qf, qi, queued, c0, c1, c2, ox, oy, oz, wx, wy, wz, tmax, time, hu, hv, t, path[j], hit,
+                            j, 0, allowed[j])
+                    queued += 1
+            else:
+                hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time)
             if keep:
                 visibility[k, j] = BLOCKED if hidden else VISIBLE
             # area lights are not geometry: a nearer area light does not block (lights cast shadows
@@ -152,4 +168,4 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
         radiance[p, 0] += s0
         radiance[p, 1] += s1
         radiance[p, 2] += s2
-    return traced
+    return traced, queued

@@ -24,6 +24,7 @@ import numpy as np
 from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.vectors import Frame
+from ..bsdf.shader import see_through
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
@@ -40,11 +41,13 @@ from .direct import direct_light
 from .hits import surface_hits
 from .mis import add_emitted
 from .ratio import RatioEstimator
-from .records import PathState, Samples, SurfaceHits
+from .records import PathState, Samples, ShadowRays, SurfaceHits
+from .shadows import TransparentShadows, limits, new_queue, stopped
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _NO_BOUNCES = camera_bounces(0)  # the kernels' bounces when paths carry none
 _NO_ROULETTE = np.full(2, -1, np.int64)
+_NOTHING_CLEAR, _NO_LIMITS = np.zeros(0, bool), np.zeros(0, np.int64)  # the kernels' transparent shadows when off
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
         ("IndexOB", "X"), ("IndexMA", "X"))
@@ -136,9 +139,14 @@ class Integrator:
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
-        # paths carry their ray kind and depths only for a scene whose shader programs read them
-        # or with diffuse bounces (which count them)
-        self.carried = self.light_path or self.diffuse > 0
+        # transparent shadows when some material lets shadow rays through (the plan lists them)
+        self.shadows = None
+        if plan.see_through:
+            clear = self.geometry.of_triangles(np.array([see_through(m) for m in scene.materials]))
+            self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count)
+        # paths carry their ray kind and depths only for a scene whose shader programs read them,
+        # with diffuse bounces or with transparent shadows (which count them)
+        self.carried = self.light_path or self.diffuse > 0 or self.shadows is not None
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
         self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)
@@ -207,10 +215,10 @@ class Integrator:
                 self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
-            bound = list(self._bind_materials(surf, u, hits))
+            bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
             lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
             light, start = self._sample_lights(lit) if lit else None, 0
-            continued = []
+            continued, queued = [], []
             for group, u_g, shader in bound:
                 if depth == 0:
                     self._colors(group, shader, out)
@@ -220,13 +228,17 @@ class Integrator:
                     self._data_passes(group, shader, out)
                 if light is not None and shader.lobes:
                     # no ray leaves the last depth: its light is light sampling's alone
-                    self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out,
-                                 depth < s.max_depth)
+                    queue = self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out,
+                                         depth < s.max_depth)
+                    if queue is not None:
+                        queued.append(queue)
                     start += len(group)
                 if (shader.can_continue or (self.diffuse and shader.lobes)) and depth < s.max_depth:
-                    nxt = self._continue(shader, group, u_g)
+                    nxt = self._continue(shader, group, u_g, state)
                     if nxt is not None:
                         continued.append(nxt)
+            if queued:
+                self.shadows.resolve(ShadowRays.concat(queued), out.radiance, self.timed)
             if not continued:
                 break
             state = PathState.concat(continued)
@@ -249,7 +261,8 @@ class Integrator:
         state = PathState(path=np.arange(n), origins=cam.origins, dirs=cam.directions, tmax=cam.tmax,
                           throughput=np.ones((n, 3)), prev_pdf=np.full(n, np.inf), prev_normal=np.zeros((n, 3)),
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
-                          bounces=camera_bounces(n) if self.carried else None)
+                          bounces=camera_bounces(n) if self.carried else None,
+                          mis_origin=cam.origins if self.shadows is not None else None)
         return state, cam
 
     # -- what rays see ----------------------------------------------------------------
@@ -260,8 +273,8 @@ class Integrator:
             return
 
         def light_pdf(smooth):  # each ray's own light, in one call
-            return self.lights.pdf(light_id[smooth], rays.origins[smooth], rays.dirs[smooth], t[smooth],
-                                   rays.time[smooth])
+            origins, dist = rays.mis_ray(smooth, t[smooth])
+            return self.lights.pdf(light_id[smooth], origins, rays.dirs[smooth], dist, rays.time[smooth])
 
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
 
@@ -318,9 +331,13 @@ class Integrator:
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
                                              self._ray_path(surf, hits, glowing))
-        e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit],
-                         lambda smooth: self.lights.pdf_emissive(prim[smooth], state.origins[hit[smooth]],
-                                                                 state.dirs[hit[smooth]], hits.t[hit[smooth]]))
+
+        def emissive_pdf(smooth):
+            rows = hit[smooth]
+            origins, dist = state.mis_ray(rows, hits.t[rows])
+            return self.lights.pdf_emissive(prim[smooth], origins, state.dirs[rows], dist)
+
+        e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit], emissive_pdf)
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
@@ -402,19 +419,19 @@ class Integrator:
             sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
         return StepSamples(light, path)
 
-    def _bind_materials(self, surf: SurfaceHits, u: StepSamples, hits):
-        """(hits, their samples, shader) per material: a slice of
-        the hits (sorted by material) for a constant material, index arrays of hits sharing one
-        bound shader for a material with varying inputs (see core.shading); a program's normal
-        replaces the shading normal and frame of its hits in the records it yields, an anisotropic
-        material's tangent the frame's tangent."""
+    def _bind_materials(self, surf: SurfaceHits, hits, shadow: bool = False):
+        """(rows of ``surf``, those hits, shader) per material: a slice of the hits (sorted by
+        material) for a constant material, index arrays of hits sharing one bound shader for a
+        material with varying inputs (see core.shading); a program's normal replaces the shading
+        normal and frame of its hits in the records it yields, an anisotropic material's tangent
+        the frame's tangent. ``shadow``: shadow rays reached the hits (Light Path's Is Shadow Ray)."""
         for g in _material_slices(surf.mat):
-            group, u_g = surf.take(g), u.take(g)
+            group = surf.take(g)
             shading = self.prepared.shading[surf.mat[g.start]]
             if not shading.varying:
-                yield group, u_g, shading.shader
+                yield g, group, shading.shader
                 continue
-            groups, normal, tangent = shading.bind(self._context(group, hits))
+            groups, normal, tangent = shading.bind(self._context(group, hits, shadow))
             if normal is not None or tangent is not None:
                 ns, wo = group.ns, group.wo
                 if normal is not None:
@@ -424,22 +441,23 @@ class Integrator:
                 frame = Frame.about(ns) if tangent is None else Frame.along(ns, tangent)
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo))
             for sub, shader in groups:
-                yield group.take(sub), u_g.take(sub), shader
+                yield g.start + sub, group.take(sub), shader
 
-    def _context(self, group: SurfaceHits, hits) -> SurfaceContext:
-        """The hits ``group`` as shader programs read them (core.shading.surface)."""
+    def _context(self, group: SurfaceHits, hits, shadow: bool = False) -> SurfaceContext:
+        """The hits ``group`` as shader programs read them (core.shading.surface); ``shadow``:
+        shadow rays reached them."""
         hu, hv = hits.u[group.row], hits.v[group.row]
         bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
         width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
         return SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
-                              self._ray_path(group, hits))
+                              self._ray_path(group, hits, shadow=shadow))
 
     @staticmethod
-    def _ray_path(group: SurfaceHits, hits, rows=slice(None)) -> RayPath | None:
+    def _ray_path(group: SurfaceHits, hits, rows=slice(None), shadow=False) -> RayPath | None:
         """The rays that reached hits ``rows`` of ``group``, for Light Path (None when no program reads it)."""
         if group.bounces is None:
             return None
-        return RayPath(group.straight[rows], group.bounces[rows], hits.t[group.row[rows]])
+        return RayPath(group.straight[rows], group.bounces[rows], hits.t[group.row[rows]], shadow=shadow)
 
     # -- next-event estimation ----------------------------------------------------------
     def _sample_lights(self, lit) -> LightSamples:
@@ -460,7 +478,8 @@ class Integrator:
         kernel (core.integrator.direct), weighed against the rays these hits may continue
         through (the diffuse lobes' within the diffuse bounces), where any ``continues``;
         what the wave's ratio estimator needs, when there is one, shown to it after
-        (core.integrator.ratio)."""
+        (core.integrator.ratio). Returns the shadow rays stopped on see-through surfaces (None:
+        none, core.integrator.shadows)."""
         n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
@@ -468,22 +487,27 @@ class Integrator:
         # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
         lifted = len(self.geometry.tables[3]) > 0 and any(lobe.diffuse for lobe in shader.lobes)
         geo = self.geometry
-        traced = direct_light(
+        shadows = self.shadows is not None
+        qf, qi = new_queue(n * light.strategies, shadows)
+        clear = self.shadows.clear if shadows else _NOTHING_CLEAR
+        allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
+        traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
             _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
-            visibility)
+            visibility, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility)
+        return stopped(qf, qi, m, group.bounces)
 
     # -- continuation through one lobe -------------------------------------------------
-    def _continue(self, shader, hits: SurfaceHits, u: StepSamples) -> PathState | None:
-        """The paths of these hits continued through one sampled lobe (None if none goes on;
-        core.integrator.continuation)."""
+    def _continue(self, shader, hits: SurfaceHits, u: StepSamples, state: PathState) -> PathState | None:
+        """The paths of these hits (rows ``hits.row`` of ``state``) continued through one sampled
+        lobe (None if none goes on; core.integrator.continuation)."""
         n = len(hits)
         go, passthrough, transmit, diffuse = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
         origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
@@ -502,10 +526,18 @@ class Integrator:
         self._count("refraction", (transmit & ~passthrough & ~diffuse).sum())
         self._count("reflection", (~transmit & ~diffuse).sum())
         self._count("transparent", passthrough.sum())
-        return PathState(path=hits.path[sel], origins=origin[sel], dirs=wi[sel], tmax=np.full(len(sel), np.inf),
-                         throughput=weight[sel], prev_pdf=prev_pdf[sel], prev_normal=hits.ng[sel],
-                         prev_shading=hits.ns[sel], straight=hits.straight[sel] & passthrough, time=hits.time[sel],
-                         bounces=None if hits.bounces is None else next_bounces[sel])
+        prev_pdf, prev_normal, prev_shading, origin = prev_pdf[sel], hits.ng[sel], hits.ns[sel], origin[sel]
+        mis_origin = None
+        if state.mis_origin is not None:  # transparent shadows: a pass-through keeps the MIS state
+            kept, rows = passthrough[:, None], hits.row[sel]
+            prev_pdf = np.where(passthrough, state.prev_pdf[rows], prev_pdf)
+            prev_normal = np.where(kept, state.prev_normal[rows], prev_normal)
+            prev_shading = np.where(kept, state.prev_shading[rows], prev_shading)
+            mis_origin = np.where(kept, state.mis_origin[rows], origin)
+        return PathState(path=hits.path[sel], origins=origin, dirs=wi[sel], tmax=np.full(len(sel), np.inf),
+                         throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
+                         prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
+                         bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin)
 
 
 def _material_slices(mat):
@@ -516,3 +548,4 @@ def _material_slices(mat):
 
 def _c(a):
     return np.ascontiguousarray(a)
+

@@ -3,7 +3,8 @@
 The renderer asks the plan which sample dimensions to draw (lens only with an
 aperture, shutter time only when something moves), and the plan lists which ray
 kinds can occur (from the lobes materials really have: zero-weight closures have no
-lobe), which light strategies cast shadow rays, and which passes are computed. The
+lobe), which light strategies cast shadow rays, which materials those go through
+(transparent shadows, core.integrator.shadows), and which passes are computed. The
 report shows it so a user sees what was left out, and tests hold the tracer to it:
 a kind the plan leaves out is never traced.
 """
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bsdf.shader import DIFFUSE_KINDS
+from ..bsdf.shader import DIFFUSE_KINDS, see_through
 from ..geometry.motion import Motion, deforms, moves
 from .ratio import delta_light, ratio_strategies
 
@@ -31,17 +32,21 @@ class RenderPlan:
     passes: list[str] = field(default_factory=list)
     ratio: list[int] = field(default_factory=list)  # strategies whose diffuse part the ratio estimator takes
     monte_carlo: list[str] = field(default_factory=list)  # with RATIO: light strategies left to Monte Carlo
+    see_through: list[str] = field(default_factory=list)  # materials shadow rays may pass (transparent shadows)
 
     def as_dict(self) -> dict:
         return {"lens": self.lens, "time": self.time, "moving": list(self.moving), "rays": dict(self.rays),
                 "strategies": list(self.strategies), "passes": list(self.passes), "left_out": list(self.left_out),
-                "ratio": [self.strategies[k] for k in self.ratio], "monte_carlo": list(self.monte_carlo)}
+                "ratio": [self.strategies[k] for k in self.ratio], "monte_carlo": list(self.monte_carlo),
+                "see_through": list(self.see_through)}
 
     def summary(self) -> str:
         """One line for Blender's stats, the console and the CLI."""
         kinds = ", ".join(k for k in RAY_KINDS if self.rays[k])
         dims = ["pixel"] + (["lens"] if self.lens else []) + (["time"] if self.time else [])
         text = f"plan: dims {'+'.join(dims)}; rays {kinds}; {len(self.strategies)} light strategies"
+        if self.see_through:
+            text += "; transparent shadows through " + ", ".join(self.see_through)
         if self.left_out:
             text += "; left out: " + ", ".join(self.left_out)
         if self.ratio or self.monte_carlo:
@@ -83,20 +88,28 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     if lights.world is not None:
         strategies.append("world")
 
+    clear = [scene.materials[m].name or f"material {m}" for m in sorted(used) if see_through(scene.materials[m])]
+    clear = clear if rays["shadow"] else []
+
     left_out = []
     if not lens:
         left_out.append("lens (aperture 0)")
     if not time:
         left_out.append("time (nothing moves)")
     left_out += [f"{k} rays" for k in RAY_KINDS if not rays[k]]
+    if rays["shadow"] and not clear:
+        left_out.append("transparent shadows")
     if lights.world is None:
         left_out.append("world sampling (black world)")
     dropped = len(scene.lights) - len(lights.lights)
     if dropped:
         left_out.append(f"{dropped} lights of zero power")
     # the ratio estimator takes diffuse direct light as light sampling alone, which with
-    # diffuse bounces is weighed against the diffuse rays (Monte Carlo then)
-    ratio = ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not rays["diffuse"] else []
+    # diffuse bounces is weighed against the diffuse rays, and a shadow ray's visibility as all
+    # or nothing, which transparent shadows are not (Monte Carlo then)
+    ratio = (ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not rays["diffuse"]
+             and not clear else [])
     by_ratio = settings.shadow_estimator == "RATIO"
     monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
-    return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo)
+    return RenderPlan(lens, time, moving, rays, strategies, left_out, list(settings.passes), ratio, monte_carlo,
+                      clear)

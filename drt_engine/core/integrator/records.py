@@ -58,7 +58,10 @@ class PathState:
     one the world's light sampling is cosine-weighted around); ``straight`` whether the
     camera sees through to here only through transparent surfaces (Cycles' camera ray);
     ``bounces`` the ray's kind and the path's depths (core.shading.lightpath), None unless a
-    shader program reads Light Path."""
+    shader program reads Light Path; ``mis_origin`` (with transparent shadows) where the
+    direction that ``prev_pdf`` is of was sampled: a transparent pass-through keeps the previous
+    bounce's pdf, normals and origin, as Cycles keeps its MIS state through transparent bounces,
+    since light sampling from there reaches through the transparent surface too."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -71,9 +74,18 @@ class PathState:
     straight: np.ndarray
     time: np.ndarray  # shutter time of each ray (zeros when nothing moves)
     bounces: np.ndarray | None = None
+    mis_origin: np.ndarray | None = None
 
     def __len__(self):
         return len(self.path)
+
+    def mis_ray(self, rows, t):
+        """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs
+        take them: from ``mis_origin`` when there is one (the direction is the same)."""
+        if self.mis_origin is None:
+            return self.origins[rows], t
+        o = self.mis_origin[rows]
+        return o, t + np.linalg.norm(self.origins[rows] - o, axis=1)
 
     take = _take
     concat = staticmethod(_concat)
@@ -113,3 +125,20 @@ class SurfaceHits:
         return self.frame.n
 
     take = _take
+
+
+@dataclass
+class ShadowRays:
+    """Shadow rays stopped on see-through surfaces: a queue's rows (``f``: floats, ``i``: ints,
+    the columns core.integrator.shadows lays out) and the depths of the paths that cast them
+    (core.shading.lightpath)."""
+
+    f: np.ndarray
+    i: np.ndarray
+    bounces: np.ndarray
+
+    def __len__(self):
+        return len(self.f)
+
+    take = _take
+    concat = staticmethod(_concat)

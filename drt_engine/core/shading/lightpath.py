@@ -8,9 +8,11 @@ ray depth (every bounce but transparent ones), glossy (non-diffuse reflections),
 transparent and diffuse (diffuse reflections, with diffuse bounces on). The integrator carries the kind and the depths per path in one small int
 array (``KIND`` bits and depth columns, updated by core.integrator.continuation).
 
+A shadow ray's surfaces (transparent shadows, core.integrator.shadows) are shaded as Cycles
+shades them: Is Shadow Ray 1 and no other ray kind, the path's depths with the surfaces the
+shadow ray passed added to its Transparent Depth, Ray Length from the shaded point.
+
 Outputs that are 0 at every point DRT shades, as Cycles' would be for the same path:
-- Is Shadow Ray: DRT's shadow rays are traced inside the direct-light kernel
-  (core.integrator.direct) and stop at the first surface, so no shader program runs for them.
 - Is Diffuse Ray and Diffuse Depth with diffuse bounces 0 (the default): paths continue only
   through non-diffuse lobes (diffuse light is direct light), so no ray is spawned by a diffuse lobe.
 - Is Volume Scatter Ray and Portal Depth (Blender 5): DRT has no volumes and no portals.
@@ -57,16 +59,17 @@ def camera_bounces(n: int) -> np.ndarray:
 @dataclass
 class RayPath:
     """The rays that reached a batch of points: ``camera`` (N,) bool, ``bounces`` (N, COLUMNS)
-    int, ``length`` (N,), and whether the points are evaluated as emission (a light sample or
-    the world: Cycles' PATH_RAY_EMISSION)."""
+    int, ``length`` (N,), whether the points are evaluated as emission (a light sample or
+    the world: Cycles' PATH_RAY_EMISSION) and whether shadow rays reached them."""
 
     camera: np.ndarray
     bounces: np.ndarray
     length: np.ndarray
     emission: bool = False
+    shadow: bool = False
 
     def take(self, rows) -> "RayPath":
-        return RayPath(self.camera[rows], self.bounces[rows], self.length[rows], self.emission)
+        return RayPath(self.camera[rows], self.bounces[rows], self.length[rows], self.emission, self.shadow)
 
     @classmethod
     def light_samples(cls, bounces: np.ndarray, length: np.ndarray) -> "RayPath":
@@ -88,10 +91,11 @@ def outputs(path: RayPath | None, n: int) -> tuple:
         return ((kind & mask) != 0).astype(float)
 
     depth = b[:, DEPTH] + (1 if path.emission else 0)
-    return (path.camera.astype(float), zero, bit(DIFFUSE), bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT), zero,
-            np.asarray(path.length, float), depth.astype(float), b[:, DIFFUSE_DEPTH].astype(float),
-            b[:, GLOSSY_DEPTH].astype(float),
-            b[:, TRANSPARENT_DEPTH].astype(float), b[:, TRANSMISSION_DEPTH].astype(float), zero)
+    shadow = np.full(n, 1.0 if path.shadow else 0.0)
+    return (path.camera.astype(float), shadow, bit(DIFFUSE), bit(GLOSSY), bit(SINGULAR), bit(REFLECT), bit(TRANSMIT),
+            zero, np.asarray(path.length, float), depth.astype(float), b[:, DIFFUSE_DEPTH].astype(float),
+            b[:, GLOSSY_DEPTH].astype(float), b[:, TRANSPARENT_DEPTH].astype(float),
+            b[:, TRANSMISSION_DEPTH].astype(float), zero)
 
 
 def falloff(strength, smooth, path: RayPath | None, n: int) -> tuple:
