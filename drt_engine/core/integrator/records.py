@@ -11,28 +11,33 @@ import numpy as np
 from ..base.vectors import Frame
 
 
-def _take(record, rows):
-    """The record's rows ``rows`` (an index array, a mask or a slice), field by field (a field
-    nobody asked for, None, stays None)."""
-    def rows_of(name):
-        value = getattr(record, name)
-        return None if value is None else value[rows]
+class Rows:
+    """A record of arrays with one row per ray: its length is its first field's, ``take`` gathers
+    rows (an index array, a mask or a slice) field by field, a field nobody asked for (None) staying None."""
 
-    return type(record)(**{f.name: rows_of(f.name) for f in fields(record)})
+    def __len__(self):
+        return len(getattr(self, fields(self)[0].name))
 
+    def take(self, rows):
+        def rows_of(name):
+            value = getattr(self, name)
+            return None if value is None else value[rows]
 
-def _concat(records: list):
-    """One record of the rows of ``records`` (of one type), in order; a field that none of
-    them has (None: nobody asked for it) stays None."""
-    def joined(name):
-        parts = [getattr(r, name) for r in records]
-        return None if parts[0] is None else np.concatenate(parts)
+        return type(self)(**{f.name: rows_of(f.name) for f in fields(self)})
 
-    return type(records[0])(**{f.name: joined(f.name) for f in fields(records[0])})
+    @staticmethod
+    def concat(records: list):
+        """One record of the rows of ``records`` (of one type), in order; a field that none of
+        them has (None: nobody asked for it) stays None."""
+        def joined(name):
+            parts = [getattr(r, name) for r in records]
+            return None if parts[0] is None else np.concatenate(parts)
+
+        return type(records[0])(**{f.name: joined(f.name) for f in fields(records[0])})
 
 
 @dataclass
-class Samples:
+class Samples(Rows):
     """Which camera samples a wave traces: ``index`` the film pixel (window), ``pixel`` the
     pixel's id in the whole image (seeds its numbers whatever the window), ``sample`` the
     sample id in the sampler's sequence."""
@@ -41,14 +46,9 @@ class Samples:
     pixel: np.ndarray
     sample: np.ndarray
 
-    def __len__(self):
-        return len(self.index)
-
-    take = _take
-
 
 @dataclass
-class PathState:
+class PathState(Rows):
     """Live paths of a wave at one depth, one row per path.
 
     ``path`` is the row of the camera sample in the wave; ``prev_pdf`` the solid-angle pdf of
@@ -76,9 +76,6 @@ class PathState:
     bounces: np.ndarray | None = None
     mis_origin: np.ndarray | None = None
 
-    def __len__(self):
-        return len(self.path)
-
     def mis_ray(self, rows, t):
         """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs
         take them: from ``mis_origin`` when there is one (the direction is the same)."""
@@ -87,12 +84,10 @@ class PathState:
         o = self.mis_origin[rows]
         return o, t + np.linalg.norm(self.origins[rows] - o, axis=1)
 
-    take = _take
-    concat = staticmethod(_concat)
 
 
 @dataclass
-class SurfaceHits:
+class SurfaceHits(Rows):
     """Rays that hit a surface, in shading order: the frame faces the incoming ray
     (``inside``: it came from the back), ``wo_l`` is the outgoing direction in that frame,
     ``scale`` the offset that clears the surface, ``row`` the hit's row in its depth's
@@ -116,19 +111,14 @@ class SurfaceHits:
     normal: np.ndarray
     bounces: np.ndarray | None = None
 
-    def __len__(self):
-        return len(self.path)
-
     @property
     def ns(self) -> np.ndarray:
         """The shading normal, facing the incoming ray: the frame's normal."""
         return self.frame.n
 
-    take = _take
-
 
 @dataclass
-class ShadowRays:
+class ShadowRays(Rows):
     """Shadow rays stopped on see-through surfaces: a queue's rows (``f``: floats, ``i``: ints,
     the columns core.integrator.shadows lays out) and the depths of the paths that cast them
     (core.shading.lightpath)."""
@@ -137,8 +127,3 @@ class ShadowRays:
     i: np.ndarray
     bounces: np.ndarray
 
-    def __len__(self):
-        return len(self.f)
-
-    take = _take
-    concat = staticmethod(_concat)
