@@ -70,19 +70,26 @@ def anisotropic_scene():
 
 
 def textured_scene():
-    """A Metallic BSDF sphere whose anisotropy rises with height (Generated z, a keyed input),
+    """A Metallic BSDF sphere (before Blender 5, which has none, a metallic Principled BSDF: the
+    same anisotropic alphas) whose anisotropy rises with height (Generated z, a keyed input),
     turned per hit by a Noise texture, along the UV map's tangent (a Tangent node)."""
     scene = _lit_scene((0.0, -5.0, 1.0))
-    material, node = _closure_material("Textured", "ShaderNodeBsdfMetallic", Base_Color=(0.8, 0.8, 0.85, 1.0),
-                                       Roughness=0.4)
+    if hasattr(bpy.types, "ShaderNodeBsdfMetallic"):
+        material, node = _closure_material("Textured", "ShaderNodeBsdfMetallic", Base_Color=(0.8, 0.8, 0.85, 1.0),
+                                           Roughness=0.4)
+        anisotropy, rotation = node.inputs["Anisotropy"], node.inputs["Rotation"]
+    else:
+        material, node = _closure_material("Textured", "ShaderNodeBsdfPrincipled", Base_Color=(0.8, 0.8, 0.85, 1.0),
+                                           Metallic=1.0, Roughness=0.4)
+        anisotropy, rotation = node.inputs["Anisotropic"], node.inputs["Anisotropic Rotation"]
     tree = material.node_tree
     coords = tree.nodes.new("ShaderNodeTexCoord")
     xyz = tree.nodes.new("ShaderNodeSeparateXYZ")
     tree.links.new(coords.outputs["Generated"], xyz.inputs["Vector"])
-    tree.links.new(xyz.outputs["Z"], node.inputs["Anisotropy"])
+    tree.links.new(xyz.outputs["Z"], anisotropy)
     noise = tree.nodes.new("ShaderNodeTexNoise")
     noise.inputs["Scale"].default_value = 2.0
-    tree.links.new(noise.outputs["Fac"], node.inputs["Rotation"])
+    tree.links.new(noise.outputs["Fac"], rotation)
     tangent = tree.nodes.new("ShaderNodeTangent")
     tangent.direction_type = "UV_MAP"
     tree.links.new(tangent.outputs["Tangent"], node.inputs["Tangent"])
