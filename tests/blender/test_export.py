@@ -378,7 +378,7 @@ def _added(tree, output, *nodes):
 
 
 def test_anisotropy_exports_with_its_tangent_and_rotation():
-    """Principled's Anisotropic, the Metallic BSDF's and Glossy's Anisotropy export with their
+    """Principled's Anisotropic, the Metallic BSDF's (Blender 5+) and Glossy's Anisotropy export with their
     rotation and a tangent, Geometry's where the Tangent socket is unlinked (one program node for
     all of them), a linked Tangent node's otherwise, without a warning; an isotropic shader has no
     tangent. Anisotropic shaders with different tangents in one material are named (a hit has one
@@ -388,9 +388,15 @@ def test_anisotropy_exports_with_its_tangent_and_rotation():
     principled = tree.nodes.new("ShaderNodeBsdfPrincipled")
     principled.inputs["Anisotropic"].default_value = 0.8
     principled.inputs["Anisotropic Rotation"].default_value = 0.25
-    metallic = tree.nodes.new("ShaderNodeBsdfMetallic")
-    metallic.inputs["Anisotropy"].default_value = 0.3
-    metallic.inputs["Rotation"].default_value = 0.25
+    if hasattr(bpy.types, "ShaderNodeBsdfMetallic"):
+        metallic = tree.nodes.new("ShaderNodeBsdfMetallic")
+        metallic.inputs["Anisotropy"].default_value = 0.3
+        metallic.inputs["Rotation"].default_value = 0.25
+    else:  # before Blender 5: a metallic Principled BSDF
+        metallic = tree.nodes.new("ShaderNodeBsdfPrincipled")
+        metallic.inputs["Metallic"].default_value = 1.0
+        metallic.inputs["Anisotropic"].default_value = 0.3
+        metallic.inputs["Anisotropic Rotation"].default_value = 0.25
     plain = tree.nodes.new("ShaderNodeBsdfPrincipled")
     _added(tree, output, principled, metallic, plain)
     turned, tree, output = _new_node_material("Turned")
