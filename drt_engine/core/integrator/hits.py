@@ -7,8 +7,22 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..base.vectors import basis
+from ..base.vectors import Frame, basis
 from ..geometry.accel import hit_surface, offset_scale
+from .records import SurfaceHits
+
+
+def surface_records(geometry, prim, u, v, ray_times, rows, dirs, **carried) -> SurfaceHits:
+    """The hits ``rows`` of a step's rays (``prim``, ``u``, ``v``, ``dirs`` per ray; ``ray_times``
+    their shutter times, None when nothing moves) as a record (``surface_hits``), with the fields
+    the paths carry to them (path, mat, throughput, straight, time, bounces) as given."""
+    n = len(rows)
+    pos, ng, wo_l, normal = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+    frame, inside, scale = np.empty((n, 3, 3)), np.empty(n, bool), np.empty(n)
+    surface_hits(geometry.tables, prim, u, v, geometry.time_values(ray_times), rows, dirs, pos, ng, frame, wo_l,
+                 inside, scale, normal)
+    return SurfaceHits(row=rows, prim=prim[rows], pos=pos, ng=ng, frame=Frame(frame), wo=-dirs[rows], wo_l=wo_l,
+                       inside=inside, scale=scale, normal=normal, **carried)
 
 
 @kernel

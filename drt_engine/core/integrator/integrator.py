@@ -38,7 +38,7 @@ from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
 from .continuation import continue_paths
 from .direct import direct_light
-from .hits import surface_hits
+from .hits import surface_records
 from .mis import add_emitted
 from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
@@ -308,18 +308,10 @@ class Integrator:
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
         facing the ray (core.integrator.hits)."""
-        n = len(rows)
-        pos, ng, frame, wo_l, normal = (np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3)),
-                                        np.empty((n, 3)))
-        inside, scale = np.empty(n, bool), np.empty(n)
-        surface_hits(self.geometry.tables, hits.prim, hits.u, hits.v, self.geometry.time_values(ray_times),
-                     rows, state.dirs, pos, ng, frame, wo_l, inside, scale, normal)
-        prim = hits.prim[rows]
-        return SurfaceHits(path=state.path[rows], row=rows, prim=prim, mat=mat, pos=pos,
-                           ng=ng, frame=Frame(frame), wo=-state.dirs[rows],
-                           wo_l=wo_l, inside=inside, scale=scale, throughput=state.throughput[rows],
-                           straight=state.straight[rows], time=state.time[rows], normal=normal,
-                           bounces=None if state.bounces is None else state.bounces[rows])
+        return surface_records(self.geometry, hits.prim, hits.u, hits.v, ray_times, rows, state.dirs,
+                               path=state.path[rows], mat=mat, throughput=state.throughput[rows],
+                               straight=state.straight[rows], time=state.time[rows],
+                               bounces=None if state.bounces is None else state.bounces[rows])
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
@@ -548,4 +540,3 @@ def _material_slices(mat):
 
 def _c(a):
     return np.ascontiguousarray(a)
-

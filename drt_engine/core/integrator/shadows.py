@@ -20,12 +20,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..base.vectors import Frame
 from ..geometry import embree
 from ..geometry.accel import Hits, instance_of, refine, spawn_point
 from ..shading.lightpath import KIND, TRANSPARENT_DEPTH
-from .hits import surface_hits
-from .records import ShadowRays, SurfaceHits
+from .hits import surface_records
+from .records import ShadowRays
 
 OPEN, OPAQUE, SEE_THROUGH = 0, 1, 2
 """What a shadow ray meets first: nothing, a surface that blocks it, a surface that may not."""
@@ -129,19 +128,14 @@ class TransparentShadows:
             order = np.argsort(mat, kind="stable")  # each material's hits one slice, as for camera hits
             rays, mat = rays.take(order), mat[order]
             f, i = rays.f, rays.i
-            pos, ng, frame, wo_l = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 3))
-            inside, scale, normal = np.empty(n, bool), np.empty(n), np.empty((n, 3))
             prim, u, v, dirs = (np.ascontiguousarray(a) for a in (i[:, 1], f[:, 11], f[:, 12], f[:, 6:9]))
-            surface_hits(geo.tables, prim, u, v, geo.time_values(f[:, 10] if timed else None), np.arange(n), dirs,
-                         pos, ng, frame, wo_l, inside, scale, normal)
             # the shadow path's depths at this hit: no ray kind, the surfaces passed counted on
             bounces = rays.bounces.copy()
             bounces[:, KIND] = 0
             bounces[:, TRANSPARENT_DEPTH] += i[:, 3]
-            surf = SurfaceHits(path=i[:, 0], row=np.arange(n), prim=prim, mat=mat, pos=pos, ng=ng,
-                               frame=Frame(frame), wo=-dirs, wo_l=wo_l, inside=inside, scale=scale,
-                               throughput=f[:, 0:3], straight=np.zeros(n, bool), time=f[:, 10], normal=normal,
-                               bounces=bounces)
+            surf = surface_records(geo, prim, u, v, f[:, 10] if timed else None, np.arange(n), dirs, path=i[:, 0],
+                                   mat=mat, throughput=f[:, 0:3], straight=np.zeros(n, bool), time=f[:, 10],
+                                   bounces=bounces)
             hits = Hits(t=f[:, 13], prim=prim, u=u, v=v)
             seen = np.zeros((n, 3))
             for rows, group, shader in self.bind(surf, hits, shadow=True):
@@ -152,6 +146,6 @@ class TransparentShadows:
             qf[:, 0:3] = c[go]
             out_f, out_i = new_queue(len(go), True)
             traced, m = pass_through(geo.handle, geo.tables, self.clear, qf, np.ascontiguousarray(i[go]),
-                                     pos[go], ng[go], scale[go], radiance, out_f, out_i)
+                                     surf.pos[go], surf.ng[go], surf.scale[go], radiance, out_f, out_i)
             self.count("shadow", traced)
             rays = ShadowRays(out_f[:m], out_i[:m], rays.bounces[go][out_i[:m, 2]])
