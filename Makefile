@@ -1,6 +1,7 @@
 # DRT: distribution ray tracing for Blender.
 #   make render      venv + render the default sample scene to out/ (SCENE=name for another one)
-#   make test        venv + the whole test suite (TESTS=path and PYTEST_ARGS=... to narrow it)
+#   make test        venv + the whole test suite, a process per core (TESTS=path and PYTEST_ARGS=... to narrow
+#                    it, TEST_JOBS= for one process)
 #   make test-versions tests/core and tests/blender under each bpy of BPY_VERSIONS (4.2 5.0 5.2 LTS),
 #                    each in its own venv (.venv-X.Y from requirements-X.Y.txt; 5.0 is .venv)
 #   make extension   download the embreex wheels, validate, build the extension zips into dist/
@@ -46,6 +47,8 @@ OUT ?= out
 DIST ?= dist
 TESTS ?= tests
 PYTEST_ARGS ?=
+# make test's processes: one per core, each test module in one of them (its fixtures built once).
+TEST_JOBS ?= -n auto --dist loadfile
 
 # The wheels listed in the manifest are the single source of truth for what gets downloaded.
 WHEELS := $(shell sed -n 's|^ *"\./\(wheels/[^"]*\.whl\)".*|\1|p' blender_manifest.toml)
@@ -77,7 +80,7 @@ render: $(STAMP)
 # pytest exits with 5 when it collects nothing; that is left as a failure on purpose:
 # a suite that runs no test must not pass CI.
 test: $(STAMP)
-	$(PY) -m pytest $(TESTS) -q $(PYTEST_ARGS)
+	$(PY) -m pytest $(TESTS) -q $(TEST_JOBS) $(PYTEST_ARGS)
 
 # Every version runs even when one fails; the summary names the ones that failed.
 test-versions: $(foreach v,$(BPY_VERSIONS),$(call venv_of,$v)/.drt-requirements-installed)
