@@ -40,12 +40,13 @@ CASES = {  # name -> (panorama type, camera settings, depth of field (f-stop, fo
     "fisheye_lens_polynomial": ("FISHEYE_LENS_POLYNOMIAL", dict(
         fisheye_fov=3.4, fisheye_polynomial_k0=0.02, fisheye_polynomial_k1=-0.09, fisheye_polynomial_k2=0.0,
         fisheye_polynomial_k3=-2e-5, fisheye_polynomial_k4=0.0), None, 0.0),
-}
-if "central_cylindrical_radius" in bpy.types.Camera.bl_rna.properties:
-    CASES["central_cylindrical"] = ("CENTRAL_CYLINDRICAL", dict(
+    "central_cylindrical": ("CENTRAL_CYLINDRICAL", dict(
         central_cylindrical_range_u_min=-2.0, central_cylindrical_range_u_max=1.5, central_cylindrical_range_v_min=-0.8,
-        central_cylindrical_range_v_max=1.3, central_cylindrical_radius=1.3), None, 0.0)
-    """Blender 4.3+ (4.2 has no Central Cylindrical)."""
+        central_cylindrical_range_v_max=1.3, central_cylindrical_radius=1.3), None, 0.0),
+}
+OFFERED = bpy.types.Camera.bl_rna.properties["panorama_type"].enum_items.keys()
+CASES = {name: case for name, case in CASES.items() if case[0] in OFFERED}
+"""The cases of the types this Blender offers (4.2 has no Central Cylindrical)."""
 
 SAMPLES = 256
 """More than the node parity's 64: a fisheye's or mirror ball's rim squeezes half the view into a
@@ -169,7 +170,7 @@ def test_window_coordinates_under_a_panoramic_camera_match_cycles(drt, tmp_path,
     assert combined[1][..., :2].std() > 0.1  # the gradients are seen
 
 
-LEFT_OUT = [t for t in bpy.types.Camera.bl_rna.properties["panorama_type"].enum_items.keys() if t not in PANORAMA_TYPES]
+LEFT_OUT = [t for t in OFFERED if t not in PANORAMA_TYPES]
 """The panorama types DRT does not render that this Blender offers (none in 4.2 to 5.0)."""
 
 

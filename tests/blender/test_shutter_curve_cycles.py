@@ -25,18 +25,21 @@ from scene_helpers import fcurves  # noqa: E402
 CURVE = ((0.0, 0.0), (0.2, 1.0), (1.0, 0.15))
 """Shutter openness over the shutter: opens fast, closes slowly."""
 
-CASES = {  # name -> (shutter curve points or None for the flat default, rolling shutter duration or None)
-    "curve": (CURVE, None),
-    "rolling": (None, 0.3),
-    "curve_and_rolling": (CURVE, 0.5),
+CASES = {  # name -> (shutter curve points or None for the flat default, rolling shutter duration or None,
+    # whether a fisheye camera slides over the still edge instead)
+    "curve": (CURVE, None, False),
+    "rolling": (None, 0.3, False),
+    "curve_and_rolling": (CURVE, 0.5, False),
+    "curve_panoramic_camera_moving": (CURVE, None, True),
 }
 
 SAMPLES = 256
 
 
-def sliding_edge_scene(curve=None, rolling=None):
+def sliding_edge_scene(curve=None, rolling=None, camera_moves=False):
     """A glowing half-plane x < X(t) sliding 1.5 m per frame (linear keys, frame 1 blurred over one
-    frame) under an orthographic camera 2 m wide (64 x 32 pixels)."""
+    frame) under an orthographic camera 2 m wide (64 x 32 pixels); ``camera_moves``: the half-plane
+    still and a fisheye (fov 2 radians) 1 m above it sliding 0.6 m per frame the other way."""
     scene = ps._scene(64, 32)
     ps.black_world(scene)
     mesh = bpy.data.meshes.new("edge")
@@ -44,15 +47,19 @@ def sliding_edge_scene(curve=None, rolling=None):
     mesh.materials.append(emission_material(1.0))
     edge = bpy.data.objects.new("edge", mesh)
     scene.collection.objects.link(edge)
+    cam = scene.camera
+    cam.location, cam.rotation_euler = (0.0, 0.0, 1.0 if camera_moves else 5.0), (0.0, 0.0, 0.0)
+    if camera_moves:
+        cam.data.type, cam.data.panorama_type, cam.data.fisheye_fov = "PANO", "FISHEYE_EQUIDISTANT", 2.0
+    else:
+        cam.data.type, cam.data.ortho_scale = "ORTHO", 2.0
+    moving, speed = (cam, -0.6) if camera_moves else (edge, 1.5)
     for frame in (0, 2):
-        edge.location.x = 1.5 * (frame - 1)
-        edge.keyframe_insert("location", index=0, frame=frame)
-    for fcurve in fcurves(edge):
+        moving.location.x = speed * (frame - 1)
+        moving.keyframe_insert("location", index=0, frame=frame)
+    for fcurve in fcurves(moving):
         for key in fcurve.keyframe_points:
             key.interpolation = "LINEAR"
-    cam = scene.camera
-    cam.location, cam.rotation_euler = (0.0, 0.0, 5.0), (0.0, 0.0, 0.0)
-    cam.data.type, cam.data.ortho_scale = "ORTHO", 2.0
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
     if curve is not None:
