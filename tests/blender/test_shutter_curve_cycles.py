@@ -20,7 +20,7 @@ from tests.support import render_helpers as rh
 from tests.support.export_helpers import render_export
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
-from scene_helpers import fcurves  # noqa: E402
+from scene_helpers import linear_keys  # noqa: E402
 
 CURVE = ((0.0, 0.0), (0.2, 1.0), (1.0, 0.15))
 """Shutter openness over the shutter: opens fast, closes slowly."""
@@ -57,9 +57,7 @@ def sliding_edge_scene(curve=None, rolling=None, camera_moves=False):
     for frame in (0, 2):
         moving.location.x = speed * (frame - 1)
         moving.keyframe_insert("location", index=0, frame=frame)
-    for fcurve in fcurves(moving):
-        for key in fcurve.keyframe_points:
-            key.interpolation = "LINEAR"
+    linear_keys(moving)
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
     if curve is not None:
