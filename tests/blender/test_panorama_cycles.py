@@ -7,6 +7,9 @@ black and opaque. Depth of field is compared strongly enough (a quarter-metre ap
 half a metre) that DRT without it fails, and so is the camera's motion blur. A panorama type DRT does not render is refused with one line naming it."""
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import bpy
 import mathutils
 import numpy as np
@@ -19,6 +22,9 @@ from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support.datablocks import new_material
 from tests.support.export_helpers import render_export
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
+from scene_helpers import linear_keys  # noqa: E402
 
 WALLS = {  # outward axis and sign -> emitted colour
     (0, 1): (1.0, 0.2, 0.1), (0, -1): (0.1, 0.9, 0.2), (1, 1): (0.2, 0.3, 1.0),
@@ -99,14 +105,12 @@ def box_scene(panorama: str, **settings):
 def _turn(scene, angle):
     """Key the camera turning by ``angle`` about its view axis, linearly over frames 0 to 2, and
     blur frame 1 over one frame."""
-    edit = bpy.context.preferences.edit
-    interpolation, edit.keyframe_new_interpolation_type = edit.keyframe_new_interpolation_type, "LINEAR"
     cam = scene.camera
     base = cam.rotation_euler.to_matrix()
     for frame, a in ((0, -0.5 * angle), (2, 0.5 * angle)):
         cam.rotation_euler = (base @ mathutils.Matrix.Rotation(a, 3, "Z")).to_euler()
         cam.keyframe_insert("rotation_euler", frame=frame)
-    edit.keyframe_new_interpolation_type = interpolation
+    linear_keys(cam)
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
     scene.frame_set(1)
