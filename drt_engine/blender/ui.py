@@ -215,6 +215,23 @@ class DRT_PT_motion_blur(DRTButtonsPanel, bpy.types.Panel):
         if hasattr(render, "motion_blur_position"):
             col.prop(render, "motion_blur_position", text="Position")
         col.prop(render, "motion_blur_shutter")
+        cycles = getattr(context.scene, "cycles", None)  # Cycles' rolling shutter, which DRT renders too
+        if cycles is not None:
+            col.prop(cycles, "rolling_shutter_type", text="Rolling Shutter")
+            sub = col.column()
+            sub.active = cycles.rolling_shutter_type != "NONE"
+            sub.prop(cycles, "rolling_shutter_duration", text="Duration")
+
+
+class DRT_PT_motion_blur_curve(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Shutter Curve"
+    bl_parent_id = "DRT_PT_motion_blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        render = context.scene.render
+        self.layout.active = render.use_motion_blur
+        self.layout.template_curve_mapping(render, "motion_blur_shutter_curve")
 
 
 class DRT_PT_performance(DRTButtonsPanel, bpy.types.Panel):
@@ -283,6 +300,7 @@ classes = (
     DRT_PT_light_paths,
     DRT_PT_film,
     DRT_PT_motion_blur,
+    DRT_PT_motion_blur_curve,
     DRT_PT_performance,
     DRT_PT_passes,
     DRT_PT_passes_aov,

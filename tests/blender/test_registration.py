@@ -177,6 +177,9 @@ class RecordingLayout:
         self.prop(data, name)
         self.prop(active_data, active_name)
 
+    def template_curve_mapping(self, data, name, **kwargs):
+        self.prop(data, name)
+
     def operator(self, idname, **kwargs):
         module, name = idname.split(".")
         assert name in dir(getattr(bpy.ops, module)), f"no operator {idname}"
