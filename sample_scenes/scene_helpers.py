@@ -226,6 +226,13 @@ def fcurves(obj):
     return animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves
 
 
+def linear_keys(obj) -> None:
+    """Make every key of the object's animation linear (new keys are Bezier, easing in and out)."""
+    for curve in fcurves(obj):
+        for key in curve.keyframe_points:
+            key.interpolation = "LINEAR"
+
+
 def save(path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=str(path), compress=True)

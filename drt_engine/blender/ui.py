@@ -215,6 +215,54 @@ class DRT_PT_motion_blur(DRTButtonsPanel, bpy.types.Panel):
         if hasattr(render, "motion_blur_position"):
             col.prop(render, "motion_blur_position", text="Position")
         col.prop(render, "motion_blur_shutter")
+        cycles = getattr(context.scene, "cycles", None)  # Cycles' rolling shutter, which DRT renders too
+        if cycles is not None:
+            col.prop(cycles, "rolling_shutter_type", text="Rolling Shutter")
+            sub = col.column()
+            sub.active = cycles.rolling_shutter_type != "NONE"
+            sub.prop(cycles, "rolling_shutter_duration", text="Duration")
+
+
+class DRT_PT_motion_blur_curve(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Shutter Curve"
+    bl_parent_id = "DRT_PT_motion_blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        render = context.scene.render
+        self.layout.active = render.use_motion_blur
+        self.layout.template_curve_mapping(render, "motion_blur_shutter_curve")
+
+
+PANORAMA_SETTINGS = {  # panorama type -> (camera property, label) as Cycles' Lens panel shows them
+    "EQUIRECTANGULAR": (("latitude_min", "Latitude Min"), ("latitude_max", "Max"),
+                        ("longitude_min", "Longitude Min"), ("longitude_max", "Max")),
+    "FISHEYE_EQUIDISTANT": (("fisheye_fov", None),),
+    "FISHEYE_EQUISOLID": (("fisheye_lens", "Lens"), ("fisheye_fov", None)),
+    "FISHEYE_LENS_POLYNOMIAL": (("fisheye_fov", None),) + tuple((f"fisheye_polynomial_k{i}", f"K{i}") for i in range(5)),
+    "CENTRAL_CYLINDRICAL": (("central_cylindrical_range_v_min", "Height Min"), ("central_cylindrical_range_v_max", "Max"),
+                            ("central_cylindrical_range_u_min", "Longitude Min"),
+                            ("central_cylindrical_range_u_max", "Max"), ("central_cylindrical_radius", "Cylinder Radius")),
+}
+
+
+class DRT_PT_camera_panorama(DRTButtonsPanel, bpy.types.Panel):
+    """The panoramic camera's projection and its settings: Blender's Lens panel shows them to Cycles only."""
+    bl_label = "Panorama"
+    bl_context = "data"
+    bl_parent_id = "DATA_PT_lens"
+
+    @classmethod
+    def poll(cls, context):
+        camera = getattr(context, "camera", None)
+        return context.engine in cls.COMPAT_ENGINES and camera is not None and camera.type == "PANO"
+
+    def draw(self, context):
+        col = split(self.layout).column()
+        camera = context.camera
+        col.prop(camera, "panorama_type")
+        for name, label in PANORAMA_SETTINGS.get(camera.panorama_type, ()):
+            col.prop(camera, name, **({} if label is None else {"text": label}))
 
 
 class DRT_PT_performance(DRTButtonsPanel, bpy.types.Panel):
@@ -283,6 +331,8 @@ classes = (
     DRT_PT_light_paths,
     DRT_PT_film,
     DRT_PT_motion_blur,
+    DRT_PT_motion_blur_curve,
+    DRT_PT_camera_panorama,
     DRT_PT_performance,
     DRT_PT_passes,
     DRT_PT_passes_aov,

@@ -363,7 +363,19 @@ class Camera:
     fisheye_lens: float = 10.5
     """Fisheye equisolid: focal length, in the sensor's units (mm)."""
     sensor: tuple[float, float] = (36.0, 24.0)
-    """Fisheye equisolid: the sensor's width and height (mm) fitted to the image, as Cycles fits them."""
+    """Fisheye equisolid and lens polynomial: the sensor's width and height (mm) fitted to the image, as Cycles fits them."""
+    fisheye_polynomial: tuple[float, float, float, float, float] = (0.0, 1.0, 0.0, 0.0, 0.0)
+    """Fisheye lens polynomial: k0 to k4, the angle from the view axis (radians) of a sensor point at
+    radius r (mm) being -(k0 + k1 r + k2 r^2 + k3 r^3 + k4 r^4)."""
+    cylinder: tuple[float, float, float, float] = (-np.pi, np.pi, -1.0, 1.0)
+    """Central cylindrical: longitudes (radians) at the image's left and right, heights on the unit
+    cylinder (Blender's heights over its cylinder radius) at its bottom and top."""
+    shutter_table: np.ndarray | None = None
+    """Motion blur's shutter curve as Cycles' inverse-CDF table of shutter times (None: times uniform
+    over the shutter, for a flat curve without a rolling shutter)."""
+    rolling_shutter: float | None = None
+    """Rolling shutter (rows read from the top down over the shutter): Cycles' rolling shutter
+    duration, None when off."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
@@ -392,7 +404,8 @@ class Camera:
         return x1 - x0, y1 - y0
 
 
-PANORAMA_TYPES = ("EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT", "FISHEYE_EQUISOLID", "MIRRORBALL")
+PANORAMA_TYPES = ("EQUIRECTANGULAR", "FISHEYE_EQUIDISTANT", "FISHEYE_EQUISOLID", "MIRRORBALL",
+                  "EQUIANGULAR_CUBEMAP_FACE", "FISHEYE_LENS_POLYNOMIAL", "CENTRAL_CYLINDRICAL")
 """Panoramic projections, as Cycles' kernel/camera/projection.h defines them."""
 
 

@@ -16,7 +16,7 @@ from conftest import emission_material, render_exr
 from tests.support.datablocks import new_world
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "sample_scenes"))
-from scene_helpers import fcurves  # noqa: E402
+from scene_helpers import linear_keys  # noqa: E402
 
 V, SHUTTER, WIDTH, HALF = 1.0, 0.5, 64, 1.0
 
@@ -47,9 +47,7 @@ def sliding_edge_scene():
     for frame in (0, 2):
         edge.location.x = V * (frame - 1)
         edge.keyframe_insert("location", index=0, frame=frame)
-    for curve in fcurves(edge):
-        for key in curve.keyframe_points:
-            key.interpolation = "LINEAR"
+    linear_keys(edge)
     world = new_world("World")
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world

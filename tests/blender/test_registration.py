@@ -177,6 +177,9 @@ class RecordingLayout:
         self.prop(data, name)
         self.prop(active_data, active_name)
 
+    def template_curve_mapping(self, data, name, **kwargs):
+        self.prop(data, name)
+
     def operator(self, idname, **kwargs):
         module, name = idname.split(".")
         assert name in dir(getattr(bpy.ops, module)), f"no operator {idname}"
@@ -191,7 +194,9 @@ class RecordingLayout:
 def test_drt_panels_draw_existing_properties(drt):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    context = SimpleNamespace(scene=scene, view_layer=scene.view_layers[0], engine="DRT")
+    camera = bpy.data.cameras.new("Panorama")
+    camera.type = "PANO"
+    context = SimpleNamespace(scene=scene, view_layer=scene.view_layers[0], engine="DRT", camera=camera)
     drawn = set()
     for panel in ui.classes:
         assert panel.poll(context)
@@ -204,4 +209,9 @@ def test_drt_panels_draw_existing_properties(drt):
     assert set(properties.BLENDER_PASS_TOGGLES.values()) | set(properties.DRT_PASS_TOGGLES.values()) <= drawn
     assert "aovs" in drawn  # the Shader AOV list
     assert {"use_motion_blur", "motion_blur_shutter", "motion_blur_position", "filter_size",
-            "film_transparent"} <= drawn
+            "film_transparent", "panorama_type", "motion_blur_shutter_curve", "rolling_shutter_type"} <= drawn
+    for panorama, settings in ui.PANORAMA_SETTINGS.items():  # each type's settings are the camera's
+        if panorama in camera.bl_rna.properties["panorama_type"].enum_items.keys():
+            camera.panorama_type = panorama
+            ui.DRT_PT_camera_panorama.draw(SimpleNamespace(layout=RecordingLayout(drawn)), context)
+            assert {name for name, _ in settings} <= drawn

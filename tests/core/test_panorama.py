@@ -12,6 +12,8 @@ from drt_engine.core.scene import PANORAMA_TYPES, Camera
 
 W, H = 64, 32
 LAT, LON = (-0.3, 0.8), (-1.0, 2.0)
+POLYNOMIAL = (0.0, -0.09, 0.0, -2e-5, 0.0)  # the angle 0.09 r + 2e-5 r^3 at sensor radius r (mm)
+CYLINDER = (-2.0, 1.5, -0.8, 1.2)
 
 
 def _matrix():
@@ -26,7 +28,7 @@ def _matrix():
 
 def _camera(panorama, **kw):
     settings = dict(latitude=LAT, longitude=LON, fisheye_fov=2.8, fisheye_lens=9.0, sensor=(36.0, 18.0),
-                    clip_start=0.25, clip_end=40.0)
+                    fisheye_polynomial=POLYNOMIAL, cylinder=CYLINDER, clip_start=0.25, clip_end=40.0)
     settings.update(kw)
     return Camera(_matrix()[None], (0.0, 1.0, 0.0, 1.0), (W, H), type="PANO", panorama=panorama, **settings)
 
@@ -46,7 +48,17 @@ def _image_point(cam, d):
         n = np.stack([x, y, z - 1.0], axis=1)
         n /= np.linalg.norm(n, axis=1, keepdims=True)
         return 0.5 * (n[:, 0] + 1.0), 0.5 * (n[:, 1] + 1.0)
+    if cam.panorama == "EQUIANGULAR_CUBEMAP_FACE":  # equal angles across the face ahead
+        return 0.5 + np.arctan2(x, -z) / (np.pi / 2), 0.5 + np.arctan2(y, -z) / (np.pi / 2)
+    if cam.panorama == "CENTRAL_CYLINDRICAL":  # longitude to the right, height on the unit cylinder up
+        lon, height = np.arctan2(x, -z), y / np.hypot(x, z)
+        return (lon - CYLINDER[0]) / (CYLINDER[1] - CYLINDER[0]), (height - CYLINDER[2]) / (CYLINDER[3] - CYLINDER[2])
     theta, rho = np.arccos(-z), np.hypot(x, y)
+    if cam.panorama == "FISHEYE_LENS_POLYNOMIAL":  # the radius (mm) whose polynomial angle is theta
+        r = np.array([min(t.real for t in np.roots([-POLYNOMIAL[4], -POLYNOMIAL[3], -POLYNOMIAL[2], -POLYNOMIAL[1],
+                                                     -POLYNOMIAL[0] - a]) if abs(t.imag) < 1e-9 and t.real >= 0)
+                      for a in theta])
+        return 0.5 + r * x / rho / cam.sensor[0], 0.5 + r * y / rho / cam.sensor[1]
     if cam.panorama == "FISHEYE_EQUIDISTANT":  # radius proportional to the angle, fov across the circle
         r = theta / (0.5 * cam.fisheye_fov)
         return 0.5 + 0.5 * r * x / rho, 0.5 + 0.5 * r * y / rho
@@ -74,7 +86,7 @@ def test_each_image_point_maps_back_to_itself(panorama):
 
 @pytest.mark.parametrize("panorama", PANORAMA_TYPES)
 def test_the_centre_looks_down_the_cameras_minus_z(panorama):
-    cam = _camera(panorama, latitude=(-np.pi / 2, np.pi / 2), longitude=(-np.pi, np.pi))
+    cam = _camera(panorama, latitude=(-np.pi / 2, np.pi / 2), longitude=(-np.pi, np.pi), cylinder=(-1.0, 1.0, -1.0, 1.0))
     rays = camera_rays.generate(cam, np.array([W / 2]), np.array([H / 2]), None)
     assert rays.valid[0] and np.allclose(_local(rays)[0], [0.0, 0.0, -1.0], atol=1e-12)
 
@@ -87,10 +99,16 @@ def test_equirectangular_corners_are_the_ranges_corners():
     assert rays.valid.all() and np.allclose(_local(rays), expected, atol=1e-12)
 
 
+def _polynomial_angle(r):
+    return -sum(k * r ** i for i, k in enumerate(POLYNOMIAL))
+
+
 @pytest.mark.parametrize("panorama, inside", [("FISHEYE_EQUIDISTANT", lambda u, v: np.hypot(2 * u - 1, 2 * v - 1) <= 1),
                                               ("MIRRORBALL", lambda u, v: np.hypot(2 * u - 1, 2 * v - 1) <= 1),
                                               ("FISHEYE_EQUISOLID", lambda u, v: np.hypot(
-                                                  (u - 0.5) * 36.0, (v - 0.5) * 18.0) <= 18.0 * np.sin(0.7))])
+                                                  (u - 0.5) * 36.0, (v - 0.5) * 18.0) <= 18.0 * np.sin(0.7)),
+                                              ("FISHEYE_LENS_POLYNOMIAL", lambda u, v: _polynomial_angle(np.hypot(
+                                                  (u - 0.5) * 36.0, (v - 0.5) * 18.0)) <= 1.4)])
 def test_no_ray_outside_the_circle(panorama, inside):
     rng = np.random.default_rng(2)
     px, py = rng.random(4000) * W, rng.random(4000) * H

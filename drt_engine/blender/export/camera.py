@@ -6,13 +6,15 @@ left in scene units for orthographic ones. Depth of field: aperture radius =
 lens[mm]·1e-3 / (2·f-stop) for perspective (1 / (2·f-stop) for orthographic), in
 scene units whatever the unit scale, and 0 when depth of field is off.
 Panoramic cameras: the frame is the (u, v) square, shifted as Cycles shifts it, and
-the projection's settings follow Cycles' blender_camera_sync.
+the projection's settings follow Cycles' blender_camera_sync. Motion blur's shutter curve and
+Cycles' rolling shutter reach the camera as Cycles' blender_camera_sync reads them.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ...core.errors import SceneError
+from ...core.geometry.shutter import TABLE_SIZE, shutter_table
 from ...core.scene import PANORAMA_TYPES, Camera
 
 
@@ -94,6 +96,7 @@ def export_camera(scene, camera_object) -> Camera:
         to_focus = matrix[:3, 3] - np.array(dof.focus_object.matrix_world.translation)
         focus = abs(float(matrix[:3, 2] @ to_focus))
     pixel_aspect = (render.pixel_aspect_x, render.pixel_aspect_y)
+    rolling = rolling_shutter(scene)
     return Camera(
         matrices=matrix[None],
         frame=(panorama_plane(cam) if cam.type == "PANO" else view_plane(cam, width, height, pixel_aspect)),
@@ -107,8 +110,32 @@ def export_camera(scene, camera_object) -> Camera:
         blades=int(dof.aperture_blades),
         blade_rotation=float(dof.aperture_rotation),
         aperture_ratio=float(dof.aperture_ratio),
+        shutter_table=shutter_curve(render, rolling),
+        rolling_shutter=rolling,
         **(panorama_settings(cam, width, height, pixel_aspect) if cam.type == "PANO" else {}),
     )
+
+
+def shutter_curve(render, rolling: float | None):
+    """The shutter curve's table of shutter times, from the curve sampled as Cycles'
+    curvemapping_to_array samples it; None without motion blur, and for a flat curve without a
+    rolling shutter (times uniform over the shutter, a hair wider than Cycles' table spreads them)."""
+    if not render.use_motion_blur:
+        return None
+    curves = render.motion_blur_shutter_curve
+    curves.initialize()
+    values = np.array([curves.evaluate(curves.curves[0], i / (TABLE_SIZE - 1)) for i in range(TABLE_SIZE)])
+    if rolling is None and np.all(values == values[0]):
+        return None
+    return shutter_table(values)
+
+
+def rolling_shutter(scene):
+    """Cycles' rolling shutter duration when its rolling shutter is on (a Cycles scene setting)."""
+    cycles = getattr(scene, "cycles", None)
+    if cycles is None or not scene.render.use_motion_blur or cycles.rolling_shutter_type == "NONE":
+        return None
+    return float(cycles.rolling_shutter_duration)
 
 
 def panorama_plane(cam) -> tuple[float, float, float, float]:
@@ -125,6 +152,12 @@ def panorama_settings(cam, width: int, height: int, pixel_aspect) -> dict:
     horizontal = x_ratio > y_ratio if fit == "AUTO" else fit == "HORIZONTAL"
     size = cam.sensor_height if fit == "VERTICAL" else cam.sensor_width
     sensor = (size, size * y_ratio / x_ratio) if horizontal else (size * x_ratio / y_ratio, size)
-    return dict(panorama=cam.panorama_type, latitude=(cam.latitude_min, cam.latitude_max),
-                longitude=(cam.longitude_min, cam.longitude_max), fisheye_fov=cam.fisheye_fov,
-                fisheye_lens=cam.fisheye_lens, sensor=sensor)
+    settings = dict(panorama=cam.panorama_type, latitude=(cam.latitude_min, cam.latitude_max),
+                    longitude=(cam.longitude_min, cam.longitude_max), fisheye_fov=cam.fisheye_fov,
+                    fisheye_lens=cam.fisheye_lens, sensor=sensor,
+                    fisheye_polynomial=tuple(getattr(cam, f"fisheye_polynomial_k{i}") for i in range(5)))
+    if hasattr(cam, "central_cylindrical_radius"):  # Blender 4.3+
+        radius = cam.central_cylindrical_radius
+        settings["cylinder"] = (cam.central_cylindrical_range_u_min, cam.central_cylindrical_range_u_max,
+                                cam.central_cylindrical_range_v_min / radius, cam.central_cylindrical_range_v_max / radius)
+    return settings

@@ -19,13 +19,15 @@ from ..base.vectors import unit
 from ..base.warps import concentric_disk
 from ..scene import PANORAMA_TYPES, Camera
 from .motion import Motion, frame_at
+from .shutter import shutter_times
 
 FOCUS_MIN = 1e-5
 """Nearest focus distance, as Cycles clamps it: at 0 every lens ray would leave sideways."""
 
 PANORAMA_CODE = {name: 2 + i for i, name in enumerate(PANORAMA_TYPES)}
 """``lens[0]`` of each panoramic projection (0 is perspective, 1 orthographic)."""
-EQUIRECTANGULAR, FISHEYE_EQUIDISTANT, FISHEYE_EQUISOLID, MIRRORBALL = (PANORAMA_CODE[n] for n in PANORAMA_TYPES)
+(EQUIRECTANGULAR, FISHEYE_EQUIDISTANT, FISHEYE_EQUISOLID, MIRRORBALL, CUBEMAP_FACE, FISHEYE_POLYNOMIAL,
+ CENTRAL_CYLINDRICAL) = (PANORAMA_CODE[n] for n in PANORAMA_TYPES)
 
 
 @dataclass
@@ -44,12 +46,16 @@ def lens_table(camera: Camera) -> np.ndarray:
     left, right, bottom, top = camera.frame
     kind = PANORAMA_CODE[camera.panorama] if camera.type == "PANO" else float(camera.type != "PERSP")
     (lat_min, lat_max), (lon_min, lon_max) = camera.latitude, camera.longitude
+    u_min, u_max, v_min, v_max = camera.cylinder
     return np.array([kind, w, h, left, right, bottom, top, camera.aperture_radius,
                      max(camera.aperture_ratio, 1e-6), camera.blades, camera.blade_rotation,
                      max(camera.focus_distance, FOCUS_MIN), camera.clip_start, camera.clip_end,
                      # Cycles' equirectangular_range: longitude from u, polar angle from v
                      lon_min - lon_max, -lon_min, lat_min - lat_max, np.pi / 2 - lat_min,
-                     camera.fisheye_fov, camera.fisheye_lens, camera.sensor[0], camera.sensor[1]], np.float64)
+                     camera.fisheye_fov, camera.fisheye_lens, camera.sensor[0], camera.sensor[1],
+                     *camera.fisheye_polynomial,
+                     # Cycles' central_cylindrical_range: the longitudes negated (positive to the left)
+                     -u_min, -u_max, v_min, v_max], np.float64)
 
 
 @kernel
@@ -68,20 +74,31 @@ def panorama_direction(lens, u, v):
         by = -math.sqrt(max(1.0 - bx * bx - bz * bz, 0.0))
         c = -2.0 * by  # 2 (n . i) with i = (0, -1, 0)
         return c * bx, c * by + 1.0, c * bz
+    if kind == CUBEMAP_FACE:  # the face ahead, equal angles per unit of u and v
+        return unit(1.0, math.tan((0.5 - u) * 0.5 * math.pi), math.tan((v - 0.5) * 0.5 * math.pi))
+    if kind == CENTRAL_CYLINDRICAL:  # a point of the cylinder about the up axis, seen from its centre
+        phi = lens[27] + u * (lens[28] - lens[27])
+        return unit(math.cos(phi), math.sin(phi), lens[29] + v * (lens[30] - lens[29]))
     if kind == FISHEYE_EQUIDISTANT:
         x, y = 2.0 * (u - 0.5), 2.0 * (v - 0.5)
         r = math.sqrt(x * x + y * y)
         if r > 1.0:
             return 0.0, 0.0, 0.0
         theta = 0.5 * r * lens[18]
+    elif kind == FISHEYE_POLYNOMIAL:  # the angle a polynomial of the radius on the sensor, inside the fov
+        x, y = (u - 0.5) * lens[20], (v - 0.5) * lens[21]
+        r = math.sqrt(x * x + y * y)
+        theta = -(lens[22] + r * (lens[23] + r * (lens[24] + r * (lens[25] + r * lens[26]))))
+        if abs(theta) > 0.5 * lens[18]:
+            return 0.0, 0.0, 0.0
     else:  # equisolid: r = 2 f sin(theta / 2) on the sensor, inside the circle of the fov
         x, y = (u - 0.5) * lens[20], (v - 0.5) * lens[21]
         r = math.sqrt(x * x + y * y)
         if r > 2.0 * lens[19] * math.sin(0.25 * lens[18]):
             return 0.0, 0.0, 0.0
         theta = 2.0 * math.asin(min(r / (2.0 * lens[19]), 1.0))
-    if r == 0.0:
-        return 1.0, 0.0, 0.0
+    if r == 0.0:  # Cycles' direction there (phi a quarter turn)
+        return math.cos(theta), 0.0, math.sin(theta)
     s = math.sin(theta) / r
     return math.cos(theta), -x * s, y * s
 
@@ -100,14 +117,38 @@ def panorama_point(lens, dx, dy, dz):
         if div > 0.0:
             dx, dz = dx / div, dz / div
         return 0.5 * (dx + 1.0), 0.5 * (dz + 1.0)
+    if kind == CUBEMAP_FACE:
+        return 0.5 - math.atan2(dy, dx) * 2.0 / math.pi, math.atan2(dz, dx) * 2.0 / math.pi + 0.5
+    if kind == CENTRAL_CYLINDRICAL:
+        height = dz / math.sqrt(dx * dx + dy * dy)
+        return ((math.atan2(dy, dx) - lens[27]) / (lens[28] - lens[27]),
+                (height - lens[29]) / (lens[30] - lens[29]))
     across = math.sqrt(dy * dy + dz * dz)
     if across == 0.0:
         return 0.5, 0.5
     if kind == FISHEYE_EQUIDISTANT:
         r = math.atan2(across, dx) / lens[18]  # 0.5 on the circle (theta half the fov)
         return 0.5 - r * dy / across, 0.5 + r * dz / across
-    r = 2.0 * lens[19] * math.sin(0.5 * math.acos(min(max(dx, -1.0), 1.0)))
+    if kind == FISHEYE_POLYNOMIAL:
+        r = polynomial_radius(lens, -math.acos(min(max(dx, -1.0), 1.0)))
+    else:
+        r = 2.0 * lens[19] * math.sin(0.5 * math.acos(min(max(dx, -1.0), 1.0)))
     return 0.5 - r * dy / across / lens[20], 0.5 + r * dz / across / lens[21]
+
+
+@kernel
+def polynomial_radius(lens, theta):
+    """The sensor radius whose lens-polynomial angle is ``theta``: Newton's method from the linear
+    term's answer, as Cycles' direction_to_fisheye_lens_polynomial (at most 20 steps)."""
+    k0, k1, k2, k3, k4 = lens[22], lens[23], lens[24], lens[25], lens[26]
+    r = (theta - k0) / k1
+    for _ in range(20):
+        f = theta - (k0 + r * (k1 + r * (k2 + r * (k3 + r * k4))))
+        step = f / (k1 + r * (2.0 * k2 + r * (3.0 * k3 + r * 4.0 * k4)))
+        r += step
+        if abs(step) < 1e-6:
+            break
+    return r
 
 
 @kernel
@@ -255,6 +296,12 @@ def aperture_point(camera: Camera, u: np.ndarray) -> np.ndarray:
     return out
 
 
+def shutter_time(camera: Camera, u: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Shutter times (0 to 1) of samples with time values ``u`` in pixel rows ``rows`` (from the
+    bottom): through the camera's shutter curve and rolling shutter, as Cycles' camera_sample."""
+    return shutter_times(camera.shutter_table, camera.rolling_shutter, camera.resolution[1], u, rows)
+
+
 def moves(camera: Camera) -> bool:
     return Motion(camera.matrices).moving
 
@@ -288,6 +335,9 @@ def pixel_spread(camera: Camera) -> tuple[float, float]:
     if camera.type == "PANO":
         per_u = {"EQUIRECTANGULAR": abs(camera.longitude[1] - camera.longitude[0]),
                  "FISHEYE_EQUIDISTANT": camera.fisheye_fov, "FISHEYE_EQUISOLID": camera.sensor[0] / camera.fisheye_lens,
-                 "MIRRORBALL": 4.0}[camera.panorama]  # the direction's angle per unit of u there
+                 "MIRRORBALL": 4.0, "EQUIANGULAR_CUBEMAP_FACE": np.pi / 2,
+                 "FISHEYE_LENS_POLYNOMIAL": abs(camera.fisheye_polynomial[1]) * camera.sensor[0],
+                 "CENTRAL_CYLINDRICAL": abs(camera.cylinder[1] - camera.cylinder[0]),
+                 }[camera.panorama]  # the direction's angle per unit of u there
         return 0.0, size * per_u
     return (0.0, size) if camera.type == "PERSP" else (size, 0.0)

@@ -255,7 +255,8 @@ class Integrator:
         py = (samples.index // w + y0) + 0.5 + off[:, 1]
         lens = sampler.get2d(samples.pixel, samples.sample, D.LENS) if self.plan.lens else None
         # the shutter is a dimension only when something moves
-        time = sampler.get(samples.pixel, samples.sample, D.TIME) if self.timed else np.zeros(n)
+        time = (camera_rays.shutter_time(self.camera, sampler.get(samples.pixel, samples.sample, D.TIME),
+                                         samples.index // w + y0) if self.timed else np.zeros(n))
         cam = camera_rays.generate(self.camera, px, py, lens, time if self.timed else None)
         self._count("camera", n)
         state = PathState(path=np.arange(n), origins=cam.origins, dirs=cam.directions, tmax=cam.tmax,
