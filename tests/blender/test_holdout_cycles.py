@@ -1,10 +1,13 @@
 """Holdouts against Cycles on a scene built for them: a ground lit by an area light and a sun; on
-it a sphere whose object is a holdout (a hole where the camera sees it, its shadow on the ground
-and its reflection in a mirror behind it as Cycles renders them), and a quad mixing a Holdout with
+it a sphere whose object is a holdout (a hole where the camera sees it, but for the 0.4 its
+Principled Alpha lets through to the ground; its shadow on the ground and its reflection in a
+mirror behind it as Cycles renders them), and a quad mixing a Holdout with
 a red Diffuse BSDF by a checker (0.25 and 0.75 held out). Compared on RGBA with Film Transparent
 on and off (Cycles takes the holdouts' share of alpha either way). The rule is
 procedural_scenes.parity's: DRT's worst 4x4-block difference from Cycles seed 0 within 1.5x
-Cycles' own seed-0-against-seed-1 worst plus 0.002."""
+Cycles' own seed-0-against-seed-1 worst plus 0.002. Measured (48 x 48, 128 samples): worst block
+0.0210, limit 0.0343 (Cycles' seeds 0.0216), Film Transparent on and off (alpha alone 0.0073 and
+0.0049); without holdouts 0.897; with the sphere held out whole (its Alpha ignored) 0.142."""
 from __future__ import annotations
 
 import bpy
@@ -63,7 +66,9 @@ def holdout_scene(transparent: bool):
     bpy.ops.mesh.primitive_plane_add(size=5.0)
     _placed(bpy.context.active_object, "Ground", ground)
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=(-0.6, 0.0, 0.6))
-    sphere = _placed(bpy.context.active_object, "Held", ground)
+    held = new_material("Held")
+    held.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.6
+    sphere = _placed(bpy.context.active_object, "Held", held)
     sphere.is_holdout = True
     bpy.ops.mesh.primitive_plane_add(size=1.4, location=(1.0, -0.6, 0.9), rotation=(1.2, 0.0, 0.2))
     _placed(bpy.context.active_object, "Mixed", _material("Mixed", "ShaderNodeHoldout", "ShaderNodeBsdfDiffuse"))
@@ -79,6 +84,7 @@ def test_holdouts_match_cycles(drt, tmp_path, transparent):
     scene = holdout_scene(transparent)
     image, cycles0, cycles1 = (rh.render(scene, engine, SAMPLES, seed, tmp_path, name="holdout").passes["Combined"]
                                for engine, seed in ps.RUNS)
-    assert (cycles0[..., 3] < 0.05).mean() > 0.02 and (abs(cycles0[..., 3] - 0.5) < 0.3).mean() > 0.02
+    alpha = cycles0[..., 3]
+    assert (alpha < 0.3).mean() > 0.01 and ((alpha > 0.3) & (alpha < 0.8)).mean() > 0.01  # holdouts seen
     figures = ps.parity(image, cycles0, cycles1)
     assert figures["ok"], ps.message(f"holdouts, Film Transparent {transparent} (RGBA)", figures)

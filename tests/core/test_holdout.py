@@ -68,3 +68,15 @@ def test_a_holdout_seen_through_a_transparent_surface():
     assert np.all(a_alone == 0.0) and np.all(background[..., 3] == 0.0)
     assert np.allclose(b_over_a[..., 3], 0.75, atol=1e-6)
     assert np.all(b_over_a[..., :3] > 0.0)
+
+
+def test_an_object_holdout_keeps_what_its_material_lets_through():
+    """B a quarter transparent, held out as an object: the rest of B is held out and A is seen
+    through the quarter, as with B's diffuse part replaced by a Holdout closure (Cycles'
+    surface_shader_apply_holdout)."""
+    clear = Closure("TRANSPARENT", weight=np.full(3, 0.25), color=(1.0, 1.0, 1.0))
+    held = render(scene([diffuse(0.75), clear], b_holdout=True), samples=32)
+    closure = render(scene([Closure("HOLDOUT", weight=np.full(3, 0.75)), clear]), samples=32)
+    assert np.allclose(held, closure, rtol=1e-6, atol=1e-7)
+    b_over_a = columns(held)[1]
+    assert np.allclose(b_over_a[..., 3], 0.25, atol=1e-6) and np.all(b_over_a[..., :3] > 0.0)

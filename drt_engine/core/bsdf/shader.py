@@ -548,6 +548,18 @@ class MaterialShader:
             taken.holdout = self.holdout[rows]
         return taken
 
+    def see_through_only(self) -> "MaterialShader":
+        """The shader with its transparent lobes alone, no emission: what an object holdout keeps
+        where the camera sees it (Cycles' surface_shader_apply_holdout)."""
+        keep = [l for l, lobe in enumerate(self.lobes) if lobe.kind == "transparent"]
+        clear = copy.copy(self)
+        clear.lobes = clear.sampled = [self.lobes[l] for l in keep]
+        clear.lp = np.ascontiguousarray(self.lp[keep])
+        clear.lp[:, layout.P_SAMPLED] = np.arange(len(keep))
+        clear.lt, clear.hp = np.ascontiguousarray(self.lt[keep]), np.ascontiguousarray(self.hp[:, keep])
+        clear.emission, clear.has_glass, clear.holds_out, clear.holdout = np.zeros(3), False, False, np.zeros(3)
+        return clear
+
     def holdout_weights(self, n) -> np.ndarray:
         """(n, 3) the Holdout closures' weight at each of the n hits of its binding."""
         return np.broadcast_to(self.holdout, (n, 3)) if self.holdout.ndim == 1 else self.holdout
