@@ -80,3 +80,11 @@ def test_an_object_holdout_keeps_what_its_material_lets_through():
     assert np.allclose(held, closure, rtol=1e-6, atol=1e-7)
     b_over_a = columns(held)[1]
     assert np.allclose(b_over_a[..., 3], 0.25, atol=1e-6) and np.all(b_over_a[..., :3] > 0.0)
+
+
+def test_a_hit_held_out_whole_writes_no_data_passes():
+    """Cycles writes Depth after the holdout: B held out whole leaves the background's depth."""
+    s = RenderSettings(samples=4, seed=1, threads=1, passes=("Combined", "Depth"), filter_type="BOX", filter_size=1.0)
+    depth = Renderer(scene([diffuse()], b_holdout=True), s).render().passes["Depth"][..., 0]
+    a_alone, b_over_a, background = columns(depth)
+    assert np.allclose(a_alone, 10.0) and np.all(b_over_a == background) and np.all(background >= 1e9)

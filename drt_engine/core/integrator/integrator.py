@@ -213,8 +213,6 @@ class Integrator:
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
             self._emission_seen(surf, state, hits, out)
-            if depth == 0:
-                self._first_hit_passes(surf, cam, hits.t[rows], out)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
@@ -226,7 +224,8 @@ class Integrator:
             light, start = self._sample_lights(lit) if lit else None, 0
             continued, queued = [], []
             for group, u_g, shader in bound:
-                if depth == 0:
+                if depth == 0:  # after the holdouts, as Cycles' film_write_data_passes
+                    self._first_hit_passes(group, cam, hits.t[group.row], out)
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
