@@ -56,11 +56,7 @@ def _placed(obj, name, mat):
 
 
 def holdout_scene(transparent: bool):
-    scene = ps._scene(SIZE, SIZE)
-    ps.aim(scene.camera, (0.0, -6.0, 4.0))
-    scene.camera.data.lens = 35.0
-    scene.render.film_transparent = transparent
-    ps.black_world(scene)
+    scene = ps.dark_scene(SIZE, (0.0, -6.0, 4.0), 35.0, transparent)
     ground = new_material("Ground")
     ground.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 1.0
     bpy.ops.mesh.primitive_plane_add(size=5.0)
