@@ -73,6 +73,7 @@ CLOSURE_KINDS = (
     "REFRACTION",  # refraction only, tinted by colour
     "EMISSION",  # emitted radiance ``emission``, two-sided
     "TRANSPARENT",  # straight through, tinted by colour
+    "HOLDOUT",  # no light: where the camera sees it, that share of the pixel is transparent (Cycles' holdout)
 )
 
 
@@ -214,6 +215,9 @@ class Instance:
     pass_index: int = 0
     random: float = 0.0
     """Object Info's Random: Cycles' per-object (or per-instance) random number in [0, 1]."""
+    holdout: bool = False
+    """The whole object is a holdout where the camera sees it (Cycles' object holdout); other
+    rays see it as it is."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)

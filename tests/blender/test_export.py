@@ -857,13 +857,12 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
 
 
 def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Ray visibility, holdout, shadow catcher, light linking and light groups change Cycles' image;
+    """Ray visibility, shadow catcher, light linking and light groups change Cycles' image;
     until DRT reads them, a scene using them says so (objects named, a long list cut short)."""
     scene = empty_scene()
     cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
     for cube in cubes[:5]:
         cube.visible_shadow = False
-    cubes[0].is_holdout = True
     cubes[1].is_shadow_catcher = True
     cubes[2].lightgroup = "key"
     cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
@@ -872,15 +871,14 @@ def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
     lamp.data.use_shadow = False
     data = render_export(scene)
     (warning,) = data.warnings
-    for expected in ("shadow ray visibility off ('Cube0', 'Cube1', 'Cube2' and 2 more)", "holdout ('Cube0')",
+    for expected in ("shadow ray visibility off ('Cube0', 'Cube1', 'Cube2' and 2 more)",
                      "shadow catcher ('Cube1')", "light group ('Cube2')", "light or shadow linking ('Cube3')",
                      f"glossy ray visibility off ('{lamp.name}')", f"cast shadow off ('{lamp.name}')"):
         assert expected in warning, warning
     assert "Cube5" not in warning and "camera ray" not in warning
     for cube in cubes[:5]:
         cube.visible_shadow = True
-    for cube, attribute, value in ((cubes[0], "is_holdout", False), (cubes[1], "is_shadow_catcher", False),
-                                   (cubes[2], "lightgroup", "")):
+    for cube, attribute, value in ((cubes[1], "is_shadow_catcher", False), (cubes[2], "lightgroup", "")):
         setattr(cube, attribute, value)
     cubes[3].light_linking.receiver_collection = None
     lamp.visible_glossy, lamp.data.use_shadow = True, True

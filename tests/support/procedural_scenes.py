@@ -210,6 +210,17 @@ def black_world(scene) -> None:
     scene.world = world
 
 
+def dark_scene(size: int, location, lens: float, transparent: bool):
+    """A ``size`` x ``size`` scene of a black world (``_scene``), its camera at ``location`` looking
+    at the origin through a ``lens`` mm lens, Film Transparent ``transparent``."""
+    scene = _scene(size, size)
+    aim(scene.camera, location)
+    scene.camera.data.lens = lens
+    scene.render.film_transparent = transparent
+    black_world(scene)
+    return scene
+
+
 def aim(camera, location) -> None:
     """Place ``camera`` at ``location`` looking at the origin, y up."""
     camera.location = location

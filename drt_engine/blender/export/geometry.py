@@ -316,8 +316,10 @@ class GeometryExporter:
     the same mesh different materials.
     """
 
-    def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None):
+    def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None,
+                 view_layer=None):
         self.materials = materials
+        self.view_layer = view_layer  # whose holdout collections make their objects holdouts
         self.cache = cache
         self.material_override = material_override
         self.meshes: list[Mesh] = []
@@ -390,8 +392,14 @@ class GeometryExporter:
                 random = object_random(obj.name, random_id)
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
-                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random))
+                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random,
+                                           holdout=self._holdout(parent or obj)))
             self.keys.append(key)
+
+    def _holdout(self, obj) -> bool:
+        """Whether Cycles holds the object out: its Holdout, or a holdout collection of the view
+        layer; an instance takes its instancer's (Cycles' sync_object reads the parent's)."""
+        return bool(obj.holdout_get(view_layer=self.view_layer))
 
     def _reads_object_info(self, slot_materials) -> bool:
         """Whether the slots' materials have an Object Info node, found once per set of slots (an

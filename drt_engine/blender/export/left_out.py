@@ -20,7 +20,6 @@ OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning cal
     ("visible_diffuse", True, "diffuse ray visibility off"),
     ("visible_glossy", True, "glossy ray visibility off"),
     ("visible_transmission", True, "transmission ray visibility off"),
-    ("is_holdout", False, "holdout"),
     ("is_shadow_catcher", False, "shadow catcher"),
 )
 LIGHT_SETTINGS = OBJECT_SETTINGS[2:5]

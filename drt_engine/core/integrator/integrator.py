@@ -39,6 +39,7 @@ from .aovs import ShaderAOVs, reach_scale
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_records
+from .holdout import Holdouts
 from .mis import add_emitted
 from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
@@ -153,6 +154,9 @@ class Integrator:
                          if self.diffuse else _NO_ROULETTE)
         # per material (and none): its hits draw lobe samples; with diffuse bounces, every lit one
         self.continues = prepared.continues | prepared.lit if self.diffuse else prepared.continues
+        held = np.array([i.holdout for i in scene.instances], bool)
+        self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
+            m.shader.holds_out for m in prepared.shading) else None
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
         self._rays_lock = threading.Lock()
 
@@ -209,18 +213,19 @@ class Integrator:
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
             self._emission_seen(surf, state, hits, out)
-            if depth == 0:
-                self._first_hit_passes(surf, cam, hits.t[rows], out)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
+            if self.holdouts is not None:
+                bound = self.holdouts.write(bound, out.alpha)
             lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
             light, start = self._sample_lights(lit) if lit else None, 0
             continued, queued = [], []
             for group, u_g, shader in bound:
-                if depth == 0:
+                if depth == 0:  # after the holdouts, as Cycles' film_write_data_passes
+                    self._first_hit_passes(group, cam, hits.t[group.row], out)
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
@@ -318,6 +323,8 @@ class Integrator:
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
         glows = self.lights.glows
         glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
+        if self.holdouts is not None and len(glowing):  # an object holdout the camera sees gives no light
+            glowing = glowing[~self.holdouts.whole(surf.take(glowing))]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]
