@@ -119,3 +119,20 @@ def test_emitter_hidden_from_diffuse_rays_lights_glossy_parts_only(emitter):
     full, partial = floor(GLOSSY_FLOOR), floor(GLOSSY_FLOOR, visible_diffuse=False)
     assert full.min() > 0 and np.allclose(partial, full)
     assert np.all(floor(GLOSSY_FLOOR, visible_glossy=False) == 0)
+
+
+
+def test_shadow_rays_through_a_transparent_sheet_pass_an_object_hidden_from_them():
+    """A transparent sheet under the occluder: the shadow rays it lets through (the transparent-shadow
+    queue) pass the occluder hidden from shadow rays as the plain occlusion queries do."""
+    def scene(occluder):
+        s = occluded_scene(visible_camera=False, visible_shadow=False)
+        s.materials.append(Material("sheet", [Closure("TRANSPARENT", color=(0.5, 0.5, 0.5))]))
+        s.meshes.append(square(0.6, 0.3, 1))  # below the occluder: the queue meets it
+        s.instances.append(Instance(2, np.eye(4), visible_camera=False))
+        if not occluder:
+            s.instances.pop(1)
+        return s
+
+    through = render(scene(occluder=True))
+    assert through[CENTRE, CENTRE].min() > 0 and np.allclose(through, render(scene(occluder=False)))
