@@ -39,24 +39,12 @@ def _principled(name, color, roughness=1.0, metallic=0.0, emission=None):
 
 
 def _add(name, mat, primitive, location, size, rotation=(0.0, 0.0, 0.0)):
-    getattr(bpy.ops.mesh, f"primitive_{primitive}_add")(size=size, location=location, rotation=rotation)
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(mat)
-    return obj
-
-
-def _scene():
-    scene = ps._scene(SIZE, SIZE)
-    ps.aim(scene.camera, (0.0, -6.0, 5.0))
-    scene.camera.data.lens = 40.0
-    scene.render.film_transparent = True
-    ps.black_world(scene)
-    return scene
+    return ps.add_primitive(getattr(bpy.ops.mesh, f"primitive_{primitive}_add"), mat, name, size=size,
+                            location=location, rotation=rotation)
 
 
 def mirror_scene():
-    scene = _scene()
+    scene = ps.oblique_scene(SIZE)
     ps.aim(scene.camera, (0.0, -4.0, 2.5))
     _add("Mirror", _principled("Mirror", (0.9, 0.9, 0.9), roughness=0.05, metallic=1.0), "plane", (0, 0, 0), 8.0)
     cube = _add("Cube", _principled("Red", (0.8, 0.1, 0.1), emission=1.0), "cube", (0.0, 0.3, 0.9), 1.0,
@@ -67,7 +55,7 @@ def mirror_scene():
 
 
 def shadow_scene():
-    scene = _scene()
+    scene = ps.oblique_scene(SIZE)
     _add("Ground", _principled("Ground", (0.8, 0.8, 0.8)), "plane", (0, 0, 0), 4.0)
     _add("Shadowless", _principled("Blue", (0.2, 0.3, 0.8)), "plane", (-0.9, 0.2, 1.0), 1.4, (0.2, 0, 0)
          ).visible_shadow = False
@@ -79,7 +67,7 @@ def shadow_scene():
 
 
 def light_scene():
-    scene = _scene()
+    scene = ps.oblique_scene(SIZE)
     _add("Ground", _principled("Shiny", (0.6, 0.5, 0.3), roughness=0.35), "plane", (0, 0, 0), 4.0)
     lamp = add_light(scene, "AREA", location=(0.8, 0.6, 2.0), rotation=(0.3, 0.0, 0.0), energy=300.0, size=0.8)
     lamp.visible_diffuse = False

@@ -216,6 +216,28 @@ def aim(camera, location) -> None:
     camera.rotation_euler = (-mathutils.Vector(camera.location)).to_track_quat("-Z", "Y").to_euler()
 
 
+def oblique_scene(size: int):
+    """A square scene seen from (0, -6, 5) at 40 mm under a black world, the film transparent (a
+    ground of 4 m about the origin fills the middle of the frame; alpha counts in parity)."""
+    scene = _scene(size, size)
+    aim(scene.camera, (0.0, -6.0, 5.0))
+    scene.camera.data.lens = 40.0
+    scene.render.film_transparent = True
+    black_world(scene)
+    return scene
+
+
+def add_primitive(op, mat, name=None, **kw):
+    """The mesh primitive the operator ``op`` (bpy.ops.mesh.primitive_*_add) makes from ``kw``,
+    with material ``mat`` (and ``name``)."""
+    op(**kw)
+    obj = bpy.context.active_object
+    if name is not None:
+        obj.name = name
+    obj.data.materials.append(mat)
+    return obj
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))
