@@ -6,6 +6,7 @@ import pytest
 
 from drt_engine.core.geometry import embree
 from drt_engine.core.geometry.visibility import CAMERA, DIFFUSE, GLOSSY, SHADOW, TRANSMIT
+from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, Mesh, SceneData
 from drt_engine.core.settings import RenderSettings
@@ -136,3 +137,10 @@ def test_shadow_rays_through_a_transparent_sheet_pass_an_object_hidden_from_them
 
     through = render(scene(occluder=True))
     assert through[CENTRE, CENTRE].min() > 0 and np.allclose(through, render(scene(occluder=False)))
+
+
+def test_emissive_object_no_bsdf_ray_sees_is_no_light():
+    """Left out of light sampling, as Cycles leaves it out of its light distribution: it lights nothing."""
+    visibility = dict(visible_diffuse=False, visible_glossy=False, visible_transmission=False)
+    assert len(PreparedScene(lit_from_above(DIFFUSE_FLOOR, visible_diffuse=False)).lights.emissive) == 2
+    assert len(PreparedScene(lit_from_above(DIFFUSE_FLOOR, **visibility)).lights.emissive) == 0

@@ -107,7 +107,7 @@ class Lights:
         self.glows = (self.emission.max(axis=1) > 0) | np.isin(np.arange(len(shaders)), self.textured)
         """Per material: whether its surface emits where a ray hits it."""
         self.attributes = SurfaceAttributes(scene, geometry) if self.textured else None
-        self._emitters(geometry)
+        self._emitters(geometry, scene)
         self._excludes(scene, geometry)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
@@ -144,11 +144,15 @@ class Lights:
         self._moving_hittable = [i for i in hittable if i in self.motions]
         self._moving_suns = [i for i in suns if i in self.motions]
 
-    def _emitters(self, geometry) -> None:
+    def _emitters(self, geometry, scene: SceneData) -> None:
         """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
         each picked by its power (``emissive_cdf``, ``emissive_prob``), with its world corners,
-        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order)."""
+        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order). Triangles
+        of objects no BSDF ray sees light nothing, and are left out (Cycles' usable_as_light)."""
         tris = geometry.triangles_with(np.flatnonzero(self.glows))
+        lighting = np.array([i.visible_diffuse or i.visible_glossy or i.visible_transmission for i in scene.instances],
+                            bool)
+        tris = tris[lighting[geometry.source_of(tris)[:, 0]]] if len(tris) and not lighting.all() else tris
         corners = geometry.world_corners(tris)
         ng, area = geometry.world_normals(tris, corners)
         mats = geometry.material_of(tris)
