@@ -144,3 +144,16 @@ def test_emissive_object_no_bsdf_ray_sees_is_no_light():
     visibility = dict(visible_diffuse=False, visible_glossy=False, visible_transmission=False)
     assert len(PreparedScene(lit_from_above(DIFFUSE_FLOOR, visible_diffuse=False)).lights.emissive) == 2
     assert len(PreparedScene(lit_from_above(DIFFUSE_FLOOR, **visibility)).lights.emissive) == 0
+
+
+@pytest.mark.parametrize("hidden, dark", [("visible_transmission", True), ("visible_glossy", False)])
+def test_object_hidden_from_transmission_is_not_seen_through_glass(hidden, dark):
+    """Rays refracted into a glass sheet are transmission rays: they pass a glowing square hidden
+    from transmission (and see it when only glossy rays may not)."""
+    glass = Material("glass", [Closure("REFRACTION", color=(1, 1, 1), roughness=0.0, ior=1.5)])
+    glowing = Material("glow", [Closure("EMISSION", emission=(1.0, 1.0, 1.0))])
+    scene = SceneData(camera=ortho_top(RES, half=1.0, height=2.0), meshes=[square(2.0, 1.0, 0), square(2.0, 0.0, 1)],
+                      instances=[Instance(0, np.eye(4)), Instance(1, np.eye(4), **{hidden: False})],
+                      materials=[glass, glowing])
+    image = render(scene, 4)
+    assert np.all(image == 0) if dark else image.min() > 0.4  # 1 / 1.5² of it, seen from inside the glass
