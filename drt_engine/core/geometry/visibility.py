@@ -3,7 +3,7 @@ see it, each ray the bit of its kind, and Embree skips an instance whose mask sh
 the ray's (Cycles' object visibility in its BVH). Rays of a scene whose objects are all fully
 visible keep ``EVERY`` and cost what they did.
 
-Measured on embreex 4.4's libembree4 (tests/core/test_visibility.py): ray masks are honoured on
+Measured on embreex 4.4's libembree4 (tests/core/test_ray_visibility.py): ray masks are honoured on
 instances; a geometry's default mask is 1, so the meshes under instances get every bit."""
 from __future__ import annotations
 

@@ -492,8 +492,8 @@ class Integrator:
             _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
-            geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
-            visibility, clear, allowed, qf, qi)
+            geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
+            wave.radiance, f_diff, visibility, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility)

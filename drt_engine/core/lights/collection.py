@@ -22,9 +22,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..base.colour import LUMINANCE
-from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..base.constants import TINY
 from ..base.jit import kernel
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
