@@ -23,11 +23,8 @@ SAMPLES = 128
 
 
 def _quad(name, mat, location, size, rotation=(0.0, 0.0, 0.0)):
-    bpy.ops.mesh.primitive_plane_add(size=size, location=location, rotation=rotation)
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(mat)
-    return obj
+    return ps.add_primitive(bpy.ops.mesh.primitive_plane_add, mat, name, size=size, location=location,
+                            rotation=rotation)
 
 
 def _checker_alpha():

@@ -227,6 +227,17 @@ def aim(camera, location) -> None:
     camera.rotation_euler = (-mathutils.Vector(camera.location)).to_track_quat("-Z", "Y").to_euler()
 
 
+def add_primitive(op, mat, name=None, **kw):
+    """The mesh primitive the operator ``op`` (bpy.ops.mesh.primitive_*_add) makes from ``kw``,
+    with material ``mat`` (and ``name``)."""
+    op(**kw)
+    obj = bpy.context.active_object
+    if name is not None:
+        obj.name = name
+    obj.data.materials.append(mat)
+    return obj
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))

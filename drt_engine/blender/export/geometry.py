@@ -393,7 +393,7 @@ class GeometryExporter:
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
                                            color=tuple(obj.color), pass_index=obj.pass_index, random=random,
-                                           holdout=self._holdout(parent or obj)))
+                                           holdout=self._holdout(parent or obj), **ray_visibility(obj, parent)))
             self.keys.append(key)
 
     def _holdout(self, obj) -> bool:
@@ -459,3 +459,13 @@ class GeometryExporter:
             self.cache.put(cache_key, mesh, obj)
         self.meshes.append(mesh)
         return len(self.meshes) - 1
+
+
+RAY_KINDS = ("camera", "shadow", "diffuse", "glossy", "transmission")
+
+
+def ray_visibility(obj, parent=None) -> dict:
+    """The object's ray visibility as ``Instance`` fields; an instance is seen by the rays that see
+    both it and its instancer, as Cycles syncs it (object_ray_visibility of both)."""
+    return {f"visible_{kind}": bool(getattr(obj, f"visible_{kind}", True))
+            and (parent is None or bool(getattr(parent, f"visible_{kind}", True))) for kind in RAY_KINDS}
