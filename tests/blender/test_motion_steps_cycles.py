@@ -11,7 +11,6 @@ shutter curve's table, export.camera).
 """
 from __future__ import annotations
 
-import bpy
 import numpy as np
 import pytest
 from conftest import emission_material
@@ -27,13 +26,7 @@ def eased_edge_scene(steps: int = 1):
     """A glowing half-plane x < X(t) under an orthographic camera 2 m wide (64 x 32 px), keyed at
     x = -1.5 on frame 0 and +1.5 on frame 2 with Blender's default (eased) interpolation, blurred
     over one frame at frame 1 with the object's motion Steps ``steps``."""
-    scene = ps._scene(64, 32)
-    ps.black_world(scene)
-    mesh = bpy.data.meshes.new("edge")
-    mesh.from_pydata([(-50, -50, 0), (0, -50, 0), (0, 50, 0), (-50, 50, 0)], [], [(0, 1, 2, 3)])
-    mesh.materials.append(emission_material(1.0))
-    edge = bpy.data.objects.new("edge", mesh)
-    scene.collection.objects.link(edge)
+    scene, edge = ps.glowing_half_plane(lambda: emission_material(1.0))
     for frame in (0, 2):
         edge.location.x = 1.5 * (frame - 1)
         edge.keyframe_insert("location", index=0, frame=frame)

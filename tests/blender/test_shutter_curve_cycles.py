@@ -13,7 +13,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import bpy
 import pytest
 from conftest import emission_material
 
@@ -43,13 +42,7 @@ def sliding_edge_scene(curve=None, rolling=None, camera_moves=False):
     """A glowing half-plane x < X(t) sliding 1.5 m per frame (linear keys, frame 1 blurred over one
     frame) under an orthographic camera 2 m wide (64 x 32 pixels); ``camera_moves``: the half-plane
     still and a fisheye (fov 2 radians) 1 m above it sliding 0.6 m per frame the other way."""
-    scene = ps._scene(64, 32)
-    ps.black_world(scene)
-    mesh = bpy.data.meshes.new("edge")
-    mesh.from_pydata([(-50, -50, 0), (0, -50, 0), (0, 50, 0), (-50, 50, 0)], [], [(0, 1, 2, 3)])
-    mesh.materials.append(emission_material(1.0))
-    edge = bpy.data.objects.new("edge", mesh)
-    scene.collection.objects.link(edge)
+    scene, edge = ps.glowing_half_plane(lambda: emission_material(1.0))
     cam = scene.camera
     cam.location, cam.rotation_euler = (0.0, 0.0, 1.0 if camera_moves else 5.0), (0.0, 0.0, 0.0)
     if camera_moves:

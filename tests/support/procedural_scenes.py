@@ -210,6 +210,20 @@ def black_world(scene) -> None:
     scene.world = world
 
 
+def glowing_half_plane(make_material):
+    """A 64 x 32 scene under a black world and in it the half-plane x < 0 (z = 0) of the material
+    ``make_material()`` makes (after the scene, which starts from Blender's factory state),
+    returned with it: the edge the motion-blur comparisons slide."""
+    scene = _scene(64, 32)
+    black_world(scene)
+    mesh = bpy.data.meshes.new("edge")
+    mesh.from_pydata([(-50, -50, 0), (0, -50, 0), (0, 50, 0), (-50, 50, 0)], [], [(0, 1, 2, 3)])
+    mesh.materials.append(make_material())
+    edge = bpy.data.objects.new("edge", mesh)
+    scene.collection.objects.link(edge)
+    return scene, edge
+
+
 def dark_scene(size: int, location, lens: float, transparent: bool):
     """A ``size`` x ``size`` scene of a black world (``_scene``), its camera at ``location`` looking
     at the origin through a ``lens`` mm lens, Film Transparent ``transparent``."""
