@@ -196,12 +196,11 @@ def test_no_camera(bl, tmp_path):
 
 def test_scene_the_engine_rejects(bl, tmp_path):
     scene = bl.emission_scene()
-    scene.camera.data.type = "PANO"
-    scene.camera.data.panorama_type = "FISHEYE_LENS_POLYNOMIAL"
-    path = tmp_path / "panorama.blend"
+    scene.camera = next(obj for obj in scene.objects if obj.type == "MESH")
+    path = tmp_path / "mesh_camera.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
     out = tmp_path / "o.exr"
-    assert_one_line_error(run_cli("render", path, "-o", out), "render failed", "panorama type FISHEYE_LENS_POLYNOMIAL")
+    assert_one_line_error(run_cli("render", path, "-o", out), "render failed", "is not a camera object")
     assert not out.exists()
 
 
