@@ -1,11 +1,15 @@
 """The Toon BSDF against Cycles: two smooth spheres under an area light and a point light, one a
 diffuse toon (Size 0.5, Smooth 0.1: lit flat out to 45 degrees from the light, fading to dark by
 54), one a glossy toon (Size 0.15, Smooth 0.1: flat highlights about the lights' mirror directions,
-and the diffuse toon sphere seen in it through glossy rays).
+and the diffuse toon sphere seen in it through glossy rays); and with diffuse bounces 2 over a
+grey floor.
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the Toon BSDF left out
-(rendered default grey, as before DRT had it) must fail that limit."""
+(rendered default grey, as before DRT had it) must fail that limit, and so must DRT without the
+diffuse bounces. Measured (64x32 px, 256 spp): 0.0276 against a limit of 0.0415 (Cycles' seeds
+0.0264), left grey 1.027; with diffuse bounces 2 over the floor 0.0276 against 0.0416, without
+them 0.630 (the diffuse toon sphere's underside, lit by the floor through its cone)."""
 from __future__ import annotations
 
 import bpy
@@ -51,7 +55,19 @@ def _light(scene, name, kind, energy, location, size=0.0):
     scene.collection.objects.link(light)
 
 
-def toon_scene():
+def _floor():
+    """A 20 m grey Diffuse floor under the spheres, which lights them from below through diffuse bounces."""
+    material = new_material("Floor")
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    tree.links.new(diffuse.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    bpy.ops.mesh.primitive_plane_add(size=20.0, location=(0.0, 0.0, -1.0))
+    bpy.context.active_object.data.materials.append(material)
+
+
+def toon_scene(floor=False):
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -7.0, 1.5))
     scene.camera.data.lens = 50.0
@@ -60,17 +76,37 @@ def toon_scene():
     _light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
     _sphere("Diffuse toon", -1.1, _toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1))
     _sphere("Glossy toon", 1.1, _toon_material("Glossy toon", "GLOSSY", (0.6, 0.8, 0.9, 1.0), 0.15, 0.1))
+    if floor:
+        _floor()
     return scene
+
+
+def _parity(scene, tmp_path, name):
+    drt, cycles0, cycles1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=name) for engine, seed in ps.RUNS]
+    figures = ps.parity(drt.rgb, cycles0.rgb, cycles1.rgb)
+    print(name, figures)
+    assert figures["ok"], ps.message(name, figures)
+    return cycles0, cycles1
 
 
 def test_toon_bsdf_matches_cycles(drt, tmp_path, monkeypatch):
     scene = toon_scene()
-    drt, cycles0, cycles1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name="toon") for engine, seed in ps.RUNS]
-    figures = ps.parity(drt.rgb, cycles0.rgb, cycles1.rgb)
-    print("toon", figures)
-    assert figures["ok"], ps.message("toon", figures)
+    cycles0, cycles1 = _parity(scene, tmp_path, "toon")
     monkeypatch.delitem(export_materials.CLOSURE_NODES, "ShaderNodeBsdfToon")
     grey = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="grey")
     off = ps.parity(grey.rgb, cycles0.rgb, cycles1.rgb)
     print("left grey", off)
     assert not off["ok"], f"the Toon BSDF left grey passes too: {off}"
+
+
+def test_toon_bsdf_with_diffuse_bounces_matches_cycles(drt, tmp_path):
+    """With diffuse bounces on, paths continue through the diffuse toon too (sampled in its cone):
+    over a grey floor that lights the spheres from below; without the bounces DRT must fail."""
+    scene = toon_scene(floor=True)
+    scene.drt.diffuse_bounces = 2
+    cycles0, cycles1 = _parity(scene, tmp_path, "toon-bounces")
+    scene.drt.diffuse_bounces = 0
+    direct = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="direct")
+    off = ps.parity(direct.rgb, cycles0.rgb, cycles1.rgb)
+    print("without diffuse bounces", off)
+    assert not off["ok"], f"the render without diffuse bounces passes too: {off}"

@@ -96,15 +96,15 @@ def test_density_integrates_to_one_and_the_value_to_the_mean_intensity(kind, siz
     d_omega = (np.sin(t) * (np.pi / 2 / nt) * (2 * np.pi / nphi)).reshape(-1)
     wo = np.broadcast_to([0.0, 0.0, 1.0], wi.shape).copy()
     n = len(wi)
-    bits_sel = np.ones((n, len(shader.sampled)))
-    ev = shader.evaluate(wo, wi, np.ones(n, bool), np.zeros(n, bool), sel=bits_sel)
+    ev = shader.evaluate(wo, wi, np.ones(n, bool), np.zeros(n, bool), sel=np.ones((n, len(shader.sampled))))
     value = ev.diffuse if kind == "DIFFUSE_TOON" else ev.glossy
     cone = _cone(size, smooth)
     pdf = np.where(t.reshape(-1) < cone, _cone_pdf(size, smooth), 0.0)
     if kind == "GLOSSY_TOON":  # the mixture's density is the glossy lobe's
         np.testing.assert_allclose(ev.pdf, pdf, rtol=1e-9, atol=1e-12)
     assert np.sum(pdf * d_omega) == pytest.approx(1.0, abs=2e-3)
-    mean = np.sum(_intensity(theta, size, smooth) * np.sin(theta) * (theta < cone)) / np.sum(np.sin(theta) * (theta < cone))
+    inside = np.sin(theta) * (theta < cone)
+    mean = np.sum(_intensity(theta, size, smooth) * inside) / np.sum(inside)
     np.testing.assert_allclose(np.sum(value * d_omega[:, None], 0), COLOUR * mean, rtol=3e-3)
 
 

@@ -58,9 +58,9 @@ DENOISE_ROUGH = 0.075
 def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
     """(diffuse-like albedo RGB, specular-like albedo RGB, whether the hit is diffuse-like enough
     to take the denoising features), by Cycles' rule: each lobe's albedo goes to one side by its
-    roughness (the glossy toon's counts as 1, as Cycles' bsdf_get_specular_roughness_squared
-    has it for a closure that is not microfacet), and the hit waits for the next bounce if 75% or more of the lobes' weight (the
-    mean of their albedos) is specular-like."""
+    roughness (the glossy toon's counts as 1, as Cycles' bsdf_get_specular_roughness_squared has
+    it for a closure that is not microfacet), and the hit waits for the next bounce if 75% or more
+    of the lobes' weight (the mean of their albedos) is specular-like."""
     j, t = locate(mu, mu_o)
     d0 = d1 = d2 = s0 = s1 = s2 = 0.0
     total = diffuse = 0.0
