@@ -1,6 +1,6 @@
 """The Toon BSDF against Cycles: two smooth spheres under an area light and a point light, one a
-diffuse toon (Size 0.5, Smooth 0.1: lit flat out to 45 degrees from the light, fading to dark by
-54), one a glossy toon (Size 0.15, Smooth 0.1: flat highlights about the lights' mirror directions,
+diffuse toon (Size from a texture, 0.3 on its lower half and 0.6 on its upper, Smooth 0.1: lit flat
+out to 27 or 54 degrees from the light, fading to dark 9 degrees further), one a glossy toon (Size 0.15, Smooth 0.1: flat highlights about the lights' mirror directions,
 and the diffuse toon sphere seen in it through glossy rays); and with diffuse bounces 2 over a
 grey floor.
 
@@ -8,8 +8,8 @@ Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the Toon BSDF left out
 (rendered default grey, as before DRT had it) must fail that limit, and so must DRT without the
 diffuse bounces. Measured (64x32 px, 256 spp): 0.0276 against a limit of 0.0415 (Cycles' seeds
-0.0264), left grey 1.027; with diffuse bounces 2 over the floor 0.0276 against 0.0416, without
-them 0.630 (the diffuse toon sphere's underside, lit by the floor through its cone)."""
+0.0264), left grey 1.097; with diffuse bounces 2 over the floor 0.0276 against 0.0416, without
+them 0.668 (the diffuse toon sphere's underside, lit by the floor through its cone)."""
 from __future__ import annotations
 
 import bpy
@@ -33,6 +33,25 @@ def _toon_material(name, component, colour, size, smooth):
     toon.inputs["Size"].default_value = size
     toon.inputs["Smooth"].default_value = smooth
     tree.links.new(toon.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    return material
+
+
+def _stepped_size(material):
+    """The toon's Size from a texture: 0.3 on the sphere's lower half, 0.6 on its upper (Generated z)."""
+    tree = material.node_tree
+    toon = tree.nodes["Toon BSDF"]
+    z = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(tree.nodes.new("ShaderNodeTexCoord").outputs["Generated"], z.inputs[0])
+    step = tree.nodes.new("ShaderNodeMath")
+    step.operation = "GREATER_THAN"
+    step.inputs[1].default_value = 0.5
+    tree.links.new(z.outputs["Z"], step.inputs[0])
+    size = tree.nodes.new("ShaderNodeMath")
+    size.operation = "MULTIPLY_ADD"
+    size.inputs[1].default_value = 0.3
+    size.inputs[2].default_value = 0.3
+    tree.links.new(step.outputs[0], size.inputs[0])
+    tree.links.new(size.outputs[0], toon.inputs["Size"])
     return material
 
 
@@ -74,7 +93,8 @@ def toon_scene(floor=False):
     ps.black_world(scene)
     _light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
     _light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
-    _sphere("Diffuse toon", -1.1, _toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1))
+    _sphere("Diffuse toon", -1.1,
+            _stepped_size(_toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1)))
     _sphere("Glossy toon", 1.1, _toon_material("Glossy toon", "GLOSSY", (0.6, 0.8, 0.9, 1.0), 0.15, 0.1))
     if floor:
         _floor()
