@@ -1,8 +1,8 @@
 """The Toon BSDF against Cycles: two smooth spheres under an area light and a point light, one a
 diffuse toon (Size from a texture, 0.3 on its lower half and 0.6 on its upper, Smooth 0.1: lit flat
-out to 27 or 54 degrees from the light, fading to dark 9 degrees further), one a glossy toon (Size 0.15, Smooth 0.1: flat highlights about the lights' mirror directions,
-and the diffuse toon sphere seen in it through glossy rays); and with diffuse bounces 2 over a
-grey floor.
+out to 27 or 54 degrees from the light, fading to dark 9 degrees further), one a glossy toon (Size
+0.15, Smooth 0.1: flat highlights about the lights' mirror directions, and the diffuse toon sphere
+seen in it through glossy rays); and with diffuse bounces 2 over a grey floor.
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the Toon BSDF left out
