@@ -123,3 +123,18 @@ def test_size_and_smooth_are_clamped_as_cycles_sets_them():
     assert toon_angles(0.0, -1.0) == pytest.approx((1e-5 * np.pi / 2, 0.0))
     assert toon_angles(3.0, 2.0) == pytest.approx((np.pi / 2, np.pi / 2))
     assert toon_angles(0.5, 0.25) == pytest.approx((np.pi / 4, np.pi / 8))
+
+
+def test_pass_colours_take_the_toon_colour_on_its_side():
+    """DiffCol takes the diffuse toon's colour and GlossCol the glossy toon's (Cycles' albedo of a
+    closure without tables is its weight); both count as diffuse-like for the denoising albedo
+    (roughness 1 for a closure that is not microfacet)."""
+    mu = np.array([0.2, 0.7, 1.0])
+    for kind, side in (("DIFFUSE_TOON", 0), ("GLOSSY_TOON", 1)):
+        shader = _shader(kind, 0.4, 0.2)
+        colours = shader.colors(mu)
+        np.testing.assert_allclose(colours[side], np.broadcast_to(COLOUR, (3, 3)))
+        assert not np.any(colours[1 - side])
+        diffuse_like, specular_like, take = shader.denoising_albedos(mu, np.zeros(3, bool))
+        np.testing.assert_allclose(diffuse_like, np.broadcast_to(COLOUR, (3, 3)))
+        assert not np.any(specular_like) and np.all(take)
