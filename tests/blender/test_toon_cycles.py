@@ -17,22 +17,14 @@ import bpy
 from drt_engine.blender.export import materials as export_materials
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
-from tests.support.datablocks import new_material
 
 WIDTH, HEIGHT = 64, 32
 SAMPLES = 256
 
 
 def _toon_material(name, component, colour, size, smooth):
-    material = new_material(name)
-    tree = material.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    toon = tree.nodes.new("ShaderNodeBsdfToon")
+    material, toon = ps.closure_material(name, "ShaderNodeBsdfToon", Color=colour, Size=size, Smooth=smooth)
     toon.component = component
-    toon.inputs["Color"].default_value = colour
-    toon.inputs["Size"].default_value = size
-    toon.inputs["Smooth"].default_value = smooth
-    tree.links.new(toon.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
     return material
 
 
@@ -55,14 +47,6 @@ def _stepped_size(material):
     return material
 
 
-def _sphere(name, x, material):
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(x, 0.0, 0.0), segments=64, ring_count=32)
-    bpy.ops.object.shade_smooth()
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(material)
-
-
 def _light(scene, name, kind, energy, location, size=0.0):
     light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
     light.data.energy = energy
@@ -76,12 +60,7 @@ def _light(scene, name, kind, energy, location, size=0.0):
 
 def _floor():
     """A 20 m grey Diffuse floor under the spheres, which lights them from below through diffuse bounces."""
-    material = new_material("Floor")
-    tree = material.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
-    tree.links.new(diffuse.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    material, _ = ps.closure_material("Floor", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
     bpy.ops.mesh.primitive_plane_add(size=20.0, location=(0.0, 0.0, -1.0))
     bpy.context.active_object.data.materials.append(material)
 
@@ -93,9 +72,9 @@ def toon_scene(floor=False):
     ps.black_world(scene)
     _light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
     _light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
-    _sphere("Diffuse toon", -1.1,
-            _stepped_size(_toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1)))
-    _sphere("Glossy toon", 1.1, _toon_material("Glossy toon", "GLOSSY", (0.6, 0.8, 0.9, 1.0), 0.15, 0.1))
+    ps.smooth_sphere("Diffuse toon", -1.1,
+                     _stepped_size(_toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1)))
+    ps.smooth_sphere("Glossy toon", 1.1, _toon_material("Glossy toon", "GLOSSY", (0.6, 0.8, 0.9, 1.0), 0.15, 0.1))
     if floor:
         _floor()
     return scene
