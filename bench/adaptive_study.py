@@ -11,6 +11,8 @@ adaptive render ends sooner, every pixel under the threshold, uniform is read at
 ``calibration``: at every logged step of uniform and default-adaptive renders, the
 estimated relMSE (``adaptive.image_error``) against the true one, each averaged over the
 seeds at the k-th step; and renders with ``target_error`` set, their true relMSE at the stop.
+``--diffuse-bounces N`` measures it with light bouncing off diffuse surfaces (its own results,
+references and docs block ``adaptive-calibration-gi``).
 
 Writes bench/results/adaptive_<what>.json; ``--publish`` also writes the table into docs/adaptive-sampling.md's
 block ``adaptive-<what>`` (bench/blocks.py) and the measurements to bench/adaptive_<what>.json
@@ -43,10 +45,17 @@ TARGETS = (3e-3, 1e-3)
 
 
 def reference(name, data, base):
-    """The scene's 2048-sample reference and its estimated variance, cached per scene and size."""
+    """The scene's 2048-sample reference and its estimated variance, cached per scene, size and
+    diffuse bounces."""
     w, h = data.camera.window_size
     settings = RenderSettings(samples=REFERENCE_SAMPLES, seed=1 << 20, **{**base, "passes": ("Combined", "Noise")})
-    return cached_reference(OUT / f"reference_{name}_{w}x{h}.npz", Renderer(data, settings).render)
+    return cached_reference(OUT / f"reference_{name}_{w}x{h}{_gi(base.get('diffuse_bounces', 0))}.npz",
+                            Renderer(data, settings).render)
+
+
+def _gi(bounces: int) -> str:
+    """The file and block suffix of measurements with diffuse bounces."""
+    return f"_diffuse{bounces}" if bounces else ""
 
 
 def steps(data, settings, truth):
@@ -77,7 +86,7 @@ def log_interp(points, t):
     return float(np.exp(np.interp(math.log(t), ts, es)))
 
 
-def sample_scenes(width, names):
+def sample_scenes(width, names, diffuse_bounces=0):
     import drt_engine
     from scenes import load
 
@@ -85,7 +94,8 @@ def sample_scenes(width, names):
     for name in names:
         scene, data = load(name, width)
         base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
-                    filter_size=scene.render.filter_size, threads=0)
+                    filter_size=scene.render.filter_size, threads=0,
+                    **({"diffuse_bounces": diffuse_bounces} if diffuse_bounces else {}))
         yield name, data, base, scene.drt.samples
 
 
@@ -149,7 +159,7 @@ def calibration_rows(name, data, base, samples, seeds, cap):
 
 def calibration(args):
     rows = []
-    for name, data, base, samples in sample_scenes(args.width, args.scenes):
+    for name, data, base, samples in sample_scenes(args.width, args.scenes, args.diffuse_bounces):
         rows += calibration_rows(name, data, base, samples, range(args.seeds), args.cap)
     return rows
 
@@ -194,15 +204,18 @@ def main(argv=None):
     parser.add_argument("--min-samples", type=int, default=0, help="adaptive Min Samples (0: automatic, the default)")
     parser.add_argument("--soft-thresholds", type=float, nargs="*", default=[None],
                         help="noise thresholds of the soft-shadow rows (default: the default threshold only)")
+    parser.add_argument("--diffuse-bounces", type=int, default=0, help="calibration with light bouncing off diffuse "
+                        "surfaces (its own results and docs block)")
     parser.add_argument("--publish", action="store_true", help="also write docs/adaptive-sampling.md's block and bench/adaptive_<what>.json")
     parser.add_argument("--publish-only", action="store_true", help="publish the last run's results without rendering")
     parser.add_argument("--append", action="store_true", help="add this run's rows to the last run's saved results "
                         "(scenes run one process each)")
     args = parser.parse_args(argv)
-    saved = OUT / f"adaptive_{args.what}.json"
+    gi = _gi(getattr(args, "diffuse_bounces", 0))
+    saved = OUT / f"adaptive_{args.what}{gi}.json"
     if args.publish_only:
         found = json.loads(saved.read_text())
-        args, rows = argparse.Namespace(**found["args"]), found["rows"]
+        args, rows = argparse.Namespace(**{"diffuse_bounces": 0, **found["args"]}), found["rows"]
         args.publish = True
     else:
         rows = gain(args) if args.what == "gain" else calibration(args)
@@ -214,15 +227,18 @@ def main(argv=None):
     text = gain_table(rows) if args.what == "gain" else calibration_table(rows)
     print(text)
     if args.publish:
-        (ROOT / "bench" / f"adaptive_{args.what}.json").write_text(saved.read_text())
+        (ROOT / "bench" / f"adaptive_{args.what}{gi}.json").write_text(saved.read_text())
         made = json.loads(saved.read_text()).get("made") or time.strftime(
             "%Y-%m-%d %H:%M UTC", time.gmtime(saved.stat().st_mtime))
         if args.what == "gain":
             setup = (f"the sample scenes at {args.width} px wide, the soft-shadow scene at {args.soft_width} px "
                      f"under a {args.time_limit:g} s limit")
         else:
-            setup = f"{args.width} px wide, uniform and adaptive renders to {args.cap} spp, target-error stops"
-        write_block(f"adaptive-{args.what}", f"Measured by `python bench/adaptive_study.py {args.what}` on {made}: "
+            setup = (f"{args.width} px wide, uniform and adaptive renders to {args.cap} spp, target-error stops"
+                     + (f", diffuse bounces {args.diffuse_bounces}" if args.diffuse_bounces else ""))
+        command = f"{args.what}" + (f" --diffuse-bounces {args.diffuse_bounces}" if args.diffuse_bounces else "")
+        write_block(f"adaptive-{args.what}" + ("-gi" if gi else ""),
+                    f"Measured by `python bench/adaptive_study.py {command}` on {made}: "
                     f"{setup}, {args.seeds} seeds pooled, references {REFERENCE_SAMPLES} spp.\n\n{text}")
 
 

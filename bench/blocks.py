@@ -17,6 +17,7 @@ PAGES = {  # bench:NAME block -> the docs page that holds it
     "preview-times": DOCS / "performance.md",
     "instances": DOCS / "performance.md",
     "adaptive-calibration": DOCS / "adaptive-sampling.md",
+    "adaptive-calibration-gi": DOCS / "adaptive-sampling.md",
     "adaptive-gain": DOCS / "adaptive-sampling.md",
     "bench-adaptive": DOCS / "adaptive-sampling.md",
     "ratio": DOCS / "ratio-estimator.md",

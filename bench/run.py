@@ -140,8 +140,9 @@ def envelope(points):
     return front
 
 
-def bench_scene(name, width, ref_samples, cap, out_dir, tmp):
+def bench_scene(name, width, ref_samples, cap, out_dir, tmp, diffuse_bounces=0):
     scene, data = load(name, width)
+    scene.drt.diffuse_bounces = diffuse_bounces  # both renderers' (configure_cycles gives Cycles DRT's)
     r = scene.render
     curves = {}
     log = print
@@ -312,6 +313,8 @@ def main(argv=None):
     parser.add_argument("--cap", type=int, default=GRID_COUNTS[-1])
     parser.add_argument("--scenes", nargs="*", default=SCENES)
     parser.add_argument("--out", default=str(ROOT / "bench" / "results"))
+    parser.add_argument("--diffuse-bounces", type=int, default=0, help="light bouncing off diffuse surfaces, in both "
+                        "renderers (not published: --out another folder)")
     parser.add_argument("--publish", action="store_true", help="also write bench/RESULTS.md, the plots in "
                         "bench/plots/ and docs/adaptive-sampling.md's adaptive benchmark block (committed)")
     args = parser.parse_args(argv)
@@ -322,7 +325,8 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.scenes:
             print(f"{name}:", flush=True)
-            results[name] = bench_scene(name, args.width, args.reference_samples, args.cap, out_dir, tmp)
+            results[name] = bench_scene(name, args.width, args.reference_samples, args.cap, out_dir, tmp,
+                                        args.diffuse_bounces)
     text = table(results, args.width, args.reference_samples, args.cap)
     (out_dir / "RESULTS.md").write_text(text)
     print(text)

@@ -29,8 +29,9 @@ def load(name, width, height=None):
 
 
 def settings(scene, **kw) -> RenderSettings:
-    """DRT's settings for the scene: its depth and pixel filter, Combined only unless ``kw`` says."""
-    base = dict(max_depth=scene.drt.max_depth, filter_type=scene.drt.filter_type,
+    """DRT's settings for the scene: its depth, diffuse bounces and pixel filter, Combined only unless
+    ``kw`` says."""
+    base = dict(max_depth=scene.drt.max_depth, diffuse_bounces=scene.drt.diffuse_bounces, filter_type=scene.drt.filter_type,
                 filter_size=scene.render.filter_size, passes=("Combined",))
     base.update(kw)
     return RenderSettings(**base)

@@ -71,7 +71,7 @@ def raw_embree(geometry, cam, threads, seconds=1.0):
     n = len(cam.origins)
     rays = (np.ascontiguousarray(cam.origins - geometry.center, np.float32),
             np.ascontiguousarray(cam.directions, np.float32), np.zeros(n, np.float32),
-            np.minimum(cam.tmax, 3e38).astype(np.float32), np.full(n, 0.5, np.float32))
+            np.minimum(cam.tmax, 3e38).astype(np.float32), np.full(n, 0.5, np.float32), np.full(n, -1, np.int32))
     out = (np.empty(n, np.float32), np.empty((n, 2), np.float32), np.empty((n, 3), np.float32),
            np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int32))
     bounds = np.linspace(0, n, threads + 1).astype(int)

@@ -77,6 +77,7 @@ CLOSURE_KINDS = (
     "REFRACTION",  # refraction only, tinted by colour
     "EMISSION",  # emitted radiance ``emission``, two-sided
     "TRANSPARENT",  # straight through, tinted by colour
+    "HOLDOUT",  # no light: where the camera sees it, that share of the pixel is transparent (Cycles' holdout)
     "DIFFUSE_TOON",  # Cycles' diffuse toon: a cone about the normal, colour = weight
     "GLOSSY_TOON",  # Cycles' glossy toon: a cone about the mirror direction, colour = weight
 )
@@ -220,6 +221,16 @@ class Instance:
     pass_index: int = 0
     random: float = 0.0
     """Object Info's Random: Cycles' per-object (or per-instance) random number in [0, 1]."""
+    holdout: bool = False
+    """The whole object is a holdout where the camera sees it (Cycles' object holdout); other
+    rays see it as it is."""
+    visible_camera: bool = True
+    visible_shadow: bool = True
+    visible_diffuse: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
+    """Blender's ray visibility: the ray kinds that see the object (the others pass through it, and
+    an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
@@ -268,6 +279,12 @@ class Light:
     spread: float = np.pi
     visible_camera: bool = False
     """Seen by camera rays (Blender's ray visibility; off for lights by default)."""
+    visible_diffuse: bool = True
+    visible_glossy: bool = True
+    visible_transmission: bool = True
+    """Which BSDF parts the light lights and which rays that left them see it (as the world's)."""
+    cast_shadow: bool = True
+    """Cycles' Cast Shadow: off, nothing blocks the light's shadow rays."""
     matrices: np.ndarray | None = None
     """(S, 4, 4) light-to-world transforms at S evenly spaced shutter times for a light
     that moves (scale removed, like ``matrix``), else None."""

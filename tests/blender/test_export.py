@@ -875,34 +875,43 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
 
 
 def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Ray visibility, holdout, shadow catcher, light linking and light groups change Cycles' image;
-    until DRT reads them, a scene using them says so (objects named, a long list cut short)."""
+    """Shadow catcher, light linking and light groups change Cycles' image; until DRT reads them,
+    a scene using them says so (objects named, a long list cut short)."""
     scene = empty_scene()
     cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
     for cube in cubes[:5]:
-        cube.visible_shadow = False
-    cubes[0].is_holdout = True
+        cube.lightgroup = "key"
     cubes[1].is_shadow_catcher = True
-    cubes[2].lightgroup = "key"
     cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
-    lamp = _light(scene, "POINT")
-    lamp.visible_glossy = False
-    lamp.data.use_shadow = False
     data = render_export(scene)
     (warning,) = data.warnings
-    for expected in ("shadow ray visibility off ('Cube0', 'Cube1', 'Cube2' and 2 more)", "holdout ('Cube0')",
-                     "shadow catcher ('Cube1')", "light group ('Cube2')", "light or shadow linking ('Cube3')",
-                     f"glossy ray visibility off ('{lamp.name}')", f"cast shadow off ('{lamp.name}')"):
+    for expected in ("light group ('Cube0', 'Cube1', 'Cube2' and 2 more)", "shadow catcher ('Cube1')",
+                     "light or shadow linking ('Cube3')"):
         assert expected in warning, warning
-    assert "Cube5" not in warning and "camera ray" not in warning
+    assert "Cube5" not in warning and "visibility" not in warning and "holdout" not in warning
     for cube in cubes[:5]:
-        cube.visible_shadow = True
-    for cube, attribute, value in ((cubes[0], "is_holdout", False), (cubes[1], "is_shadow_catcher", False),
-                                   (cubes[2], "lightgroup", "")):
-        setattr(cube, attribute, value)
+        cube.lightgroup = ""
+    cubes[1].is_shadow_catcher = False
     cubes[3].light_linking.receiver_collection = None
-    lamp.visible_glossy, lamp.data.use_shadow = True, True
     assert not render_export(scene).warnings
+
+
+def test_ray_visibility_and_cast_shadow_are_exported():
+    """Objects' ray visibility, lights' diffuse, glossy and transmission visibility and Cast Shadow
+    reach the scene, without a warning."""
+    scene = empty_scene()
+    cube = add_object(scene, "Cube", cube_mesh("Cube"))
+    cube.visible_camera, cube.visible_shadow, cube.visible_glossy = False, False, False
+    lamp = _light(scene, "POINT")
+    lamp.visible_diffuse, lamp.visible_transmission, lamp.data.use_shadow = False, False, False
+    data = render_export(scene)
+    assert not data.warnings
+    (inst,) = data.instances
+    assert (inst.visible_camera, inst.visible_shadow, inst.visible_diffuse, inst.visible_glossy,
+            inst.visible_transmission) == (False, False, True, False, True)
+    (light,) = data.lights
+    assert (light.visible_diffuse, light.visible_glossy, light.visible_transmission, light.cast_shadow) == \
+        (False, True, False, False)
 
 
 @pytest.mark.skipif(not hasattr(bpy.types, "ShaderNodeBsdfMetallic"), reason="Blender 5's Metallic BSDF")

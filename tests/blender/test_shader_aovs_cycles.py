@@ -53,13 +53,6 @@ def _material(name, color):
     return mat
 
 
-def _add(op, mat, **kw):
-    op(**kw)
-    obj = bpy.context.active_object
-    obj.data.materials.append(mat)
-    return obj
-
-
 def aov_scene():
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -8.0, 4.0))
@@ -82,14 +75,14 @@ def aov_scene():
     _aov(sphere.node_tree, "col", color=SPHERE_COLOR, value=0.3)
     _aov(sphere.node_tree, "val", color=(1.0, 1.0, 1.0), value=SPHERE_VALUE)
     _aov(sphere.node_tree, "elsewhere", color=(1.0, 1.0, 1.0), value=1.0)
-    _add(bpy.ops.mesh.primitive_plane_add, floor, size=12.0)
-    _add(bpy.ops.mesh.primitive_uv_sphere_add, sphere, radius=1.0, location=(-1.2, 0.0, 1.0))
-    _add(bpy.ops.mesh.primitive_cube_add, box, size=1.4, location=(1.5, 0.5, 0.7))
+    ps.add_primitive(bpy.ops.mesh.primitive_plane_add, floor, size=12.0)
+    ps.add_primitive(bpy.ops.mesh.primitive_uv_sphere_add, sphere, radius=1.0, location=(-1.2, 0.0, 1.0))
+    ps.add_primitive(bpy.ops.mesh.primitive_cube_add, box, size=1.4, location=(1.5, 0.5, 0.7))
     veil = _material("Veil", (0.2, 0.7, 0.2))
     veil.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = VEIL_ALPHA
     _aov(veil.node_tree, "col", color=(0.9, 0.9, 0.2))
     _aov(veil.node_tree, "val", value=0.1)
-    _add(bpy.ops.mesh.primitive_plane_add, veil, size=1.6, location=(0.0, -2.5, 1.2), rotation=(1.2, 0.0, 0.0))
+    ps.add_primitive(bpy.ops.mesh.primitive_plane_add, veil, size=1.6, location=(0.0, -2.5, 1.2), rotation=(1.2, 0.0, 0.0))
     _aov(scene.world.node_tree, "col", color=WORLD_COLOR)
     layer = scene.view_layers[0]
     for name, kind in AOVS:

@@ -23,11 +23,8 @@ SAMPLES = 128
 
 
 def _quad(name, mat, location, size, rotation=(0.0, 0.0, 0.0)):
-    bpy.ops.mesh.primitive_plane_add(size=size, location=location, rotation=rotation)
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(mat)
-    return obj
+    return ps.add_primitive(bpy.ops.mesh.primitive_plane_add, mat, name, size=size, location=location,
+                            rotation=rotation)
 
 
 def _checker_alpha():
@@ -64,11 +61,7 @@ def _tinted_mix():
 
 
 def shadow_scene():
-    scene = ps._scene(SIZE, SIZE)
-    ps.aim(scene.camera, (0.0, -6.0, 5.0))
-    scene.camera.data.lens = 40.0
-    scene.render.film_transparent = True
-    ps.black_world(scene)
+    scene = ps.dark_scene(SIZE, (0.0, -6.0, 5.0), 40.0, True)
     ground = new_material("Ground")
     ground.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
     ground.node_tree.nodes["Principled BSDF"].inputs["Roughness"].default_value = 1.0

@@ -16,16 +16,19 @@ class ExportCaptureEngine(bpy.types.RenderEngine):
     bl_label = "DRT export capture"
     bl_use_shading_nodes_custom = False
     captured: list = []
+    motion = False  # sample the shutter as a render does (the engine's frame_set)
 
     def render(self, depsgraph):
         try:
-            self.captured.append(export_scene(depsgraph))
+            self.captured.append(export_scene(depsgraph, frame_set=self.frame_set if self.motion else None))
         except Exception as error:  # handed back to the test, which re-raises it
             self.captured.append(error)
 
 
-def render_export(scene=None):
-    """SceneData exported from the render depsgraph of ``scene`` (default: the context scene)."""
+def render_export(scene=None, motion=False):
+    """SceneData exported from the render depsgraph of ``scene`` (default: the context scene);
+    ``motion``: with its motion over the shutter."""
+    ExportCaptureEngine.motion = motion
     if not ExportCaptureEngine.is_registered:
         bpy.utils.register_class(ExportCaptureEngine)
     scene = scene or bpy.context.scene

@@ -210,19 +210,39 @@ def black_world(scene) -> None:
     scene.world = world
 
 
+def dark_scene(size: int, location, lens: float, transparent: bool):
+    """A ``size`` x ``size`` scene of a black world (``_scene``), its camera at ``location`` looking
+    at the origin through a ``lens`` mm lens, Film Transparent ``transparent``."""
+    scene = _scene(size, size)
+    aim(scene.camera, location)
+    scene.camera.data.lens = lens
+    scene.render.film_transparent = transparent
+    black_world(scene)
+    return scene
+
+
 def aim(camera, location) -> None:
     """Place ``camera`` at ``location`` looking at the origin, y up."""
     camera.location = location
     camera.rotation_euler = (-mathutils.Vector(camera.location)).to_track_quat("-Z", "Y").to_euler()
 
 
+def add_primitive(op, mat, name=None, **kw):
+    """The mesh primitive the operator ``op`` (bpy.ops.mesh.primitive_*_add) makes from ``kw``,
+    with material ``mat`` (and ``name``)."""
+    op(**kw)
+    obj = bpy.context.active_object
+    if name is not None:
+        obj.name = name
+    obj.data.materials.append(mat)
+    return obj
+
+
 def smooth_sphere(name, x, material) -> None:
     """A smooth-shaded unit UV sphere at (x, 0, 0) with ``material``."""
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(x, 0.0, 0.0), segments=64, ring_count=32)
+    add_primitive(bpy.ops.mesh.primitive_uv_sphere_add, material, name, radius=1.0, location=(x, 0.0, 0.0),
+                  segments=64, ring_count=32)
     bpy.ops.object.shade_smooth()
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(material)
 
 
 def closure_material(name, bl_idname, **inputs):

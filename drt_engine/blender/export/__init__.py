@@ -47,7 +47,7 @@ def export_scene(
     warnings: list[str] = []
     images = ImageTable(warnings)
     materials = MaterialTable(warnings, images, (scene, depsgraph.view_layer))
-    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes)
+    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes, depsgraph.view_layer_eval)
     lights = []
     light_keys = []
     left_out = LeftOut(depsgraph.mode == "RENDER")

@@ -118,16 +118,15 @@ def export_camera(scene, camera_object) -> Camera:
 
 def shutter_curve(render, rolling: float | None):
     """The shutter curve's table of shutter times, from the curve sampled as Cycles'
-    curvemapping_to_array samples it; None without motion blur, and for a flat curve without a
-    rolling shutter (times uniform over the shutter, a hair wider than Cycles' table spreads them)."""
+    curvemapping_to_array samples it; None without motion blur. Cycles reads its table for every
+    curve, the flat default too, whose times run from 0.002 to 0.994 of the shutter: a sharp edge
+    sliding across the view differed from Cycles' by 0.0090 with times uniform over the whole
+    shutter (limit 0.0068)."""
     if not render.use_motion_blur:
         return None
     curves = render.motion_blur_shutter_curve
     curves.initialize()
-    values = np.array([curves.evaluate(curves.curves[0], i / (TABLE_SIZE - 1)) for i in range(TABLE_SIZE)])
-    if rolling is None and np.all(values == values[0]):
-        return None
-    return shutter_table(values)
+    return shutter_table(np.array([curves.evaluate(curves.curves[0], i / (TABLE_SIZE - 1)) for i in range(TABLE_SIZE)]))
 
 
 def rolling_shutter(scene):

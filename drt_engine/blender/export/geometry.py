@@ -316,8 +316,10 @@ class GeometryExporter:
     the same mesh different materials.
     """
 
-    def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None):
+    def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None,
+                 view_layer=None):
         self.materials = materials
+        self.view_layer = view_layer  # whose holdout collections make their objects holdouts
         self.cache = cache
         self.material_override = material_override
         self.meshes: list[Mesh] = []
@@ -390,8 +392,14 @@ class GeometryExporter:
                 random = object_random(obj.name, random_id)
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
-                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random))
+                                           color=tuple(obj.color), pass_index=obj.pass_index, random=random,
+                                           holdout=self._holdout(parent or obj), **ray_visibility(obj, parent)))
             self.keys.append(key)
+
+    def _holdout(self, obj) -> bool:
+        """Whether Cycles holds the object out: its Holdout, or a holdout collection of the view
+        layer; an instance takes its instancer's (Cycles' sync_object reads the parent's)."""
+        return bool(obj.holdout_get(view_layer=self.view_layer))
 
     def _reads_object_info(self, slot_materials) -> bool:
         """Whether the slots' materials have an Object Info node, found once per set of slots (an
@@ -451,3 +459,13 @@ class GeometryExporter:
             self.cache.put(cache_key, mesh, obj)
         self.meshes.append(mesh)
         return len(self.meshes) - 1
+
+
+RAY_KINDS = ("camera", "shadow", "diffuse", "glossy", "transmission")
+
+
+def ray_visibility(obj, parent=None) -> dict:
+    """The object's ray visibility as ``Instance`` fields; an instance is seen by the rays that see
+    both it and its instancer, as Cycles syncs it (object_ray_visibility of both)."""
+    return {f"visible_{kind}": bool(getattr(obj, f"visible_{kind}", True))
+            and (parent is None or bool(getattr(parent, f"visible_{kind}", True))) for kind in RAY_KINDS}

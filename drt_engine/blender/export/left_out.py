@@ -2,8 +2,9 @@
 it leaves out (one warning) and object and light settings it does not read (another), so that a
 scene relying on them is never rendered differently without a word.
 
-Each object is looked at once (its instances share its settings). Lights' camera visibility and
-the world's ray visibility are read (export.lights, export.world) and so are not listed here.
+Each object is looked at once (its instances share its settings). Objects' and lights' ray
+visibility, lights' Cast Shadow, objects' Holdout and the world's ray visibility are read (export.geometry,
+export.lights, export.world) and so are not listed here.
 """
 from __future__ import annotations
 
@@ -15,16 +16,8 @@ SHOWN = 3
 """Object names a setting's entry shows before "and N more"."""
 
 OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning calls another value
-    ("visible_camera", True, "camera ray visibility off"),
-    ("visible_shadow", True, "shadow ray visibility off"),
-    ("visible_diffuse", True, "diffuse ray visibility off"),
-    ("visible_glossy", True, "glossy ray visibility off"),
-    ("visible_transmission", True, "transmission ray visibility off"),
-    ("is_holdout", False, "holdout"),
     ("is_shadow_catcher", False, "shadow catcher"),
 )
-LIGHT_SETTINGS = OBJECT_SETTINGS[2:5]
-"""A light's own camera visibility is read; its shadow visibility is Cast Shadow (below)."""
 
 
 class LeftOut:
@@ -50,12 +43,9 @@ class LeftOut:
             self._objects[name] = TYPES[obj.type]
         elif obj.type == "MESH" and not instanced and self._shows_hair(obj):
             self._objects[name] = "hair particles"
-        light = obj.type == "LIGHT"
-        for attribute, rendered, what in LIGHT_SETTINGS if light else OBJECT_SETTINGS:
-            if getattr(obj, attribute, rendered) != rendered:
+        for attribute, rendered, what in OBJECT_SETTINGS:
+            if obj.type != "LIGHT" and getattr(obj, attribute, rendered) != rendered:
                 self._add(what, name)
-        if light and not getattr(obj.data, "use_shadow", True):
-            self._add("cast shadow off", name)
         linking = getattr(obj, "light_linking", None)  # Blender 4.0+
         if linking is not None and (linking.receiver_collection is not None or linking.blocker_collection is not None):
             self._add("light or shadow linking", name)

@@ -79,7 +79,10 @@ def export_light(obj, matrix: np.ndarray, warnings: list[str]) -> Light | None:
         return None  # no direction to shine along
     rotation = matrix.copy()
     rotation[:3, :3] /= np.where(axes > 0.0, axes, 1.0)
-    common = dict(matrix=rotation, name=obj.name, visible_camera=bool(getattr(obj, "visible_camera", False)))
+    common = dict(matrix=rotation, name=obj.name, visible_camera=bool(getattr(obj, "visible_camera", False)),
+                  cast_shadow=bool(getattr(light, "use_shadow", True)),
+                  **{f"visible_{kind}": bool(getattr(obj, f"visible_{kind}", True))
+                     for kind in ("diffuse", "glossy", "transmission")})
     if light.type in ("POINT", "SPOT"):
         radius = float(light.shadow_soft_size)
         if normalize:

@@ -233,6 +233,11 @@ def _metallic(node, weight, issues, compiler):
     return [_weighted(closure, weight, value.varying)]
 
 
+def _holdout(node, weight, issues, compiler):
+    """Cycles' Holdout closure: its weight is the share of the hit held out (core.integrator.holdout)."""
+    return [_weighted(Closure("HOLDOUT"), weight, {})]
+
+
 CLOSURE_NODES = {
     "ShaderNodeBsdfMetallic": _metallic,
     "ShaderNodeBsdfPrincipled": _principled,
@@ -244,6 +249,7 @@ CLOSURE_NODES = {
     "ShaderNodeEmission": _emission,
     "ShaderNodeBsdfTransparent": _bsdf("TRANSPARENT"),
     "ShaderNodeBsdfTranslucent": _bsdf("TRANSLUCENT"),
+    "ShaderNodeHoldout": _holdout,
     "ShaderNodeBsdfToon": _toon,
 }
 

@@ -508,6 +508,10 @@ class MaterialShader:
         self.lp, self.lt, self.hp = _pack(self.lobes, self.sampled)
         self.mu = np.ascontiguousarray(mf.MU_TABLE, np.float64)
         self.bound = False
+        self.holds_out = any(c.kind == "HOLDOUT" and (bool(c.inputs) or np.any(c.weight > 0))
+                             for c in material.closures)
+        self.holdout = sum((c.weight for c in material.closures if c.kind == "HOLDOUT"), np.zeros(3))
+        """The Holdout closures' summed weight RGB: (3,), or (N, 3) per hit once bound."""
 
     @property
     def can_continue(self) -> bool:
@@ -542,7 +546,39 @@ class MaterialShader:
                 hp[:, l, layout.H_F0:layout.H_F0 + 3] = base
         bound = copy.copy(self)
         bound.hp, bound.bound = hp, True
+        if self.holds_out:
+            holdout = np.zeros((n, 3))
+            for i, c in enumerate(self.material.closures):
+                if c.kind == "HOLDOUT":
+                    holdout += values.get(i, {}).get("weight", c.weight)
+            bound.holdout = holdout
         return bound
+
+    def take(self, rows) -> "MaterialShader":
+        """The shader of the hits ``rows`` of its binding (itself when it is not bound)."""
+        if not self.bound:
+            return self
+        taken = copy.copy(self)
+        taken.hp = self.hp[rows]
+        if self.holdout.ndim == 2:
+            taken.holdout = self.holdout[rows]
+        return taken
+
+    def see_through_only(self) -> "MaterialShader":
+        """The shader with its transparent lobes alone, no emission: what an object holdout keeps
+        where the camera sees it (Cycles' surface_shader_apply_holdout)."""
+        keep = [l for l, lobe in enumerate(self.lobes) if lobe.kind == "transparent"]
+        clear = copy.copy(self)
+        clear.lobes = clear.sampled = [self.lobes[l] for l in keep]
+        clear.lp = np.ascontiguousarray(self.lp[keep])
+        clear.lp[:, layout.P_SAMPLED] = np.arange(len(keep))
+        clear.lt, clear.hp = np.ascontiguousarray(self.lt[keep]), np.ascontiguousarray(self.hp[:, keep])
+        clear.emission, clear.has_glass, clear.holds_out, clear.holdout = np.zeros(3), False, False, np.zeros(3)
+        return clear
+
+    def holdout_weights(self, n) -> np.ndarray:
+        """(n, 3) the Holdout closures' weight at each of the n hits of its binding."""
+        return np.broadcast_to(self.holdout, (n, 3)) if self.holdout.ndim == 1 else self.holdout
 
     def hit_rows(self, n, rows=None) -> np.ndarray:
         """Row of ``hp`` each of n rays reads."""

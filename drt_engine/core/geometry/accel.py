@@ -34,10 +34,12 @@ from ..errors import SceneError
 from ..scene import Mesh, SceneData
 from . import embree
 from .motion import deforms, frame_at, invert_frame, moves
+from .visibility import EVERY, SHADOW, instance_mask
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
 _EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates hit points are rebuilt in
 _FAR = np.float32(3.0e38)
+_EVERY_RAY = np.zeros(0, np.int32)  # no ray masks: every ray sees every object
 
 
 @dataclass
@@ -173,7 +175,12 @@ class Geometry:
             self.warnings.append(f"{dropped} triangles with NaN or infinite vertex coordinates were left out")
         self._motion_steps(kept)
         self._mesh_scenes(kept, analysed, known)
-        self._instances(kept)
+        masks = [instance_mask(scene.instances[k]) for k, _, _ in kept]
+        self.masked = any(mask != EVERY for mask in masks)
+        """Some object is hidden from some ray kind: rays then carry their kind's mask."""
+        self.shadow_mask = SHADOW if self.masked else EVERY
+        """The Embree mask of shadow rays."""
+        self._instances(kept, masks)
         self._triangle_tables(kept)
         self.tables = self._tables()
 
@@ -217,8 +224,9 @@ class Geometry:
             self._mesh_list.append(ms)
         self._moving = any(len(ms.steps) > 1 for ms in self._mesh_list) or bool(self._steps[:, 1].any())
 
-    def _instances(self, kept):
-        """The top-level Embree scene: each instance with the centre taken off its transforms."""
+    def _instances(self, kept, masks):
+        """The top-level Embree scene: each instance with the centre taken off its transforms and
+        its ray visibility as its mask."""
         n = len(kept)
         self._top = embree.InstanceScene() if n else None
         self._base = np.zeros(n + 1, np.int64)
@@ -228,7 +236,7 @@ class Geometry:
             self._base[j + 1] = self._base[j] + len(ms.kept)
             placed = matrices.copy()
             placed[:, :3, 3] -= self.center  # Embree works relative to the centre
-            self._top.add(ms.scene, placed if self._steps[j, 1] else placed[0], ms.pivot)
+            self._top.add(ms.scene, placed if self._steps[j, 1] else placed[0], ms.pivot, masks[j])
             invert_frame(self._frames[j], self._inverses[j])
         if self._top is not None:
             self._top.commit()
@@ -343,13 +351,14 @@ class Geometry:
             return time
         return RayTimes(None if time is None else np.asarray(time, dtype=np.float64))
 
-    def intersect(self, origins, directions, tmax, time=None) -> Hits:
+    def intersect(self, origins, directions, tmax, time=None, masks=None) -> Hits:
+        """Closest hits; ``masks``: each ray's Embree mask (geometry.visibility; None: every object)."""
         n = len(origins)
         hits = Hits(np.full(n, np.inf), np.full(n, -1, np.int64), np.zeros(n), np.zeros(n))
         if self._top is not None and n:
             _intersects(self._top.handle, self.tables, np.asarray(origins, np.float64),
                         np.asarray(directions, np.float64), np.asarray(tmax, np.float64), self.time_values(time),
-                        hits.t, hits.prim, hits.u, hits.v)
+                        _EVERY_RAY if masks is None else masks, hits.t, hits.prim, hits.u, hits.v)
         return hits
 
     def occluded(self, origins, directions, tmax, time=None) -> np.ndarray:
@@ -357,7 +366,7 @@ class Geometry:
         blocked = np.zeros(n, dtype=bool)
         if self._top is not None and n:
             _occludeds(self._top.handle, np.asarray(origins, np.float64), np.asarray(directions, np.float64),
-                       np.asarray(tmax, np.float64), self.time_values(time), self.center, blocked)
+                       np.asarray(tmax, np.float64), self.time_values(time), self.center, self.shadow_mask, blocked)
         return blocked
 
     def surface(self, hits: Hits, index: np.ndarray, time=None):
@@ -589,9 +598,9 @@ def _time_of(times, r):
 
 
 @kernel
-def _intersects(scene, geo, origins, directions, tmax, times, t, prim, u, v):
+def _intersects(scene, geo, origins, directions, tmax, times, masks, t, prim, u, v):
     """Closest hits of rays from float64 world origins (made relative to the centre here, then
-    float32 for Embree); the hit's global triangle id is its instance's first id plus primID, its
+    float32 for Embree) among the objects each ray's mask sees (``masks`` empty: all); the hit's global triangle id is its instance's first id plus primID, its
     distance and barycentrics those of the float64 ray on the float64 triangle (``refine``)."""
     center, base = geo[13], geo[6]
     rayhit = embree.new_rayhit()
@@ -600,7 +609,8 @@ def _intersects(scene, geo, origins, directions, tmax, times, t, prim, u, v):
         time = _time_of(times, r)
         th, uh, vh, _, _, _, p, _, inst = embree.intersect1(
             scene, rayhit, origins[r, 0] - center[0], origins[r, 1] - center[1], origins[r, 2] - center[2],
-            directions[r, 0], directions[r, 1], directions[r, 2], 0.0, min(tmax[r], _FAR), time)
+            directions[r, 0], directions[r, 1], directions[r, 2], 0.0, min(tmax[r], _FAR), time,
+            masks[r] if len(masks) else EVERY)
         if p >= 0:
             prim[r] = base[inst] + p
             t[r], u[r], v[r] = refine(geo, prim[r], origins[r, 0], origins[r, 1], origins[r, 2], directions[r, 0],
@@ -637,21 +647,21 @@ def refine(geo, prim, ox, oy, oz, dx, dy, dz, time, t, u, v, scratch):
 
 
 @kernel(inline="always")
-def blocked(scene, center, rayhit, ox, oy, oz, dx, dy, dz, tmax, time):
-    """Whether geometry lies on the ray from the float64 world origin before tmax at ``time``
-    (the top-level scene ``scene``, 0 when there is none; rayhit from embree.new_rayhit)."""
+def blocked(scene, center, rayhit, ox, oy, oz, dx, dy, dz, tmax, time, mask):
+    """Whether geometry ``mask`` sees lies on the ray from the float64 world origin before tmax at
+    ``time`` (the top-level scene ``scene``, 0 when there is none; rayhit from embree.new_rayhit)."""
     if scene == 0:
         return False
     return embree.occluded1(scene, rayhit, ox - center[0], oy - center[1], oz - center[2], dx, dy, dz, 0.0,
-                            min(tmax, _FAR), time)
+                            min(tmax, _FAR), time, mask)
 
 
 @kernel
-def _occludeds(scene, origins, directions, tmax, times, center, out):
+def _occludeds(scene, origins, directions, tmax, times, center, mask, out):
     rayhit = embree.new_rayhit()
     for r in range(len(origins)):
         out[r] = blocked(scene, center, rayhit, origins[r, 0], origins[r, 1], origins[r, 2], directions[r, 0],
-                         directions[r, 1], directions[r, 2], tmax[r], _time_of(times, r))
+                         directions[r, 1], directions[r, 2], tmax[r], _time_of(times, r), mask)
 
 
 @kernel

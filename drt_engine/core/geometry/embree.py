@@ -83,6 +83,7 @@ _SIGNATURES = {  # name: (result, arguments), from include/embree4/rtcore_*.h of
     "rtcSetGeometryInstancedScene": (None, [_p, _p]),
     "rtcSetGeometryTransform": (None, [_p, _u, _i, _p]),
     "rtcSetGeometryTransformQuaternion": (None, [_p, _u, _p]),
+    "rtcSetGeometryMask": (None, [_p, _u]),
     "rtcIntersect1": (None, [_p, _p, _p]),
     "rtcOccluded1": (None, [_p, _p, _p]),
 }
@@ -109,6 +110,7 @@ _SCENE_FLAG_ROBUST = 1 << 2
 _ERROR_NAMES = {1: "unknown error", 2: "invalid argument", 3: "invalid operation",
                 4: "out of memory", 5: "unsupported CPU", 6: "cancelled"}
 MAX_TIME_STEPS = 129  # RTC_MAX_TIME_STEP_COUNT
+_EVERY_BIT = 0xFFFFFFFF
 
 # --- the process's device ---------------------------------------------------------------------------
 
@@ -226,6 +228,7 @@ class TriangleScene(_Scene):
         _lib.rtcSetSharedGeometryBuffer(geometry, _BUFFER_INDEX, 0, _FORMAT_UINT3, indices.ctypes.data,
                                         0, 12, len(indices))
         self._keep.append(indices)
+        _lib.rtcSetGeometryMask(geometry, _EVERY_BIT)  # Embree's default is 1: instances' masks decide
         self._attach(geometry)
         self.commit()
 
@@ -244,16 +247,19 @@ class InstanceScene(_Scene):
     (vertices near zero keep float32 precise); the transforms stay the object's own, the pivot
     turning about the object's origin with it.
 
+    ``mask``: the ray mask bits that see the instance (geometry.visibility; default every bit).
+
     Call ``commit()`` after adding or moving instances and before tracing."""
 
     def __init__(self):
         super().__init__()
         self._instances: list = []  # RTCGeometry handles, kept so that a transform can be changed
 
-    def add(self, scene: TriangleScene, transforms, pivot=None) -> int:
+    def add(self, scene: TriangleScene, transforms, pivot=None, mask: int = -1) -> int:
         geometry = _lib.rtcNewGeometry(self.device.handle, _GEOMETRY_INSTANCE)
         try:
             _lib.rtcSetGeometryInstancedScene(geometry, scene.handle)
+            _lib.rtcSetGeometryMask(geometry, mask & _EVERY_BIT)
             self._set_transforms(geometry, transforms, pivot)  # checks for errors
         except DRTError:
             _lib.rtcReleaseGeometry(geometry)
@@ -333,22 +339,23 @@ def new_rayhit():
 
 
 @kernel
-def _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
+def _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time, mask):
     f, w = rayhit
     f[RAY_ORG], f[RAY_ORG + 1], f[RAY_ORG + 2], f[RAY_TNEAR] = ox, oy, oz, tnear
     f[RAY_DIR], f[RAY_DIR + 1], f[RAY_DIR + 2], f[RAY_TIME] = dx, dy, dz, time
     f[RAY_TFAR] = tfar
-    w[RAY_MASK] = -1  # every mask bit: geometries keep Embree's default mask
+    w[RAY_MASK] = mask
     w[RAY_ID] = 0
     w[RAY_FLAGS] = 0
 
 
 @kernel
-def intersect1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
-    """The closest hit of one ray in (tnear, tfar) at ``time``: (t, u, v, Ng x, y, z, primID,
-    geomID, instID), ids -1 for none; t is inf on a miss. ``rayhit`` from ``new_rayhit``."""
+def intersect1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time, mask):
+    """The closest hit of one ray in (tnear, tfar) at ``time`` among the instances whose mask
+    shares a bit with ``mask`` (-1: all): (t, u, v, Ng x, y, z, primID, geomID, instID), ids -1 for
+    none; t is inf on a miss. ``rayhit`` from ``new_rayhit``."""
     f, w = rayhit
-    _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time)
+    _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time, mask)
     w[HIT_GEOM] = INVALID
     w[HIT_INST] = INVALID
     _intersect1(scene, f.ctypes.data, 0)
@@ -359,55 +366,57 @@ def intersect1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
 
 
 @kernel
-def occluded1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
-    """Whether anything lies on the ray in (tnear, tfar) at ``time`` (Embree sets tfar to -inf)."""
-    _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time)
+def occluded1(scene, rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time, mask):
+    """Whether anything ``mask`` sees (as ``intersect1``) lies on the ray in (tnear, tfar) at
+    ``time`` (Embree sets tfar to -inf)."""
+    _set_ray(rayhit, ox, oy, oz, dx, dy, dz, tnear, tfar, time, mask)
     _occluded1(scene, rayhit[0].ctypes.data, 0)
     return rayhit[0][RAY_TFAR] == -np.inf
 
 
 @kernel
-def intersect_batch(scene, origins, directions, tnear, tfar, time, t, uv, ng, prim, geom, inst):
-    """``intersect1`` over rays (N, 3) with per-ray tnear, tfar, time; writes the outputs."""
+def intersect_batch(scene, origins, directions, tnear, tfar, time, mask, t, uv, ng, prim, geom, inst):
+    """``intersect1`` over rays (N, 3) with per-ray tnear, tfar, time, mask; writes the outputs."""
     rayhit = new_rayhit()
     for i in range(len(origins)):
         (t[i], uv[i, 0], uv[i, 1], ng[i, 0], ng[i, 1], ng[i, 2], prim[i], geom[i], inst[i]) = intersect1(
             scene, rayhit, origins[i, 0], origins[i, 1], origins[i, 2], directions[i, 0], directions[i, 1],
-            directions[i, 2], tnear[i], tfar[i], time[i])
+            directions[i, 2], tnear[i], tfar[i], time[i], mask[i])
 
 
 @kernel
-def occluded_batch(scene, origins, directions, tnear, tfar, time, out):
+def occluded_batch(scene, origins, directions, tnear, tfar, time, mask, out):
     rayhit = new_rayhit()
     for i in range(len(origins)):
         out[i] = occluded1(scene, rayhit, origins[i, 0], origins[i, 1], origins[i, 2], directions[i, 0],
-                           directions[i, 1], directions[i, 2], tnear[i], tfar[i], time[i])
+                           directions[i, 1], directions[i, 2], tnear[i], tfar[i], time[i], mask[i])
 
 
-def intersect(scene: _Scene, origins, directions, tnear=0.0, tfar=np.inf, time=0.0) -> dict:
+def intersect(scene: _Scene, origins, directions, tnear=0.0, tfar=np.inf, time=0.0, mask=-1) -> dict:
     """Closest hits of a batch of rays, as a dict named like embreex's ``run(..., output=1)``
     plus ``t`` and ``instID``; for tests, benchmarks and callers outside kernels."""
-    origins, directions, tnear, tfar, time = _rays(origins, directions, tnear, tfar, time)
+    origins, directions, tnear, tfar, time, mask = _rays(origins, directions, tnear, tfar, time, mask)
     n = len(origins)
     out = {"t": np.empty(n, np.float32), "uv": np.empty((n, 2), np.float32), "Ng": np.empty((n, 3), np.float32),
            "primID": np.empty(n, np.int32), "geomID": np.empty(n, np.int32), "instID": np.empty(n, np.int32)}
-    intersect_batch(scene.handle, origins, directions, tnear, tfar, time, *out.values())
+    intersect_batch(scene.handle, origins, directions, tnear, tfar, time, mask, *out.values())
     scene.device.check("tracing rays")
     return out
 
 
-def occluded(scene: _Scene, origins, directions, tnear=0.0, tfar=np.inf, time=0.0) -> np.ndarray:
+def occluded(scene: _Scene, origins, directions, tnear=0.0, tfar=np.inf, time=0.0, mask=-1) -> np.ndarray:
     """Whether each ray of a batch is blocked between tnear and tfar."""
-    origins, directions, tnear, tfar, time = _rays(origins, directions, tnear, tfar, time)
+    origins, directions, tnear, tfar, time, mask = _rays(origins, directions, tnear, tfar, time, mask)
     out = np.empty(len(origins), np.bool_)
-    occluded_batch(scene.handle, origins, directions, tnear, tfar, time, out)
+    occluded_batch(scene.handle, origins, directions, tnear, tfar, time, mask, out)
     scene.device.check("tracing shadow rays")
     return out
 
 
-def _rays(origins, directions, tnear, tfar, time):
+def _rays(origins, directions, tnear, tfar, time, mask):
     origins = np.ascontiguousarray(origins, dtype=np.float32)
     n = len(origins)
     per_ray = (np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=np.float32), (n,)))
                for x in (tnear, tfar, time))
-    return (origins, np.ascontiguousarray(directions, dtype=np.float32), *per_ray)
+    masks = np.ascontiguousarray(np.broadcast_to(np.asarray(mask, dtype=np.int32), (n,)))
+    return (origins, np.ascontiguousarray(directions, dtype=np.float32), *per_ray, masks)

@@ -15,7 +15,7 @@ from ..base.jit import kernel
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
-from ..lights.strategies import UNRESTRICTED
+from ..lights.strategies import NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
@@ -73,8 +73,8 @@ def unlit_parts(restrict, k):
 
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
-                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, scene, center,
-                 times, radiance, f_diff, visibility, clear, allowed, qf, qi):
+                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, exclude, scene,
+                 center, shadow_mask, times, radiance, f_diff, visibility, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
     traced and the rows queued.
 
@@ -88,8 +88,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     barycentrics on the geometry tables ``geo``, for the terminator lift where ``lifted``
     (core.geometry.accel.lift).
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
-    to stop short of an emitter that is geometry, and the BSDF parts each strategy lights
-    (``restrict``). ``times``: each hit's shutter time (empty when nothing moves).
+    to stop short of an emitter that is geometry, the BSDF parts each strategy lights
+    (``restrict``) and what each sample's light leaves out (``exclude``, lights.strategies: BSDF
+    parts, and its shadow ray with NO_SHADOW; empty: nothing). Shadow rays see the objects whose
+    Embree mask shares a bit with ``shadow_mask``. ``times``: each hit's shutter time (empty when
+    nothing moves).
     ``f_diff`` and ``visibility`` (strategy by hit) are filled when they have rows (the ratio
     estimator reads them): the diffuse part toward each sample and what became of its ray.
     With transparent shadows (``clear``, per mesh triangle row: its material can be transparent;
@@ -103,6 +106,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
     sel_all = np.empty((1, max(lp.shape[0], 1)))
     keep = f_diff.shape[1] > 0
     see_through = len(clear) > 0
+    excluding = exclude.size > 0
     traced = queued = 0
     for j in range(len(pos)):
         bits = diffuse_bits(bounces, j, diffuse_limit)
@@ -120,12 +124,13 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             if not _positive(v0, v1, v2):
                 continue
             wx, wy, wz = wi[k, j, 0], wi[k, j, 1], wi[k, j, 2]
+            left_out = exclude[k, j] if excluding else 0
             lx = wx * frame[j, 0, 0] + wy * frame[j, 0, 1] + wz * frame[j, 0, 2]
             ly = wx * frame[j, 1, 0] + wy * frame[j, 1, 1] + wz * frame[j, 1, 2]
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits, unlit_parts(restrict, k))
+                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~NO_SHADOW))
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
@@ -145,17 +150,20 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
                 wx, wy, wz, d = _aim(pos[j, 0] + wx * dist[k, j] - ox, pos[j, 1] + wy * dist[k, j] - oy,
                                      pos[j, 2] + wz * dist[k, j] - oz)
                 tmax = max(d * (1.0 - 1e-6) - stop[k, j], 0.0)
-            traced += 1
-            if see_through:
+            if left_out & NO_SHADOW:
+                hidden = False
+            elif see_through:
+                traced += 1
                 what, hit, t, hu, hv = first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, wx, wy, wz,
-                                                     tmax, time)
+                                                     tmax, time, shadow_mask)
                 hidden = what != OPEN
                 if what == SEE_THROUGH and allowed[j] > 0:
                     enqueue(qf, qi, queued, c0, c1, c2, ox, oy, oz, wx, wy, wz, tmax, time, hu, hv, t, path[j], hit,
                             j, 0, allowed[j])
                     queued += 1
             else:
-                hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time)
+                traced += 1
+                hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time, shadow_mask)
             if keep:
                 visibility[k, j] = BLOCKED if hidden else VISIBLE
             # area lights are not geometry: a nearer area light does not block (lights cast shadows

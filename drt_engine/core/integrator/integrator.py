@@ -33,12 +33,14 @@ from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..settings import AOV_CHANNELS
-from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
+from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_records
+from .holdout import Holdouts
+from .masks import ray_masks
 from .mis import add_emitted
 from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
@@ -145,14 +147,18 @@ class Integrator:
             clear = self.geometry.of_triangles(np.array([see_through(m) for m in scene.materials]))
             self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count)
         # paths carry their ray kind and depths only for a scene whose shader programs read them,
-        # with diffuse bounces or with transparent shadows (which count them)
-        self.carried = self.light_path or self.diffuse > 0 or self.shadows is not None
+        # with diffuse bounces, with transparent shadows (which count them) or with objects hidden
+        # from some kind of ray (whose masks they give)
+        self.carried = self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
         self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)
                          if self.diffuse else _NO_ROULETTE)
         # per material (and none): its hits draw lobe samples; with diffuse bounces, every lit one
         self.continues = prepared.continues | prepared.lit if self.diffuse else prepared.continues
+        held = np.array([i.holdout for i in scene.instances], bool)
+        self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
+            m.shader.holds_out for m in prepared.shading) else None
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
         self._rays_lock = threading.Lock()
 
@@ -187,12 +193,13 @@ class Integrator:
             if len(state) == 0:
                 break
             ray_times = times[state.path]
-            hits = self.geometry.intersect(state.origins, state.dirs, state.tmax, ray_times)
+            masks = None if not self.geometry.masked else ray_masks(
+                state.straight, state.bounces[:, KIND].copy(), state.dirs, state.prev_normal)
+            hits = self.geometry.intersect(state.origins, state.dirs, state.tmax, ray_times, masks)
             light_t, light_id, light_le = self.lights.intersect(state.origins, state.dirs,
                                                                 np.minimum(hits.t, state.tmax), state.time)
-            # a light hidden from the camera is not there for camera rays: they go on past it
-            hidden = state.straight & ~self.lights.camera_visible[np.maximum(light_id, 0)]
-            light_id = np.where(hidden, -1, light_id)
+            # a light hidden from a kind of ray is not there for it: it goes on past the light
+            light_id = self.lights.seen(light_id, state.straight, state.dirs, state.prev_normal, state.bounces)
             on_light = light_id >= 0
             self._lights_hit(state.take(np.flatnonzero(on_light)), light_t[on_light], light_id[on_light],
                              light_le[on_light], out)
@@ -209,18 +216,19 @@ class Integrator:
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
             self._emission_seen(surf, state, hits, out)
-            if depth == 0:
-                self._first_hit_passes(surf, cam, hits.t[rows], out)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out)
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
+            if self.holdouts is not None:
+                bound = self.holdouts.write(bound, out.alpha)
             lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
             light, start = self._sample_lights(lit) if lit else None, 0
             continued, queued = [], []
             for group, u_g, shader in bound:
-                if depth == 0:
+                if depth == 0:  # after the holdouts, as Cycles' film_write_data_passes
+                    self._first_hit_passes(group, cam, hits.t[group.row], out)
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
@@ -318,6 +326,8 @@ class Integrator:
         """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
         glows = self.lights.glows
         glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
+        if self.holdouts is not None and len(glowing):  # an object holdout the camera sees gives no light
+            glowing = glowing[~self.holdouts.whole(surf.take(glowing))]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]
@@ -490,8 +500,8 @@ class Integrator:
             _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
-            geo.handle, geo.center, geo.time_values(group.time if self.timed else None), wave.radiance, f_diff,
-            visibility, clear, allowed, qf, qi)
+            geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
+            wave.radiance, f_diff, visibility, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility)

@@ -41,14 +41,15 @@ def limits(bounces: np.ndarray, max_transparent: int) -> np.ndarray:
 
 
 @kernel(inline="always")
-def first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tmax, time):
-    """(what, triangle, t, u, v) of the first surface on the ray before tmax: OPEN, OPAQUE or
-    SEE_THROUGH (the triangle's material can be transparent: ``clear`` per mesh triangle row)."""
+def first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tmax, time, mask):
+    """(what, triangle, t, u, v) of the first surface ``mask`` sees on the ray before tmax: OPEN,
+    OPAQUE or SEE_THROUGH (the triangle's material can be transparent: ``clear`` per mesh triangle
+    row)."""
     if scene == 0:
         return OPEN, -1, 0.0, 0.0, 0.0
     center = geo[13]
     th, uh, vh, _, _, _, p, _, inst = embree.intersect1(scene, rayhit, ox - center[0], oy - center[1],
-                                                       oz - center[2], dx, dy, dz, 0.0, min(tmax, _FAR), time)
+                                                       oz - center[2], dx, dy, dz, 0.0, min(tmax, _FAR), time, mask)
     if p < 0:
         return OPEN, -1, 0.0, 0.0, 0.0
     prim = geo[6][inst] + p
@@ -71,8 +72,8 @@ def enqueue(qf, qi, m, c0, c1, c2, ox, oy, oz, dx, dy, dz, tmax, time, u, v, len
 
 
 @kernel
-def pass_through(scene, geo, clear, qf, qi, pos, ng, scale, radiance, out_f, out_i):
-    """Sends each queued ray (its contribution already attenuated by its surface) on from the far
+def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, radiance, out_f, out_i):
+    """Sends each queued ray (``mask``: the shadow rays' Embree mask) (its contribution already attenuated by its surface) on from the far
     side of the surface at ``pos`` (geometric normal ``ng`` facing the ray, offset ``scale``):
     open, its contribution goes to ``radiance``; opaque, or see-through past its allowed count,
     nothing; see-through within it, queued again in ``out``. Returns (rays traced, rows queued)."""
@@ -86,7 +87,7 @@ def pass_through(scene, geo, clear, qf, qi, pos, ng, scale, radiance, out_f, out
         along = (ox - qf[r, 3]) * dx + (oy - qf[r, 4]) * dy + (oz - qf[r, 5]) * dz
         tmax = max(qf[r, 9] - along, 0.0)
         what, prim, t, u, v = first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tmax,
-                                            qf[r, 10])
+                                            qf[r, 10], mask)
         if what == OPEN:
             p = qi[r, 0]
             radiance[p, 0] += qf[r, 0]
@@ -145,7 +146,8 @@ class TransparentShadows:
             qf = np.ascontiguousarray(f[go])
             qf[:, 0:3] = c[go]
             out_f, out_i = new_queue(len(go), True)
-            traced, m = pass_through(geo.handle, geo.tables, self.clear, qf, np.ascontiguousarray(i[go]),
+            traced, m = pass_through(geo.handle, geo.tables, self.clear, geo.shadow_mask, qf,
+                                     np.ascontiguousarray(i[go]),
                                      surf.pos[go], surf.ng[go], surf.scale[go], radiance, out_f, out_i)
             self.count("shadow", traced)
             rays = ShadowRays(out_f[:m], out_i[:m], rays.bounces[go][out_i[:m, 2]])

@@ -24,6 +24,7 @@ import numpy as np
 from ..base.colour import LUMINANCE
 from ..base.constants import TINY
 from ..base.jit import kernel
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..errors import SceneError
 from ..geometry.motion import Motion
 from ..scene import Light, SceneData
@@ -32,10 +33,10 @@ from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
-from .strategies import MAP_WORLD, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
+from .strategies import MAP_WORLD, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch
-from .world import pdf_world_batch, world_shown_batch
+from .world import lights_shown_batch, pdf_world_batch, world_shown_batch
 
 
 class LightSample:
@@ -93,6 +94,11 @@ class Lights:
         self.table = light_table(self.lights)
         """One row per light (lights.table's columns): what every light kernel reads."""
         self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
+        self.visibility = np.array([(light.visible_camera, light.visible_diffuse, light.visible_glossy,
+                                     light.visible_transmission) for light in self.lights], np.bool_).reshape(-1, 4)
+        """Per light: seen by camera, diffuse, glossy and transmission rays (its ray visibility)."""
+        self.partly_lit = not self.visibility[:, 1:].all()
+        """Some light is hidden from some kind of BSDF ray (not only from the camera)."""
         self.geometry = geometry
         self.shaders = shaders
         self.emission = np.array([s.emission for s in shaders], np.float64).reshape(-1, 3)
@@ -101,7 +107,8 @@ class Lights:
         self.glows = (self.emission.max(axis=1) > 0) | np.isin(np.arange(len(shaders)), self.textured)
         """Per material: whether its surface emits where a ray hits it."""
         self.attributes = SurfaceAttributes(scene, geometry) if self.textured else None
-        self._emitters(geometry)
+        self._emitters(geometry, scene)
+        self._excludes(scene, geometry)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
@@ -137,11 +144,15 @@ class Lights:
         self._moving_hittable = [i for i in hittable if i in self.motions]
         self._moving_suns = [i for i in suns if i in self.motions]
 
-    def _emitters(self, geometry) -> None:
+    def _emitters(self, geometry, scene: SceneData) -> None:
         """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
         each picked by its power (``emissive_cdf``, ``emissive_prob``), with its world corners,
-        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order)."""
+        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order). Triangles
+        of objects no BSDF ray sees light nothing, and are left out (Cycles' usable_as_light)."""
         tris = geometry.triangles_with(np.flatnonzero(self.glows))
+        lighting = np.array([i.visible_diffuse or i.visible_glossy or i.visible_transmission for i in scene.instances],
+                            bool)
+        tris = tris[lighting[geometry.source_of(tris)[:, 0]]] if len(tris) and not lighting.all() else tris
         corners = geometry.world_corners(tris)
         ng, area = geometry.world_normals(tris, corners)
         mats = geometry.material_of(tris)
@@ -157,6 +168,20 @@ class Lights:
         self.emitters = (np.ascontiguousarray(corners[keep].reshape(-1, 3)),
                          np.arange(3 * len(keep), dtype=np.int64).reshape(-1, 3), np.ascontiguousarray(ng[keep]),
                          area[keep], np.ascontiguousarray(self.emission[mats[keep]]))
+
+    def _excludes(self, scene: SceneData, geometry) -> None:
+        """What each light's and each emissive triangle's samples leave out (``LightSamples.exclude``
+        bits): the BSDF parts whose rays do not see it (an emissive object's by its object's ray
+        visibility, as Cycles' light_object_shader_flags) and, for lights, Cast Shadow off."""
+        def unlit(item):
+            return ((0 if item.visible_diffuse else UNLIT_DIFFUSE) | (0 if item.visible_glossy else UNLIT_REFLECTION)
+                    | (0 if item.visible_transmission else UNLIT_TRANSMISSION))
+
+        self.light_exclude = np.array([unlit(light) | (0 if light.cast_shadow else NO_SHADOW) for light in self.lights],
+                                      np.int8)
+        sources = geometry.source_of(self.emissive)[:, 0] if len(self.emissive) else np.zeros(0, np.int64)
+        self.emissive_exclude = np.array([unlit(scene.instances[k]) for k in sources], np.int8)
+        self.excluding = bool(self.light_exclude.any() or self.emissive_exclude.any())
 
     @property
     def moving(self) -> bool:
@@ -251,6 +276,19 @@ class Lights:
                 out.value[w, k] = self.environment.radiance(out.wi[w, k], path) / out.pdf[w, k, None]
             if self.world_lobes is not None:
                 out.restrict[w] = self.world_lobes
+        if self.excluding:
+            out.exclude = self._sample_excludes(pick)
+        return out
+
+    def _sample_excludes(self, pick) -> np.ndarray:
+        """``LightSamples.exclude`` of samples whose lights or triangles are ``pick`` (strategy by hit)."""
+        out = np.zeros(pick.shape, np.int8)
+        slots = self.light_slots
+        if slots:
+            out[:slots] = self.light_exclude[pick[:slots]]
+        if len(self.emissive):
+            out[slots] = self.emissive_exclude[np.minimum(np.searchsorted(self.emissive, pick[slots]),
+                                                          len(self.emissive) - 1)]
         return out
 
     def sample(self, k: int, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, u_pick: np.ndarray | None = None,
@@ -346,6 +384,17 @@ class Lights:
                                             np.ascontiguousarray(origins[found], np.float64), dirs[found],
                                             np.asarray(t, np.float64)[found])
         return out
+
+    def seen(self, light_id, straight, dirs, prev_normal, bounces):
+        """``light_id`` (the light each ray hit, -1: none) where the ray sees that light as its ray
+        visibility says, -1 where it does not (the ray goes on past it); ``bounces`` the rays'
+        kinds and depths when paths carry them (core.shading.lightpath)."""
+        if not self.partly_lit:  # only the camera may not see a light
+            return np.where(straight & ~self.camera_visible[np.maximum(light_id, 0)], -1, light_id)
+        kinds = np.ascontiguousarray(bounces[:, KIND]) if bounces is not None else _NO_KINDS
+        shown = lights_shown_batch(np.ascontiguousarray(light_id, np.int64), dirs, straight, prev_normal, kinds,
+                                   self.visibility)
+        return np.where(shown, light_id, -1)
 
     def pdf_world(self, prev_normal, dirs):
         return pdf_world_batch(prev_normal, dirs, self._map_share, *self._map[2:])

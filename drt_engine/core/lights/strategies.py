@@ -6,7 +6,7 @@ caller fills in after, from what the kernel leaves (picks, barycentrics, ``lit``
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -23,14 +23,20 @@ UNRESTRICTED = -1
 holds whether it lights the diffuse, reflection and transmission parts (the world's ray visibility)."""
 
 NO_WORLD, UNIFORM_WORLD, MAP_WORLD = 0, 1, 2
+NO_SHADOW = 8
+"""A bit of ``LightSamples.exclude`` beside bsdf.mixture's ``UNLIT_*``: the sample's light casts no
+shadow (Cycles' Cast Shadow off), its shadow ray is not traced."""
+_NOTHING_EXCLUDED = np.zeros((0, 0), np.int8)
 
 
 @dataclass
 class LightSamples:
     """Every light strategy's sample at the hits of one depth step, strategy by hit: direction,
     distance (inf for distant), value (radiance / pdf; zero where nothing was sampled), pdf, the
-    distance to stop short of an emitter that is geometry, and per strategy the BSDF parts it
-    lights (core.integrator.direct's ``restrict``)."""
+    distance to stop short of an emitter that is geometry, per strategy the BSDF parts it
+    lights (core.integrator.direct's ``restrict``) and per sample what its light leaves out
+    (``exclude``: bsdf.mixture's ``UNLIT_*`` bits and ``NO_SHADOW``, from the ray visibility of
+    the light or emissive object sampled; empty when no light leaves anything out)."""
 
     wi: np.ndarray
     dist: np.ndarray
@@ -38,6 +44,7 @@ class LightSamples:
     pdf: np.ndarray
     stop: np.ndarray
     restrict: np.ndarray
+    exclude: np.ndarray = field(default_factory=lambda: _NOTHING_EXCLUDED)
 
     @classmethod
     def empty(cls, strategies: int, n: int) -> "LightSamples":
@@ -55,7 +62,8 @@ class LightSamples:
 
     def take(self, rows) -> "LightSamples":
         return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
-                            self.stop[:, rows], self.restrict)
+                            self.stop[:, rows], self.restrict, self.exclude[:, rows] if self.exclude.size else
+                            self.exclude)
 
     def arrays(self) -> tuple:
         """The fields, contiguous, in the order core.integrator.direct's kernel takes them."""

@@ -55,24 +55,45 @@ def pdf_world_batch(normal, dirs, share, cell, cell_area, sun):
     return out
 
 
+@kernel(inline="always")
+def shown(straight, kinds, j, reflected, camera, diffuse, glossy, transmission):
+    """Whether ray j sees a light of this ray visibility, as Cycles' background and light shaders
+    decide: by the camera (``straight``); with ``kinds`` (the rays' kind bits,
+    core.shading.lightpath) hidden from a diffuse ray by Diffuse, from a glossy reflection by
+    Glossy, from any transmission (a translucent one too) by Transmission; without them (no ray
+    took a diffuse lobe) a ray ``reflected`` (on the normal's side) is a glossy one, any other a
+    transmission."""
+    if straight:
+        return camera
+    if len(kinds):
+        k = kinds[j]
+        return not (((k & DIFFUSE) != 0 and not diffuse)
+                    or ((k & (GLOSSY | REFLECT)) == (GLOSSY | REFLECT) and not glossy)
+                    or ((k & TRANSMIT) != 0 and not transmission))
+    return glossy if reflected else transmission
+
+
 @kernel
 def world_shown_batch(dirs, straight, normal, kinds, camera, diffuse, glossy, transmission):
-    """Whether the world is seen along each ray, as its ray visibility says: by the camera; with
-    ``kinds`` (the rays' kind bits, core.shading.lightpath), as Cycles' background shader does:
-    hidden from a diffuse ray by Diffuse, from a glossy reflection by Glossy, from any
-    transmission (a translucent one too) by Transmission; without them (no ray took a diffuse
-    lobe) a ray reflected (d on the normal's side) is a glossy one, any other a transmission."""
+    """Whether the world is seen along each ray, as its ray visibility says (``shown``)."""
     out = np.empty(len(dirs), np.bool_)
     for j in range(len(dirs)):
-        if straight[j]:
-            out[j] = camera
-        elif len(kinds):
-            k = kinds[j]
-            out[j] = not (((k & DIFFUSE) != 0 and not diffuse)
-                          or ((k & (GLOSSY | REFLECT)) == (GLOSSY | REFLECT) and not glossy)
-                          or ((k & TRANSMIT) != 0 and not transmission))
-        elif dirs[j, 0] * normal[j, 0] + dirs[j, 1] * normal[j, 1] + dirs[j, 2] * normal[j, 2] >= 0:
-            out[j] = glossy
-        else:
-            out[j] = transmission
+        reflected = dirs[j, 0] * normal[j, 0] + dirs[j, 1] * normal[j, 1] + dirs[j, 2] * normal[j, 2] >= 0
+        out[j] = shown(straight[j], kinds, j, reflected, camera, diffuse, glossy, transmission)
+    return out
+
+
+@kernel
+def lights_shown_batch(ids, dirs, straight, normal, kinds, visibility):
+    """Whether each ray sees the light it hit (``ids``, -1: none), as that light's ray visibility
+    (``visibility`` per light: camera, diffuse, glossy, transmission) says (``shown``)."""
+    out = np.empty(len(dirs), np.bool_)
+    for j in range(len(dirs)):
+        i = ids[j]
+        if i < 0:
+            out[j] = False
+            continue
+        reflected = dirs[j, 0] * normal[j, 0] + dirs[j, 1] * normal[j, 1] + dirs[j, 2] * normal[j, 2] >= 0
+        out[j] = shown(straight[j], kinds, j, reflected, visibility[i, 0], visibility[i, 1], visibility[i, 2],
+                       visibility[i, 3])
     return out
