@@ -52,6 +52,10 @@ class Closure:
     (core.bsdf.shader.anisotropic_alphas), along the hits' tangent (input "tangent")."""
     anisotropic_rotation: float = 0.0
     """Turns of the tangent about the normal."""
+    toon_size: float = 0.5
+    """DIFFUSE_TOON / GLOSSY_TOON: the Toon BSDF's Size, the cone of full intensity (0 to 1: 0 to 90 degrees)."""
+    toon_smooth: float = 0.0
+    """The Toon BSDF's Smooth, the angle past Size over which the intensity falls to 0 (0 to 1: 0 to 90 degrees)."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
     "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``
@@ -74,6 +78,8 @@ CLOSURE_KINDS = (
     "EMISSION",  # emitted radiance ``emission``, two-sided
     "TRANSPARENT",  # straight through, tinted by colour
     "HOLDOUT",  # no light: where the camera sees it, that share of the pixel is transparent (Cycles' holdout)
+    "DIFFUSE_TOON",  # Cycles' diffuse toon: a cone about the normal, colour = weight
+    "GLOSSY_TOON",  # Cycles' glossy toon: a cone about the mirror direction, colour = weight
 )
 
 

@@ -18,17 +18,8 @@ import bpy
 from drt_engine.core.bsdf import shader as shader_module
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
-from tests.support.datablocks import new_material
 
 WIDTH, HEIGHT = 64, 32
-
-
-def _sphere(name, x, material):
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(x, 0.0, 0.0), segments=64, ring_count=32)
-    bpy.ops.object.shade_smooth()
-    obj = bpy.context.active_object
-    obj.name = name
-    obj.data.materials.append(material)
 
 
 def _lit_scene(camera_location):
@@ -46,26 +37,14 @@ def _lit_scene(camera_location):
     return scene
 
 
-def _closure_material(name, bl_idname, **inputs):
-    """A material of one closure node ``bl_idname`` with these input values, and the node."""
-    material = new_material(name)
-    tree = material.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    node = tree.nodes.new(bl_idname)
-    for socket, value in inputs.items():
-        node.inputs[socket.replace("_", " ")].default_value = value
-    tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
-    return material, node
-
-
 def anisotropic_scene():
     scene = _lit_scene((0.0, -7.0, 1.5))
-    metal, _ = _closure_material("Brushed", "ShaderNodeBsdfPrincipled", Base_Color=(0.9, 0.7, 0.4, 1.0),
-                                 Metallic=1.0, Roughness=0.35, Anisotropic=0.9)
-    _sphere("Principled", -1.1, metal)
-    glossy, _ = _closure_material("Turned", "ShaderNodeBsdfAnisotropic", Color=(0.5, 0.7, 0.9, 1.0),
-                                  Roughness=0.4, Anisotropy=-0.7, Rotation=0.125)
-    _sphere("Glossy", 1.1, glossy)
+    metal, _ = ps.closure_material("Brushed", "ShaderNodeBsdfPrincipled", Base_Color=(0.9, 0.7, 0.4, 1.0),
+                                   Metallic=1.0, Roughness=0.35, Anisotropic=0.9)
+    ps.smooth_sphere("Principled", -1.1, metal)
+    glossy, _ = ps.closure_material("Turned", "ShaderNodeBsdfAnisotropic", Color=(0.5, 0.7, 0.9, 1.0),
+                                    Roughness=0.4, Anisotropy=-0.7, Rotation=0.125)
+    ps.smooth_sphere("Glossy", 1.1, glossy)
     return scene
 
 
@@ -75,12 +54,12 @@ def textured_scene():
     turned per hit by a Noise texture, along the UV map's tangent (a Tangent node)."""
     scene = _lit_scene((0.0, -5.0, 1.0))
     if hasattr(bpy.types, "ShaderNodeBsdfMetallic"):
-        material, node = _closure_material("Textured", "ShaderNodeBsdfMetallic", Base_Color=(0.8, 0.8, 0.85, 1.0),
-                                           Roughness=0.4)
+        material, node = ps.closure_material("Textured", "ShaderNodeBsdfMetallic", Base_Color=(0.8, 0.8, 0.85, 1.0),
+                                              Roughness=0.4)
         anisotropy, rotation = node.inputs["Anisotropy"], node.inputs["Rotation"]
     else:
-        material, node = _closure_material("Textured", "ShaderNodeBsdfPrincipled", Base_Color=(0.8, 0.8, 0.85, 1.0),
-                                           Metallic=1.0, Roughness=0.4)
+        material, node = ps.closure_material("Textured", "ShaderNodeBsdfPrincipled", Base_Color=(0.8, 0.8, 0.85, 1.0),
+                                              Metallic=1.0, Roughness=0.4)
         anisotropy, rotation = node.inputs["Anisotropic"], node.inputs["Anisotropic Rotation"]
     tree = material.node_tree
     coords = tree.nodes.new("ShaderNodeTexCoord")
@@ -93,7 +72,7 @@ def textured_scene():
     tangent = tree.nodes.new("ShaderNodeTangent")
     tangent.direction_type = "UV_MAP"
     tree.links.new(tangent.outputs["Tangent"], node.inputs["Tangent"])
-    _sphere("Sphere", 0.0, material)
+    ps.smooth_sphere("Sphere", 0.0, material)
     return scene
 
 

@@ -805,14 +805,32 @@ def test_view_layer_material_and_world_overrides():
 
 def test_unsupported_shader_node_renders_default_grey_with_one_warning():
     scene = empty_scene()
-    material, tree, output = _new_node_material("Toon")
-    tree.links.new(tree.nodes.new("ShaderNodeBsdfToon").outputs[0], output.inputs["Surface"])
+    material, tree, output = _new_node_material("Sheen")
+    tree.links.new(tree.nodes.new("ShaderNodeBsdfSheen").outputs[0], output.inputs["Surface"])
     data = render_export(_material_scene(material))
-    closures = _closures(data, "Toon")
+    closures = _closures(data, "Sheen")
     assert [(c.kind, tuple(c.color)) for c in closures] == [
         (c.kind, tuple(c.color)) for c in DEFAULT_MATERIAL.closures
     ]
-    assert len(data.warnings) == 1 and "Toon" in data.warnings[0]
+    assert len(data.warnings) == 1 and "Sheen" in data.warnings[0]
+
+
+@pytest.mark.parametrize("component, kind", [("DIFFUSE", "DIFFUSE_TOON"), ("GLOSSY", "GLOSSY_TOON")])
+def test_toon_bsdf_exports_its_component_size_and_smooth_without_a_warning(component, kind):
+    empty_scene()
+    material, tree, output = _new_node_material("Toon")
+    toon = tree.nodes.new("ShaderNodeBsdfToon")
+    toon.component = component
+    toon.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1.0)
+    toon.inputs["Size"].default_value = 0.3
+    toon.inputs["Smooth"].default_value = 0.1
+    tree.links.new(toon.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Toon")
+    assert closure.kind == kind
+    np.testing.assert_allclose(closure.color, (0.2, 0.4, 0.6), rtol=1e-6)
+    assert (closure.toon_size, closure.toon_smooth) == pytest.approx((0.3, 0.1))
+    assert data.warnings == []
 
 
 def test_light_node_tree_emission_scales_the_strength():

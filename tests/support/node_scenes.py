@@ -906,6 +906,15 @@ def _metallic(tree):
                  **{"Base Color": ramp.outputs[2], "Edge Tint": (0.6, 0.8, 1.0, 1.0)})
 
 
+def _toon(component, size, smooth):
+    """A Toon BSDF of this component, Size and Smooth."""
+    def build(tree):
+        node = _link(tree, _node(tree, "ShaderNodeBsdfToon"), Color=(0.9, 0.6, 0.3, 1.0), Size=size, Smooth=smooth)
+        node.component = component
+        return node
+    return build
+
+
 def _translucent(tree, colour=(0.3, 0.9, 0.4, 1.0)):
     return _link(tree, _node(tree, "ShaderNodeBsdfTranslucent"), Color=colour)
 
@@ -937,6 +946,8 @@ class ClosureCase:
 
 
 CLOSURES = (
+    ClosureCase("Toon BSDF, glossy, Size 0.2, Smooth 0.1", "sphere", _toon("GLOSSY", 0.2, 0.1)),
+    ClosureCase("Toon BSDF, diffuse, Size 0.5, Smooth 0.1", "sphere", _toon("DIFFUSE", 0.5, 0.1)),
     ClosureCase("Metallic BSDF, F82, base colour from a texture", "sphere", _metallic, since=(5, 0)),
     ClosureCase("Oren-Nayar, roughness 1", "sphere", lambda tree: _rough_diffuse(tree, 1.0), True),
     ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
@@ -945,9 +956,10 @@ CLOSURES = (
     ClosureCase("Translucent", "square", _translucent),
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
 )
-"""Closures under two suns, each in its own square of ``closure_scene``: a Metallic BSDF sphere
-(first: a glossy neighbour would light the translucent squares through Cycles' transmission
-bounces, which DRT does not trace through a Translucent), rough diffuse spheres
+"""Closures under two suns, each in its own square of ``closure_scene``: toon spheres, glossy and
+diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere (these first: a glossy
+neighbour would light the translucent squares through Cycles' transmission bounces, which DRT
+does not trace through a Translucent), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
 textured, and a Principled BSDF's Diffuse Roughness) and upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front)."""

@@ -252,6 +252,26 @@ def add_primitive(op, mat, name=None, **kw):
     return obj
 
 
+def smooth_sphere(name, x, material) -> None:
+    """A smooth-shaded unit UV sphere at (x, 0, 0) with ``material``."""
+    add_primitive(bpy.ops.mesh.primitive_uv_sphere_add, material, name, radius=1.0, location=(x, 0.0, 0.0),
+                  segments=64, ring_count=32)
+    bpy.ops.object.shade_smooth()
+
+
+def closure_material(name, bl_idname, **inputs):
+    """A material of one closure node ``bl_idname`` with these input values (underscores for
+    spaces), and the node."""
+    material = new_material(name)
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    node = tree.nodes.new(bl_idname)
+    for socket, value in inputs.items():
+        node.inputs[socket.replace("_", " ")].default_value = value
+    tree.links.new(node.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    return material, node
+
+
 def grid_shape(n: int) -> tuple[int, int]:
     cols = int(np.ceil(np.sqrt(n)))
     return cols, int(np.ceil(n / cols))

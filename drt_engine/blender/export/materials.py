@@ -41,7 +41,7 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation")
+           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -163,6 +163,18 @@ def _bsdf(kind):
     return make
 
 
+def _toon(node, weight, issues, compiler):
+    """The Toon BSDF: Cycles' diffuse or glossy toon closure (its component), Size and Smooth as the
+    node gives them (core.bsdf.shader.toon_angles clamps them as Cycles does)."""
+    value = _Inputs(node, compiler, issues)
+    kind = "GLOSSY_TOON" if getattr(node, "component", "DIFFUSE") == "GLOSSY" else "DIFFUSE_TOON"
+    closure = Closure(kind, color=rgb(value(0.8, "Color", field="color", kind="color")),
+                      toon_size=value(0.5, "Size", field="toon_size", kind="float"),
+                      toon_smooth=value(0.0, "Smooth", field="toon_smooth", kind="float"))
+    value.normal()
+    return [_weighted(closure, weight, value.varying)]
+
+
 OREN_NAYAR_MATCHED_FROM = (4, 3)
 """The first Blender taken to have the Oren-Nayar DRT computes (Fujii's with a multiple-scattering
 term, kernel/closure/bsdf_oren_nayar.h), the version that added the Principled BSDF's Diffuse
@@ -238,6 +250,7 @@ CLOSURE_NODES = {
     "ShaderNodeBsdfTransparent": _bsdf("TRANSPARENT"),
     "ShaderNodeBsdfTranslucent": _bsdf("TRANSLUCENT"),
     "ShaderNodeHoldout": _holdout,
+    "ShaderNodeBsdfToon": _toon,
 }
 
 

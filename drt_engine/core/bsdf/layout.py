@@ -8,7 +8,7 @@
   ``hp[prow[i]]`` (``hp`` and the row ``r`` in the scalar functions).
 """
 # lobe kinds and Fresnel kinds
-DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR = 0, 1, 2, 3, 4, 5
+DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
 F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
@@ -38,7 +38,9 @@ P_SIGMA = 31  # Oren-Nayar roughness sigma
 P_ANISO = 32  # 1: anisotropic GGX (reflect lobes), alpha_x along the frame's tangent, alpha_y along its bitangent
 P_ALPHA_X = 33
 P_ALPHA_Y = 34
-P = 35
+P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
+P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
+P = 37
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice
@@ -53,7 +55,7 @@ T = 17
 
 # hp: per hit
 H_SCALE = 0  # (3) weight multiplier
-H_COLOUR = 3  # (3) diffuse / transparent colour
+H_COLOUR = 3  # (3) diffuse / transparent / toon colour
 H_TINT_R = 6  # (3) glass reflection tint
 H_TINT_T = 9  # (3) glass transmission tint
 H_F0 = 12  # (3) Fresnel colour

@@ -22,11 +22,12 @@ from ..base.jit import kernel
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
 from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
-                     TRANSLUCENT, TRANSPARENT)
+                     TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import reflect_eval, reflect_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
+from .toon import toon_cone_sample, toon_diffuse_eval, toon_glossy_eval, toon_glossy_sample
 from .translucent import translucent_eval
 from .transparent import transparent_sample
 
@@ -43,7 +44,7 @@ def slot(lp, l, diffuse):
     if diffuse == 0:
         return int(lp[l, P_SAMPLED])
     kind = int(lp[l, P_KIND])
-    if kind == DIFFUSE or kind == OREN_NAYAR:
+    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE:
         return l if diffuse & SAMPLE_DIFFUSE else -1
     if kind == TRANSLUCENT:
         return l if diffuse & SAMPLE_TRANSLUCENT else -1
@@ -99,6 +100,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             continue
         kind = int(lp[l, P_KIND])
         if diffuse_kind(kind):
+            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone
             if kind == TRANSLUCENT:
                 if not trans:
                     continue
@@ -107,6 +109,8 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 continue
             elif kind == DIFFUSE:
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
+            elif kind == TOON_DIFFUSE:
+                d0, d1, d2, p = toon_diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
             else:
                 d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
             d0, d1, d2 = d0 * lit_diffuse, d1 * lit_diffuse, d2 * lit_diffuse
@@ -115,7 +119,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 fn0 += d0
                 fn1 += d1
                 fn2 += d2
-                pdf += sel[si, k] * abs(wiz) / np.pi
+                pdf += sel[si, k] * p
                 continue
             fd0 += d0
             fd1 += d1
@@ -125,6 +129,10 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             if not refl:
                 continue
             f0, f1, f2, p = reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+        elif kind == TOON_GLOSSY:
+            if not refl:
+                continue
+            f0, f1, f2, p = toon_glossy_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
         else:
             f0, f1, f2, p = glass_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz, refl, trans, lobe_eta(lp, l, inside))
             if p == 0.0 and f0 == 0.0 and f1 == 0.0 and f2 == 0.0:
@@ -147,6 +155,8 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
         return transparent_sample(hp, r, l, wox, woy, woz)
     if kind == REFLECT:
         return reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
+    if kind == TOON_GLOSSY:
+        return toon_glossy_sample(lp, hp, r, l, wox, woy, woz, u0, u1)
     return glass_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta)
 
 
@@ -182,7 +192,11 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         while int(lp[l, P_SAMPLED]) != choice:
             l += 1
     kind = int(lp[l, P_KIND])
-    if diffuse_kind(kind):  # its weight is the mixture's, below
+    if kind == TOON_DIFFUSE:  # its weight is the mixture's, below, as the other diffuse lobes'
+        wix, wiy, wiz = toon_cone_sample(lp, l, 0.0, 0.0, 1.0, u0, u1)
+        w0 = w1 = w2 = 1.0
+        ok = True
+    elif diffuse_kind(kind):
         wix, wiy, wiz, _ = cosine_sample(u0, u1, -1.0 if kind == TRANSLUCENT else 1.0)
         w0 = w1 = w2 = 1.0
         ok = True

@@ -5,15 +5,15 @@ from __future__ import annotations
 from ..base.jit import kernel
 from . import microfacet as mf
 from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND, P_REFRACT_ONLY, REFLECT,
-                     TRANSLUCENT, TRANSPARENT)
+                     TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
 
 
 @kernel(inline="always")
 def diffuse_kind(kind):
-    """Lambert, Oren-Nayar or translucent: Cycles' diffuse closures (CLOSURE_IS_BSDF_DIFFUSE), which
-    its DiffCol pass and the diffuse side of its denoising albedo take."""
-    return kind == DIFFUSE or kind == OREN_NAYAR or kind == TRANSLUCENT
+    """Lambert, Oren-Nayar, diffuse toon or translucent: Cycles' diffuse closures
+    (CLOSURE_IS_BSDF_DIFFUSE), which its DiffCol pass and the diffuse side of its denoising albedo take."""
+    return kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == TRANSLUCENT
 
 
 @kernel(inline="always")
@@ -34,6 +34,11 @@ def colours(lp, lt, hp, r, mu, mu_o):
             g0 += s0 * e0
             g1 += s1 * e1
             g2 += s2 * e2
+        elif kind == TOON_GLOSSY:  # Cycles' albedo of a closure without tables: its weight
+            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            g0 += a0
+            g1 += a1
+            g2 += a2
         elif kind == GLASS and lp[l, P_REFRACT_ONLY] == 0.0:
             # Cycles reports the reflected share of glass as its glossy colour
             s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
@@ -53,8 +58,9 @@ DENOISE_ROUGH = 0.075
 def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
     """(diffuse-like albedo RGB, specular-like albedo RGB, whether the hit is diffuse-like enough
     to take the denoising features), by Cycles' rule: each lobe's albedo goes to one side by its
-    roughness, and the hit waits for the next bounce if 75% or more of the lobes' weight (the
-    mean of their albedos) is specular-like."""
+    roughness (the glossy toon's counts as 1, as Cycles' bsdf_get_specular_roughness_squared has
+    it for a closure that is not microfacet), and the hit waits for the next bounce if 75% or more
+    of the lobes' weight (the mean of their albedos) is specular-like."""
     j, t = locate(mu, mu_o)
     d0 = d1 = d2 = s0 = s1 = s2 = 0.0
     total = diffuse = 0.0
@@ -76,7 +82,7 @@ def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         weight = (a0 + a1 + a2) / 3.0
         total += weight
-        if diffuse_kind(kind) or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
+        if diffuse_kind(kind) or kind == TOON_GLOSSY or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
             d0 += a0
             d1 += a1
             d2 += a2

@@ -1,5 +1,5 @@
 """Materials as sums of lobes: Lambert, Oren-Nayar, translucent, GGX reflection, dielectric (glass),
-transparent.
+transparent, toon (diffuse and glossy).
 
 A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
 with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
@@ -8,7 +8,7 @@ the layer below weighted by one minus the albedo of the layer above. Energy term
 
 Directions are in the local shading frame with ``wo`` always in the upper hemisphere
 (the caller flips the frame to the side the ray arrived from; glass inverts its IOR).
-The diffuse lobes (Lambert, Oren-Nayar, translucent) are evaluated for light sampling only: as
+The diffuse lobes (Lambert, Oren-Nayar, translucent, diffuse toon) are evaluated for light sampling only: as
 in Cook's distribution ray tracing (and Cycles with diffuse bounces 0) no rays continue from them.
 
 Building lobes and their tables is NumPy, once per shader; the per-ray work (evaluation,
@@ -37,12 +37,14 @@ from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, sel
 class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
     arrays of ``layout``."""
-    kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent"
+    kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent" | "toon_diffuse"
+    # | "toon_glossy"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
     alpha: float = 0.0
     sigma: float = 0.0  # Oren-Nayar roughness
+    toon: tuple = (0.0, 0.0)  # toon: (size, smooth) as angles in radians
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
     fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
@@ -57,6 +59,7 @@ class Lobe:
     f82: np.ndarray | None = None  # metal: F82 tint
     source: int = 0  # index of the closure the lobe comes from
     role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent" | "translucent"
+    # | "toon"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
     alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
 
@@ -90,7 +93,7 @@ class Lobe:
         return self.alpha * min(1.0, abs(self.eta - 1.0))
 
 
-DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent")
+DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent", "toon_diffuse")
 
 
 def _alpha(roughness: float) -> float:
@@ -365,6 +368,14 @@ def _diffuse_lobe(weight, albedo, roughness, layers=()) -> Lobe:
                 sigma=float(roughness) if rough else 0.0, role="diffuse")
 
 
+def toon_angles(size: float, smooth: float) -> tuple[float, float]:
+    """(size, smooth) as angles, as Cycles' bsdf_toon_setup_common sets them: Size clamped to
+    [1e-5, 1] and Smooth to [0, 1], each times pi / 2 (a non-finite value counts as 0)."""
+    size = float(size) if np.isfinite(size) else 0.0
+    smooth = float(smooth) if np.isfinite(smooth) else 0.0
+    return float(np.clip(size, 1e-5, 1.0)) * np.pi / 2, float(np.clip(smooth, 0.0, 1.0)) * np.pi / 2
+
+
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     lobes = []
     for i, c in enumerate(material.closures):
@@ -386,6 +397,9 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
             tint = np.clip(c.color, 0, 1)
             new = [Lobe("glass", c.weight, alpha=_alpha(c.roughness), eta=max(float(c.ior), 1e-5),
                         tint_r=tint, tint_t=tint, refract_only=c.kind == "REFRACTION", role="bsdf_glass")]
+        elif c.kind in ("DIFFUSE_TOON", "GLOSSY_TOON"):
+            new = [Lobe("toon_diffuse" if c.kind == "DIFFUSE_TOON" else "toon_glossy", c.weight,
+                        albedo=np.clip(c.color, 0, 1), toon=toon_angles(c.toon_size, c.toon_smooth), role="toon")]
         elif c.kind == "TRANSPARENT":
             new = [Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1), role="transparent")]
         else:
@@ -405,7 +419,8 @@ def see_through(material: Material) -> bool:
 
 
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
-          "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR}
+          "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR,
+          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -422,6 +437,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_ALPHA], row[layout.P_ALPHA_T], row[layout.P_ETA] = lobe.alpha, lobe.alpha_t, lobe.eta
         row[layout.P_REFRACT_ONLY] = lobe.refract_only
         row[layout.P_SIGMA] = lobe.sigma
+        row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
@@ -519,7 +535,7 @@ class MaterialShader:
             if color is None:
                 continue
             base = np.clip(color, 0.0, 1.0)
-            if lobe.role in ("diffuse", "transparent", "translucent"):
+            if lobe.role in ("diffuse", "transparent", "translucent", "toon"):
                 hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = base
             elif lobe.role == "glass":
                 hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = np.sqrt(base)

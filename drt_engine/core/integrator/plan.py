@@ -73,7 +73,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     bounces = settings.max_depth > 0
     rays = {"camera": True,
             "shadow": lights.strategies > 0 and bool(kinds),
-            "reflection": bounces and bool(kinds & {"reflect", "glass"}),
+            "reflection": bounces and bool(kinds & {"reflect", "glass", "toon_glossy"}),
             "refraction": bounces and "glass" in kinds,
             "transparent": bounces and "transparent" in kinds,
             "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS))}
