@@ -107,6 +107,11 @@ class Material:
     transparent_shadow: bool = True
     """Shadow rays may pass it where it is transparent (Blender's Transparent Shadows, read by
     Cycles): off, its surfaces block them."""
+    bump_shadowing: str = "GGX"
+    """How a bumped normal shadows the light the smooth normal sees at grazing angles
+    (core.bsdf.bump_shadowing): "GGX" as Cycles 5, "CHIANG" as Cycles 4.2."""
+    bump_correction: bool = True
+    """Its Bump Map Correction (Cycles' material setting): off, no smoothing at the terminator."""
 
     @property
     def emission(self) -> np.ndarray:

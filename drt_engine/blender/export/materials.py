@@ -191,6 +191,17 @@ def _oren_nayar_version(node, closure, value, issues):
         issues.add(f"'{node.name}' roughness ({VERSION_OREN_NAYAR})")
 
 
+BUMP_SHADOWING_GGX_FROM = (5, 0)
+"""The first Blender taken to shadow bumps as Cycles 5 does (Conty Estevez et al.'s microfacet
+term, kernel/closure/bsdf.h bump_shadowing_term; read in 5.0's and 5.2's Cycles); 4.2's and 4.3's
+Cycles have Chiang et al.'s term. 4.4 and 4.5 were not read: taken as 4.3's."""
+
+
+def bump_shadowing_model() -> str:
+    """The bump shadowing of the running Blender's Cycles (core.scene.Material.bump_shadowing)."""
+    return "GGX" if bpy.app.version >= BUMP_SHADOWING_GGX_FROM else "CHIANG"
+
+
 def _emission_input(closure, value, compiler, default_strength, color_names, strength_names):
     """Emission colour x strength: constant, or a varying input of the closure."""
     color = value(1.0, *color_names, field="emission_color", kind="color")
@@ -279,7 +290,9 @@ def export_material(material, images: ImageTable, layer=None) -> tuple[Material,
     varying = any(c.inputs for c in closures) or displacement is not None or any(is_ref(v) for _, v in aovs)
     return (Material(material.name, closures, compiler.program if varying else None, displacement,
                      pass_index=material.pass_index, aovs=aovs,
-                     transparent_shadow=bool(getattr(material, "use_transparent_shadow", True))),
+                     transparent_shadow=bool(getattr(material, "use_transparent_shadow", True)),
+                     bump_shadowing=bump_shadowing_model(),
+                     bump_correction=bool(getattr(getattr(material, "cycles", None), "use_bump_map_correction", True))),
             issues.message(f"Material '{material.name}'"))
 
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
+from .bump_shadowing import bump_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
 from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
@@ -77,14 +78,16 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 
 
 @kernel(inline="always")
-def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit):
+def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit,
+               sx, sy, sz, model):
     """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
 
     ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
     back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo, for the ``diffuse``
     lobes a path may continue through (``slot``). ``unlit`` (``UNLIT_*`` bits): parts a light
     does not reach (the world's ray visibility): their BSDF is left out, their density kept, so
-    that the rays the lobes send weigh against this light sample as they would. Returns (the part
+    that the rays the lobes send weigh against this light sample as they would. (sx, sy, sz, model):
+    the smooth normal before a bump and its model of shadowing (``bump_shadowing``). Returns (the part
     no ray continues through RGB: the diffuse lobes (Lambert, Oren-Nayar, translucent) left out
     of the choice, the part rays continue through RGB, density of continuing toward wi through
     the lobes of the choice).
@@ -93,8 +96,9 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     fd0 = fd1 = fd2 = fn0 = fn1 = fn2 = pdf = 0.0
     refl = above and wiz > 0.0
     trans = (not above) and wiz < 0.0
-    lit = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else 1.0
-    lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else 1.0
+    shade_diffuse, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
+    lit = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else shade
+    lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else shade_diffuse
     for l in range(lp.shape[0]):
         if lp[l, P_DELTA] != 0.0:
             continue
@@ -161,9 +165,11 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
 
 
 @kernel(inline="always")
-def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si, diffuse):
+def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si, diffuse,
+                 sx, sy, sz, model):
     """Continue through one lobe chosen by ``sel[si]`` (``selection`` at wo with the same
-    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through.
+    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through;
+    (sx, sy, sz, model) the smooth normal as ``eval_lobes`` takes it.
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
     the transparent lobe was taken, diffuse: a diffuse lobe was). For non-delta lobes the weight
@@ -212,7 +218,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     pdf = 0.0
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
-                                              sel, si, diffuse, 0)
+                                              sel, si, diffuse, 0, sx, sy, sz, model)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
+from ..bsdf.bump_shadowing import smooth_local
 from ..bsdf.mixture import sample_lobes, selection
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
@@ -17,7 +18,7 @@ from .bounces import diffuse_bits
 
 
 @kernel
-def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, wo_l, inside, u_select, u2, throughput, pos, ng, scale,
+def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside, u_select, u2, throughput, pos, ng, scale,
                    bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf, passthrough,
                    transmit, next_bounces, diffuse):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
@@ -39,8 +40,9 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, wo_l, inside, u_selec
         bits = diffuse_bits(bounces, j, diffuse_limit)
         sel = sel_nd if bits == 0 else sel_all
         selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
+        sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
-                         inside[j], sel, 0, bits)
+                         inside[j], sel, 0, bits, sx, sy, sz, model)
         t0, t1, t2 = throughput[j, 0] * s[3], throughput[j, 1] * s[4], throughput[j, 2] * s[5]
         peak = np.maximum(np.maximum(t0, t1), t2)
         go[j] = False

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
+from ..bsdf.bump_shadowing import smooth_local
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
@@ -72,7 +73,7 @@ def unlit_parts(restrict, k):
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path, bounces,
                  diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, exclude, scene,
                  center, shadow_mask, times, radiance, f_diff, visibility, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
@@ -80,7 +81,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
-    normal rows), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
+    normal rows), the smooth normal a bump replaced (empty: none, bsdf.bump_shadowing), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
     the diffuse bounces (the diffuse lobes paths continue through are weighed against sampling
     them, integrator.bounces; the others are light-sampled alone), whether any ray ``continues``
     from these hits (at the last depth none does: light sampling alone finds all their light,
@@ -113,6 +114,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
         sel = sel_nd if bits == 0 else sel_all
         selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
         time = times[j] if len(times) else 0.5
+        sx, sy, sz, model = smooth_local(smooth, frame, j)
         hx = hy = hz = 0.0
         if lifted:
             hx, hy, hz = lift(geo, prim[j], u[j], v[j], time, scratch)
@@ -130,7 +132,8 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~NO_SHADOW))
+                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~NO_SHADOW),
+                           sx, sy, sz, model)
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2

@@ -24,6 +24,7 @@ import numpy as np
 from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.vectors import Frame
+from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
 from ..film.denoising import Features
 from ..film.film import PixelFilter
@@ -50,6 +51,7 @@ _MISS_DEPTH = 1e10  # Blender's depth for the background
 _NO_BOUNCES = camera_bounces(0)  # the kernels' bounces when paths carry none
 _NO_ROULETTE = np.full(2, -1, np.int64)
 _NOTHING_CLEAR, _NO_LIMITS = np.zeros(0, bool), np.zeros(0, np.int64)  # the kernels' transparent shadows when off
+_NO_BUMP = np.zeros((0, 4))  # the kernels' smooth normals where no bump replaced the shading normal
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
         ("IndexOB", "X"), ("IndexMA", "X"))
@@ -434,7 +436,7 @@ class Integrator:
             if not shading.varying:
                 yield g, group, shading.shader
                 continue
-            groups, normal, tangent = shading.bind(self._context(group, hits, shadow))
+            groups, normal, tangent, smooth = shading.bind(self._context(group, hits, shadow))
             if normal is not None or tangent is not None:
                 ns, wo = group.ns, group.wo
                 if normal is not None:
@@ -442,7 +444,9 @@ class Integrator:
                     ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, ns)
                     ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
                 frame = Frame.about(ns) if tangent is None else Frame.along(ns, tangent)
-                group = replace(group, frame=frame, wo_l=frame.to_local(wo))
+                if smooth is not None:
+                    smooth = _smooth_rows(smooth, shading.material)
+                group = replace(group, frame=frame, wo_l=frame.to_local(wo), smooth=smooth)
             for sub, shader in groups:
                 yield g.start + sub, group.take(sub), shader
 
@@ -496,7 +500,7 @@ class Integrator:
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
-            _c(group.ng), _c(group.frame.m), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
+            _c(group.ng), _c(group.frame.m), _smooth(group), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
             _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
@@ -517,7 +521,7 @@ class Integrator:
         bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
         next_bounces = np.empty_like(bounces)
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
-                       _c(hits.frame.m),
+                       _c(hits.frame.m), _smooth(hits),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
                        _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, self.diffuse, _c(u.roulette),
                        self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse)
@@ -551,3 +555,14 @@ def _material_slices(mat):
 
 def _c(a):
     return np.ascontiguousarray(a)
+
+
+def _smooth_rows(smooth, material) -> np.ndarray:
+    """The kernels' rows of a bumped material's hits: the smooth normal and its model's code."""
+    code = model_code(material.bump_shadowing, material.bump_correction)
+    return np.concatenate([smooth, np.full((len(smooth), 1), float(code))], axis=1)
+
+
+def _smooth(hits) -> np.ndarray:
+    """The smooth normals of ``hits`` whose shading normal a bump replaced, for the kernels."""
+    return _NO_BUMP if hits.smooth is None else _c(hits.smooth)

@@ -92,7 +92,8 @@ class SurfaceHits(Rows):
     (``inside``: it came from the back), ``wo_l`` is the outgoing direction in that frame,
     ``scale`` the offset that clears the surface, ``row`` the hit's row in its depth's
     intersection results, ``normal`` the mesh's shading normal as interpolated (the Normal pass),
-    ``bounces`` the path state's."""
+    ``bounces`` the path state's, ``smooth`` the shading normal a bump or normal map replaced
+    (facing the ray; None where none did), which shadows the diffuse lobes (bsdf.bump_shadowing)."""
 
     path: np.ndarray
     row: np.ndarray
@@ -110,6 +111,7 @@ class SurfaceHits(Rows):
     time: np.ndarray
     normal: np.ndarray
     bounces: np.ndarray | None = None
+    smooth: np.ndarray | None = None
 
     @property
     def ns(self) -> np.ndarray:

@@ -449,13 +449,16 @@ class MaterialShading:
         return [ev(ref) for ref in refs]
 
     def bind(self, ctx: SurfaceContext):
-        """[(hit indices, shader bound to them)], the per-hit shading normal (or None) and the
-        per-hit tangent of an anisotropic material (or None; ``tangent``)."""
+        """[(hit indices, shader bound to them)], the per-hit shading normal (or None), the
+        per-hit tangent of an anisotropic material (or None; ``tangent``) and the smooth normal
+        the closures' own normal replaced (the hits' or their displacement's; None where they
+        have none: what bump shadowing compares, core.bsdf.bump_shadowing)."""
         if not self.varying:
-            return [(np.arange(ctx.n), self.shader)], None, None
+            return [(np.arange(ctx.n), self.shader)], None, None, None
         ctx = self._displaced(ctx)
         ev = Evaluator(self.material.program, ctx, self.textures)
         normal = ev(self.normal_ref) if self.normal_ref is not None else ctx.normal if self.displaced else None
+        smooth = ctx.normal if self.normal_ref is not None else None
         tangent = None if self.tangent_of is None else self.tangent(ev, ctx.normal if normal is None else normal)
         linear = {}
         keyed = []
@@ -480,7 +483,7 @@ class MaterialShading:
             shader = self._shader_for(key, keyed, linear)
             values = {i: {name: v[rows] for name, v in d.items()} for i, d in linear.items()}
             out.append((rows, shader.bind(values) if values else shader))
-        return out, normal, tangent
+        return out, normal, tangent, smooth
 
     def tangent(self, ev, normal):
         """(N, 3) world tangents of the anisotropic closure: its Tangent input turned about the
