@@ -37,7 +37,8 @@ def fresnel(lp, hp, r, l, c):
                 tf.tinted(f2, hp[r, l, H_F0 + 2], f0_real))
     if kind == F_F82_FILM:
         return tf.film_conductor(tf.SENSITIVITY, c, lp[l, P_FILM], lp[l, P_FILM_IOR], hp[r, l, H_F0],
-                                 hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2], lp[l, P_F82], lp[l, P_F82 + 1], lp[l, P_F82 + 2])
+                                 hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2], lp[l, P_F82], lp[l, P_F82 + 1],
+                                 lp[l, P_F82 + 2])
     return hp[r, l, H_F0], hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2]
 
 

@@ -127,6 +127,17 @@ def anisotropic_alphas(kind: str, roughness: float, anisotropy: float) -> tuple 
     return alpha * (1.0 - a), alpha / (1.0 - a)
 
 
+FILM_GRID = np.linspace(0.0, 1.0, 4097)
+"""Cosines a thin film's Fresnel is computed at for its albedo tables (interpolated between; the
+kernels compute it exactly per ray): the tables then cost what a plain lobe's do."""
+
+
+def _on_grid(fresnel: Callable) -> Callable:
+    """``fresnel`` (cosines -> (N, 3)) read from its values at FILM_GRID."""
+    f = fresnel(FILM_GRID)
+    return lambda c: np.stack([np.interp(c, FILM_GRID, f[:, k]) for k in range(3)], axis=-1)
+
+
 def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
     return lambda c: mf.fresnel_dielectric(c, eta)[:, None] * tint
 
@@ -332,8 +343,8 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
     if metallic > 0:
         f82 = np.clip(c.specular_tint, 0, 1)
         if film and c.thin_film_metal:
-            metal = _reflect_lobe(w * metallic, alpha, lambda x: tf.conductor(x, film, film_ior, base, f82), base_layers,
-                                  c.multiscatter, tables, _key("f82 film", base, f82, film, film_ior),
+            metal = _reflect_lobe(w * metallic, alpha, _on_grid(lambda x: tf.conductor(x, film, film_ior, base, f82)),
+                                  base_layers, c.multiscatter, EXACT, _key("f82 film", base, f82, film, film_ior),
                                   fresnel_kind=layout.F_F82_FILM, f0=base, bare=_f82_fresnel(base, f82))
             metal.film = (film, film_ior)
         else:
@@ -362,8 +373,9 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
             eta = ior if level == 0.5 else float(mf.ior_from_f0(f0)) if f0 > 0 else 1.0
             eta = 1.0 / eta if ior < 1.0 and level != 0.5 else eta
             tint = np.clip(spec_tint, 0.0, 1.0 / max(mf.f0_from_ior(eta), 1e-6))
-            spec = _reflect_lobe(w * opaque, alpha, lambda x: tf.dielectric(x, film, film_ior, eta, tint), base_layers,
-                                 c.multiscatter, tables, _key("dielectric film", eta, tint, film, film_ior),
+            fresnel = _on_grid(lambda x: tf.dielectric(x, film, film_ior, eta, tint))
+            spec = _reflect_lobe(w * opaque, alpha, fresnel, base_layers, c.multiscatter, EXACT,
+                                 _key("dielectric film", eta, tint, film, film_ior),
                                  fresnel_kind=layout.F_FILM, fresnel_eta=eta, f0=tint,
                                  bare=lambda x: np.clip(mf.fresnel_dielectric(x, eta)[:, None] * tint, 0.0, 1.0))
             spec.role, spec.film = "spec", (film, film_ior)
