@@ -1,16 +1,16 @@
 """Principled's Thin Film against Cycles: three smooth spheres under an area light, a point light
-and a grey world, each with a film of IOR 1.33 (Cycles' default), 500 nm thick but on the dielectric (its specular
-layer over the film, coloured by interference over a dark base), where a texture sets it from 300 nm
-at the bottom to 700 nm at the top, a metal (the film over
-the F82-tint metal, Blender 5.0 on) and a glass (reflection and refraction through the film).
+and a grey world, each with a film of IOR 1.33 (Cycles' default), 500 nm thick but on the
+dielectric, where a texture sets it from 300 nm at the bottom to 700 nm at the top: a dielectric
+(its specular layer over the film, coloured by interference over a dark base), a metal (the film
+over the F82-tint metal, Blender 5.0 on) and a glass (reflection and refraction through the film).
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the film left out (as DRT
 rendered it before, with a warning) must fail that limit. Measured (64x48 px, 1024 spp, Blender
-5.0.1): 0.0212 against a limit of 0.0477 (Cycles' seeds 0.0304; the textured dielectric's third 0.0051
-against Cycles' 0.0063), the film left out 0.694; at 256 spp
-Cycles' own figure is 0.12 (the metal's highlight), too loose to hold the film to. Before 5.0
-Cycles computes the film otherwise (DRT names it in the warning): skipped there."""
+5.0.1): 0.0212 against a limit of 0.0477 (Cycles' seeds 0.0304; the textured dielectric's third
+0.0051 against Cycles' 0.0063), the film left out 0.694; at 256 spp Cycles' own figure is 0.12 (the
+metal's highlight), too loose to hold the film to. Before 5.0 Cycles computes the film otherwise
+(DRT names it in the warning): skipped there."""
 from __future__ import annotations
 
 import bpy
