@@ -56,6 +56,13 @@ class Closure:
     """DIFFUSE_TOON / GLOSSY_TOON: the Toon BSDF's Size, the cone of full intensity (0 to 1: 0 to 90 degrees)."""
     toon_smooth: float = 0.0
     """The Toon BSDF's Smooth, the angle past Size over which the intensity falls to 0 (0 to 1: 0 to 90 degrees)."""
+    thin_film_thickness: float = 0.0
+    """PRINCIPLED: thickness (nm) of a thin film over the specular layer, glass and (with
+    ``thin_film_metal``) metal, as Cycles' fresnel_iridescence (core.bsdf.thin_film); up to 0.1, none."""
+    thin_film_ior: float = 1.33
+    """The thin film's IOR."""
+    thin_film_metal: bool = True
+    """The film covers the metal lobe too (Cycles 5.0 on; 4.x leaves metal bare)."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
     "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``

@@ -833,6 +833,42 @@ def test_toon_bsdf_exports_its_component_size_and_smooth_without_a_warning(compo
     assert data.warnings == []
 
 
+def test_principled_thin_film_exports_thickness_and_ior_without_a_warning_from_5_0():
+    """Thickness and IOR go to the closure (the thickness linkable); from 5.0 the film covers the
+    metal too and nothing is named; before, the metal stays bare and the film is named."""
+    empty_scene()
+    material, tree, output = _new_node_material("Film")
+    bsdf = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Thin Film Thickness"].default_value = 420.0
+    bsdf.inputs["Thin Film IOR"].default_value = 1.6
+    tree.links.new(bsdf.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Film")
+    assert (closure.thin_film_thickness, closure.thin_film_ior) == pytest.approx((420.0, 1.6))
+    if bpy.app.version >= (5, 0):
+        assert closure.thin_film_metal and data.warnings == []
+    else:
+        assert not closure.thin_film_metal and len(data.warnings) == 1 and "thin film" in data.warnings[0]
+    z = tree.nodes.new("ShaderNodeSeparateXYZ")
+    tree.links.new(tree.nodes.new("ShaderNodeTexCoord").outputs["Generated"], z.inputs[0])
+    tree.links.new(z.outputs["Z"], bsdf.inputs["Thin Film Thickness"])
+    (closure,) = _closures(render_export(bpy.context.scene), "Film")
+    assert "thin_film_thickness" in closure.inputs
+
+
+def test_thin_film_over_a_physical_conductor_is_named():
+    if bpy.app.version < (5, 0):
+        pytest.skip("the Metallic BSDF is Blender 5's")
+    empty_scene()
+    material, tree, output = _new_node_material("Conductor film")
+    metal = tree.nodes.new("ShaderNodeBsdfMetallic")
+    metal.fresnel_type = "PHYSICAL_CONDUCTOR"
+    metal.inputs["Thin Film Thickness"].default_value = 300.0
+    tree.links.new(metal.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    assert len(data.warnings) == 1 and "thin film over a Physical Conductor" in data.warnings[0]
+
+
 def test_light_node_tree_emission_scales_the_strength():
     scene = empty_scene()
     lamp = _light(scene, "POINT", energy=10.0)

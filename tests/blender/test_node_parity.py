@@ -3,7 +3,7 @@ and mode of tests/support/node_scenes.CASES as a tile of one emissive grid, and 
 Weight as the colour of diffuse spheres seen at every angle, from the front and the back; Object
 Info, a Wireframe in pixels, the material's Displacement (as bump), Light Path (on a mirror floor,
 through glass and a transparent sheet), a Sky Texture world lighting a sphere on the ground, and
-closures (Toon, Metallic, Oren-Nayar, Translucent) under suns in scenes of their own.
+closures (Toon, Metallic, Principled Thin Film, Oren-Nayar, Translucent) under suns in scenes of their own.
 The rule is the procedural textures' (procedural_scenes.parity):
 DRT's worst 4x4-block difference from Cycles (seed 0) at most 1.5x Cycles' own between seeds 0 and
 1, plus 0.002. Export is checked to evaluate every case without a warning, while a node DRT still

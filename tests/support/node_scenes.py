@@ -906,6 +906,16 @@ def _metallic(tree):
                  **{"Base Color": ramp.outputs[2], "Edge Tint": (0.6, 0.8, 1.0, 1.0)})
 
 
+def _thin_film(metallic):
+    """A Principled BSDF, roughness 0.5, with a 500 nm film of IOR 1.33 (Cycles' default): over a dark
+    dielectric (metallic 0) or a copper-coloured metal (metallic 1)."""
+    def build(tree):
+        colour = (0.9, 0.6, 0.3, 1.0) if metallic else (0.05, 0.05, 0.05, 1.0)
+        return _link(tree, _node(tree, "ShaderNodeBsdfPrincipled"), Metallic=metallic, Roughness=0.5,
+                     **{"Base Color": colour, "Thin Film Thickness": 500.0, "Thin Film IOR": 1.33})
+    return build
+
+
 def _toon(component, size, smooth):
     """A Toon BSDF of this component, Size and Smooth."""
     def build(tree):
@@ -949,6 +959,10 @@ CLOSURES = (
     ClosureCase("Toon BSDF, glossy, Size 0.2, Smooth 0.1", "sphere", _toon("GLOSSY", 0.2, 0.1)),
     ClosureCase("Toon BSDF, diffuse, Size 0.5, Smooth 0.1", "sphere", _toon("DIFFUSE", 0.5, 0.1)),
     ClosureCase("Metallic BSDF, F82, base colour from a texture", "sphere", _metallic, since=(5, 0)),
+    ClosureCase("Principled BSDF, Thin Film 500 nm, dielectric, roughness 0.5", "sphere", _thin_film(0.0),
+                since=(5, 0)),
+    ClosureCase("Principled BSDF, Thin Film 500 nm, metallic, roughness 0.5", "sphere", _thin_film(1.0),
+                since=(5, 0)),
     ClosureCase("Oren-Nayar, roughness 1", "sphere", lambda tree: _rough_diffuse(tree, 1.0), True),
     ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
                 lambda tree: _rough_diffuse(tree, _generated_z(tree, 1.0, 0.0)), True),
@@ -957,7 +971,8 @@ CLOSURES = (
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
 )
 """Closures under two suns, each in its own square of ``closure_scene``: toon spheres, glossy and
-diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere (these first: a glossy
+diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere, thin-film spheres from 5.0 (whose
+Cycles computes the film as DRT does; these first: a glossy
 neighbour would light the translucent squares through Cycles' transmission bounces, which DRT
 does not trace through a Translucent), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,

@@ -41,7 +41,8 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth")
+           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth",
+           "thin_film_thickness", "thin_film_ior")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -105,7 +106,6 @@ def _principled(node, weight, issues, compiler):
     for feature, names in (
         ("Subsurface", ("Subsurface Weight", "Subsurface")),
         ("Sheen", ("Sheen Weight", "Sheen")),
-        ("Thin Film", ("Thin Film Thickness",)),
     ):
         if value(0.0, *names) > 0.0:
             issues.add(f"'{node.name}' {feature}")
@@ -125,6 +125,7 @@ def _principled(node, weight, issues, compiler):
         diffuse_roughness=value(0.0, "Diffuse Roughness", field="diffuse_roughness", kind="float"),
         multiscatter=_multiscatter(node, issues),
     )
+    _thin_film(node, principled, value, issues)
     value.anisotropy(principled, "Anisotropic", "Anisotropic Rotation")
     _oren_nayar_version(node, principled, value, issues)
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
@@ -139,6 +140,25 @@ def _principled(node, weight, issues, compiler):
     if alpha < 1.0:
         closures.append(_weighted(Closure("TRANSPARENT", color=np.ones(3)), compiler.scale(weight, 1.0 - alpha), {}))
     return closures
+
+
+THIN_FILM_MATCHED_FROM = (5, 0)
+"""The first Blender whose Cycles computes the thin film as DRT does (core.bsdf.thin_film: 5.0's
+sensitivity table, the film's IOR blended below 1 nm, the film over the metal lobe too). 4.2's
+Cycles blends below 30 nm, integrates with another fit of the colour matching functions and
+leaves metal bare: there DRT leaves metal bare too and names the film in the warning."""
+VERSION_THIN_FILM = "thin film: rendered as Cycles 5.0 computes it"
+
+
+def _thin_film(node, closure, value, issues):
+    """Principled's Thin Film Thickness and IOR (linkable), on the metal lobe too from 5.0."""
+    closure.thin_film_thickness = value(0.0, "Thin Film Thickness", field="thin_film_thickness", kind="float")
+    if closure.thin_film_thickness == 0.0 and "thin_film_thickness" not in value.varying:
+        return
+    closure.thin_film_ior = value(1.33, "Thin Film IOR", field="thin_film_ior", kind="float")
+    closure.thin_film_metal = bpy.app.version >= THIN_FILM_MATCHED_FROM
+    if bpy.app.version < THIN_FILM_MATCHED_FROM:
+        issues.add(f"'{node.name}' {VERSION_THIN_FILM}")
 
 
 def _bsdf(kind):
@@ -225,12 +245,14 @@ def _emission(node, weight, issues, compiler):
 def _metallic(node, weight, issues, compiler):
     """Blender 5's Metallic BSDF. With its F82 Fresnel it is Cycles' Principled metal (the base
     colour as f0, Edge Tint as the F82 tint, through the same bsdf_microfacet_setup_fresnel_f82_tint),
-    so a Principled closure of metallic 1; Physical Conductor's IOR and extinction go through their
-    F82-tint fit (core.bsdf.microfacet.conductor_f82), named in the warning."""
+    so a Principled closure of metallic 1, its thin film too; Physical Conductor's IOR and extinction
+    go through their F82-tint fit (core.bsdf.microfacet.conductor_f82), named in the warning, as is a
+    film over it (Cycles' exact conductor film is not built)."""
     value = _Inputs(node, compiler, issues)
-    if value(0.0, "Thin Film Thickness") > 0.0:
-        issues.add(f"'{node.name}' thin film")
-    if getattr(node, "fresnel_type", "F82") == "PHYSICAL_CONDUCTOR":
+    conductor = getattr(node, "fresnel_type", "F82") == "PHYSICAL_CONDUCTOR"
+    if conductor and value(0.0, "Thin Film Thickness") > 0.0:
+        issues.add(f"'{node.name}' thin film over a Physical Conductor (not rendered yet)")
+    if conductor:
         color, tint = conductor_f82(rgb(value(np.ones(3), "IOR")), rgb(value(np.zeros(3), "Extinction")))
         issues.add(f"'{node.name}' Physical Conductor (rendered through the F82-tint fit of its IOR and extinction)")
     else:
@@ -239,6 +261,8 @@ def _metallic(node, weight, issues, compiler):
     closure = Closure("PRINCIPLED", color=color, metallic=1.0, specular_tint=tint,
                       roughness=value(0.5, "Roughness", field="roughness", kind="float"),
                       multiscatter=_multiscatter(node, issues))
+    if not conductor:
+        _thin_film(node, closure, value, issues)
     value.anisotropy(closure, "Anisotropy", "Rotation")
     value.normal()
     return [_weighted(closure, weight, value.varying)]

@@ -1,11 +1,16 @@
-"""Glass lobe: rough dielectric reflection and refraction, evaluation with its pdf, sampling."""
+"""Glass lobe: rough dielectric reflection and refraction, evaluation with its pdf, sampling.
+
+With a thin film (Principled's, ``P_FILM`` above ``thin_film.CUTOFF``) the reflectance R is the
+film's RGB one with Cycles' specular tint, the transmission (1 - R) times the transmission tint,
+and reflection is chosen with probability mean(R); without one, today's scalar Fresnel."""
 from __future__ import annotations
 
 from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import H_TINT_R, H_TINT_T, P_ALPHA, P_ETA, P_REFRACT_ONLY
+from . import thin_film as tf
+from .layout import H_TINT_R, H_TINT_T, P_ALPHA, P_ETA, P_FILM, P_FILM_IOR, P_REFRACT_ONLY
 from .reflection import masking, reflected
 
 
@@ -26,10 +31,19 @@ def glass_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz, refl, trans, eta):
     refract_only = lp[l, P_REFRACT_ONLY] != 0.0
     if refl and refract_only:
         return 0.0, 0.0, 0.0, 0.0
-    fr = mf.fresnel_dielectric1(dot_mo, eta)
     d = mf.ggx_d(mz, alpha)
     g2 = mf.ggx_g2(abs(woz), abs(wiz), alpha)
     dv = mf.visible_normal_pdf(wox, woy, woz, mx, my, mz, alpha)
+    if lp[l, P_FILM] > tf.CUTOFF:
+        r0, r1, r2, p = film_reflectance(lp, hp, r, l, dot_mo, eta)
+        if refl:
+            c = d * g2 / (4.0 * abs(woz))
+            return r0 * c, r1 * c, r2 * c, dv / (4.0 * abs(dot_mo)) * p
+        denom = (dot_mi + dot_mo / etap) ** 2
+        c = d * g2 * abs(dot_mi * dot_mo) / max(denom * abs(woz), TINY) / etap ** 2
+        return ((1.0 - r0) * hp[r, l, H_TINT_T] * c, (1.0 - r1) * hp[r, l, H_TINT_T + 1] * c,
+                (1.0 - r2) * hp[r, l, H_TINT_T + 2] * c, dv * abs(dot_mi) / max(denom, TINY) * (1.0 - p))
+    fr = mf.fresnel_dielectric1(dot_mo, eta)
     if refl:
         c = fr * d * g2 / (4.0 * abs(woz))
         pdf = dv / (4.0 * abs(dot_mo)) * fr
@@ -39,6 +53,20 @@ def glass_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz, refl, trans, eta):
     c = d * t_frac * g2 * abs(dot_mi * dot_mo) / max(denom * abs(woz), TINY) / etap ** 2
     pdf = dv * abs(dot_mi) / max(denom, TINY) * t_frac
     return hp[r, l, H_TINT_T] * c, hp[r, l, H_TINT_T + 1] * c, hp[r, l, H_TINT_T + 2] * c, pdf
+
+
+@kernel(inline="always")
+def film_reflectance(lp, hp, r, l, c, eta):
+    """(RGB reflectance, chance of reflecting = its mean) of a glass lobe with a thin film at
+    cos(wo, h) = c: Cycles' film over the relative IOR eta, the film's IOR relative to the side
+    wo is on (divided by the glass's from inside), the specular tint in H_TINT_R."""
+    film_ior = lp[l, P_FILM_IOR] if eta == lp[l, P_ETA] else lp[l, P_FILM_IOR] * eta
+    f0_real = ((eta - 1.0) / (eta + 1.0)) ** 2
+    f0, f1, f2 = tf.film_dielectric(tf.SENSITIVITY, c, lp[l, P_FILM], film_ior, eta)
+    f0 = tf.tinted(f0, hp[r, l, H_TINT_R], f0_real)
+    f1 = tf.tinted(f1, hp[r, l, H_TINT_R + 1], f0_real)
+    f2 = tf.tinted(f2, hp[r, l, H_TINT_R + 2], f0_real)
+    return f0, f1, f2, min(max((f0 + f1 + f2) / 3.0, 0.0), 1.0)
 
 
 @kernel(inline="always")
@@ -53,6 +81,15 @@ def glass_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     """Sample the lobe alone, reflection or refraction by the Fresnel factor at the sampled
     normal: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
     hx, hy, hz, c, rx, ry, rz = reflected(lp, l, wox, woy, woz, u0, u1)
+    if lp[l, P_FILM] > tf.CUTOFF:
+        r0, r1, r2, p = film_reflectance(lp, hp, r, l, c, eta)
+        if u_choice < p:
+            g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz) / p
+            return rx, ry, rz, r0 * g, r1 * g, r2 * g, rz > 0.0
+        tx, ty, tz, ok = mf.refract(wox, woy, woz, hx, hy, hz, eta)
+        g = masking(lp, lt, l, j, t, wox, woy, woz, tx, ty, tz) / (eta ** 2 * max(1.0 - p, TINY))
+        return (tx, ty, tz, (1.0 - r0) * hp[r, l, H_TINT_T] * g, (1.0 - r1) * hp[r, l, H_TINT_T + 1] * g,
+                (1.0 - r2) * hp[r, l, H_TINT_T + 2] * g, ok and tz < 0.0)
     fr = mf.fresnel_dielectric1(c, eta)
     p_reflect = 0.0 if lp[l, P_REFRACT_ONLY] != 0.0 else fr
     if u_choice < p_reflect:  # the Fresnel factor cancels against the choice probability

@@ -9,7 +9,7 @@
 """
 # lobe kinds and Fresnel kinds
 DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
-F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
+F_DIELECTRIC, F_F82, F_TINT, F_FILM, F_F82_FILM = 0, 1, 2, 3, 4  # F_FILM: thin film over a dielectric
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
 # covers every lobe (slot = lobe index) and the diffuse lobes outside the bits get no share
@@ -22,7 +22,8 @@ P_ALPHA = 2
 P_ALPHA_T = 3  # glass: spread of refracted directions
 P_ETA = 4  # glass: n_inside / n_outside
 P_REFRACT_ONLY = 5
-P_FRESNEL = 6  # F_DIELECTRIC (times the colour H_F0), F_F82 (f0 = H_F0), F_TINT (H_F0)
+P_FRESNEL = 6  # F_DIELECTRIC (times the colour H_F0), F_F82 (f0 = H_F0), F_TINT (H_F0), F_FILM (tint H_F0),
+# F_F82_FILM (f0 = H_F0)
 P_ETA_F = 7  # IOR of a dielectric Fresnel
 P_F82 = 8  # (3) F82 tint
 P_MS = 11  # 1: multiple-scattering compensation
@@ -40,7 +41,9 @@ P_ALPHA_X = 33
 P_ALPHA_Y = 34
 P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
 P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
-P = 37
+P_FILM = 37  # thin film's thickness (nm; reflect lobes of F_FILM / F_F82_FILM, glass above thin_film.CUTOFF)
+P_FILM_IOR = 38  # thin film's IOR
+P = 39
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice

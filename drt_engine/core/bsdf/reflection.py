@@ -12,8 +12,9 @@ from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y, P_ANISO, P_DELTA,
-                     P_ETA_F, P_F82, P_FRESNEL, P_KIND, T_WHITE)
+from . import thin_film as tf
+from .layout import (F_DIELECTRIC, F_F82, F_F82_FILM, F_FILM, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y,
+                     P_ANISO, P_DELTA, P_ETA_F, P_F82, P_FILM, P_FILM_IOR, P_FRESNEL, P_KIND, T_WHITE)
 from .tables import at
 
 
@@ -28,6 +29,16 @@ def fresnel(lp, hp, r, l, c):
         return (mf.fresnel_f82(c, hp[r, l, H_F0], lp[l, P_F82]),
                 mf.fresnel_f82(c, hp[r, l, H_F0 + 1], lp[l, P_F82 + 1]),
                 mf.fresnel_f82(c, hp[r, l, H_F0 + 2], lp[l, P_F82 + 2]))
+    if kind == F_FILM:  # a film over the specular layer: Cycles' specular tint in H_F0
+        eta = lp[l, P_ETA_F]
+        f0_real = ((eta - 1.0) / (eta + 1.0)) ** 2
+        f0, f1, f2 = tf.film_dielectric(tf.SENSITIVITY, c, lp[l, P_FILM], lp[l, P_FILM_IOR], eta)
+        return (tf.tinted(f0, hp[r, l, H_F0], f0_real), tf.tinted(f1, hp[r, l, H_F0 + 1], f0_real),
+                tf.tinted(f2, hp[r, l, H_F0 + 2], f0_real))
+    if kind == F_F82_FILM:
+        return tf.film_conductor(tf.SENSITIVITY, c, lp[l, P_FILM], lp[l, P_FILM_IOR], hp[r, l, H_F0],
+                                 hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2], lp[l, P_F82], lp[l, P_F82 + 1],
+                                 lp[l, P_F82 + 2])
     return hp[r, l, H_F0], hp[r, l, H_F0 + 1], hp[r, l, H_F0 + 2]
 
 

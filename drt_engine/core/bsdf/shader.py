@@ -28,6 +28,7 @@ import numpy as np
 from ..scene import Closure, Material
 from . import layout
 from . import microfacet as mf
+from . import thin_film as tf
 from .records import BsdfSample, BsdfValue
 from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
                    weights_rows)
@@ -62,6 +63,7 @@ class Lobe:
     # | "toon"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
     alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
+    film: tuple = (0.0, 1.0)  # thin film (thickness nm, IOR): reflect lobes of F_FILM / F_F82_FILM, glass
 
     @property
     def delta(self) -> bool:
@@ -123,6 +125,17 @@ def anisotropic_alphas(kind: str, roughness: float, anisotropy: float) -> tuple 
     if a < 0.0:
         return alpha / (1.0 + a), alpha * (1.0 + a)
     return alpha * (1.0 - a), alpha / (1.0 - a)
+
+
+FILM_GRID = np.linspace(0.0, 1.0, 4097)
+"""Cosines a thin film's Fresnel is computed at for its albedo tables (interpolated between; the
+kernels compute it exactly per ray): the tables then cost what a plain lobe's do."""
+
+
+def _on_grid(fresnel: Callable) -> Callable:
+    """``fresnel`` (cosines -> (N, 3)) read from its values at FILM_GRID."""
+    f = fresnel(FILM_GRID)
+    return lambda c: np.stack([np.interp(c, FILM_GRID, f[:, k]) for k in range(3)], axis=-1)
 
 
 def _dielectric_fresnel(eta: float, tint: np.ndarray) -> Callable:
@@ -203,11 +216,13 @@ EXACT = Tables()
 
 
 def _reflect_lobe(weight, alpha, fresnel, layers=(), multiscatter=True, tables=EXACT, key=None, tint=None,
-                  table=None, fresnel_kind=layout.F_TINT, fresnel_eta=1.0, f0=None) -> Lobe:
+                  table=None, fresnel_kind=layout.F_TINT, fresnel_eta=1.0, f0=None, bare=None) -> Lobe:
     """A GGX reflection lobe with Fresnel ``fresnel`` (for the kernels: ``fresnel_kind``,
     ``fresnel_eta`` and the colour ``f0``) times a constant ``tint`` (its albedo table is the
     untinted one times the tint, so lobes differing in tint share tables); ``table`` (mu, E)
-    when the caller has it."""
+    when the caller has it. ``bare``: a thin film's lobe, the Fresnel without the film, which
+    Cycles' multiple-scattering term keeps; its layering albedo is then, as Cycles estimates it,
+    the film's Fresnel at the view cosine times that term's darkening."""
     mu, e = table if table is not None else tables.albedo(alpha, fresnel, key)
     f0 = np.ones(3) if f0 is None else np.asarray(f0, float)
     if tint is not None:
@@ -222,16 +237,18 @@ def _reflect_lobe(weight, alpha, fresnel, layers=(), multiscatter=True, tables=E
         # Cycles' multiscatter GGX (Kulla-Conty): f_ss times 1 + F_ms (1 - E) / E with
         # F_ms = F_avg E_avg / (1 - F_avg (1 - E_avg)), E the white single-scatter albedo.
         e_avg = _cosine_average(mu, e1)
-        f_avg = _cosine_average(mu, np.asarray(fresnel(mu)).mean(axis=-1))
+        f_avg = _cosine_average(mu, np.asarray((fresnel if bare is None else bare)(mu)).mean(axis=-1))
         f_ms = f_avg * e_avg / (1.0 - f_avg * (1.0 - e_avg))
         factor = 1.0 + f_ms * (1.0 - e1) / np.maximum(e1, 1e-3)
         lobe.ms = (mu, factor, e_avg)
         e = e * factor[:, None]
         lobe.layer_table = (mu, e)
+        if bare is not None:
+            lobe.layer_table = (mu, np.asarray(fresnel(mu)) * (e1 + f_ms * (1.0 - e1))[:, None])
     else:
         # Cycles' albedo estimate for plain GGX is the lobe-averaged Fresnel, without the
         # energy masking loses (measured: diffuse weight 0.9595 under a 0.5-rough, IOR 1.5 layer)
-        lobe.layer_table = (mu, e / np.maximum(e1, 1e-6)[:, None])
+        lobe.layer_table = (mu, e / np.maximum(e1, 1e-6)[:, None] if bare is None else np.asarray(fresnel(mu)))
     lobe.table = (mu, e)
     return lobe
 
@@ -321,14 +338,22 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
     base = np.clip(c.color, 0.0, 1.0)
     metallic = float(np.clip(c.metallic, 0, 1))
     transmission = float(np.clip(c.transmission, 0, 1))
+    film = float(c.thin_film_thickness) if c.thin_film_thickness > tf.CUTOFF else 0.0
+    film_ior = max(float(c.thin_film_ior), 1e-5)
     if metallic > 0:
         f82 = np.clip(c.specular_tint, 0, 1)
-        table = None
-        if tables.grid:  # tint-independent tables; exact but for the clipping of mf.fresnel_f82
-            mu, ea, eb = tables.f82(alpha, f82)
-            table = (mu, base * ea + eb)
-        metal = _reflect_lobe(w * metallic, alpha, _f82_fresnel(base, f82), base_layers, c.multiscatter, tables,
-                              _key("f82", base, f82), table=table, fresnel_kind=layout.F_F82, f0=base)
+        if film and c.thin_film_metal:
+            metal = _reflect_lobe(w * metallic, alpha, _on_grid(lambda x: tf.conductor(x, film, film_ior, base, f82)),
+                                  base_layers, c.multiscatter, EXACT, _key("f82 film", base, f82, film, film_ior),
+                                  fresnel_kind=layout.F_F82_FILM, f0=base, bare=_f82_fresnel(base, f82))
+            metal.film = (film, film_ior)
+        else:
+            table = None
+            if tables.grid:  # tint-independent tables; exact but for the clipping of mf.fresnel_f82
+                mu, ea, eb = tables.f82(alpha, f82)
+                table = (mu, base * ea + eb)
+            metal = _reflect_lobe(w * metallic, alpha, _f82_fresnel(base, f82), base_layers, c.multiscatter, tables,
+                                  _key("f82", base, f82), table=table, fresnel_kind=layout.F_F82, f0=base)
         metal.role, metal.f82 = "metal", f82
         metal.alpha_xy = anisotropic_alphas("PRINCIPLED", c.roughness, c.anisotropy)
         lobes.append(metal)
@@ -336,14 +361,28 @@ def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
     ior = max(float(c.ior), 1e-5)  # IOR below 1 is a valid medium (a bubble), as in Cycles
     if dielectric * transmission > 0:
         lobes.append(Lobe("glass", w * dielectric * transmission, layers=list(base_layers), alpha=alpha, eta=ior,
-                          tint_r=np.clip(c.specular_tint, 0, None), tint_t=np.sqrt(base), role="glass"))
+                          tint_r=np.clip(c.specular_tint, 0, None), tint_t=np.sqrt(base), role="glass",
+                          film=(film, film_ior)))
     opaque = dielectric * (1.0 - transmission)
     if opaque > 0:
         level = max(float(c.specular_ior_level), 0.0)
         f0 = mf.f0_from_ior(ior) * 2.0 * level
         spec_tint = np.clip(c.specular_tint, 0, None)
         diffuse_layers = list(base_layers)
-        if f0 > 0:
+        if film:  # Cycles' specular layer over a film: its tint scales the film's reflectance near F0
+            eta = ior if level == 0.5 else float(mf.ior_from_f0(f0)) if f0 > 0 else 1.0
+            eta = 1.0 / eta if ior < 1.0 and level != 0.5 else eta
+            tint = np.clip(spec_tint, 0.0, 1.0 / max(mf.f0_from_ior(eta), 1e-6))
+            fresnel = _on_grid(lambda x: tf.dielectric(x, film, film_ior, eta, tint))
+            spec = _reflect_lobe(w * opaque, alpha, fresnel, base_layers, c.multiscatter, EXACT,
+                                 _key("dielectric film", eta, tint, film, film_ior),
+                                 fresnel_kind=layout.F_FILM, fresnel_eta=eta, f0=tint,
+                                 bare=lambda x: np.clip(mf.fresnel_dielectric(x, eta)[:, None] * tint, 0.0, 1.0))
+            spec.role, spec.film = "spec", (film, film_ior)
+            spec.alpha_xy = anisotropic_alphas("PRINCIPLED", c.roughness, c.anisotropy)
+            lobes.append(spec)
+            diffuse_layers.append(_layer_under(spec))
+        elif f0 > 0:
             eta = mf.ior_from_f0(f0)
             spec = _reflect_lobe(w * opaque, alpha, _dielectric_fresnel(eta, np.ones(3)), base_layers,
                                  c.multiscatter, tables, _key("dielectric", eta, np.ones(3)), spec_tint,
@@ -438,6 +477,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_REFRACT_ONLY] = lobe.refract_only
         row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
+        row[layout.P_FILM], row[layout.P_FILM_IOR] = lobe.film
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy

@@ -28,6 +28,8 @@ LINEAR_INPUTS = ("weight", "color")
 PER_HIT_INPUTS = ("normal", "emission", "tangent", "anisotropic_rotation")
 """Inputs read per hit outside the lobes: the shading frame's normal and tangent, emission."""
 QUANTUM = 256.0
+KEY_SCALE = {"thin_film_thickness": 1.0 / 256.0}
+"""Keyed inputs rounded in other units than 1: a thin film's thickness (nm) in steps of 1 nm at QUANTUM."""
 MIN_QUANTUM = 8.0
 MAX_GROUPS = 64
 CACHE_LIMIT = 4096
@@ -472,7 +474,7 @@ class MaterialShading:
                         value if value.ndim == 2 else value[:, None], (ctx.n, 3))
                 else:
                     v = value if value.ndim == 2 else value[:, None]
-                    keyed.append((i, name, v))
+                    keyed.append((i, name, v * KEY_SCALE[name] if name in KEY_SCALE else v))
         if keyed:
             keys, inverse, keyed = self._quantise(keyed)
         else:
@@ -518,8 +520,10 @@ class MaterialShading:
             quantum /= 2
         if quantum < QUANTUM and not self.coarsened:
             self.coarsened = True
+            film = (f" (a thin film's thickness: of {256.0 / quantum:g} nm)"
+                    if any(name in KEY_SCALE for _, name, _ in keyed) else "")
             self.warnings.append(f"material '{self.material.name}': its textured inputs other than colours "
-                              f"were rounded to steps of 1/{int(quantum)}")
+                              f"were rounded to steps of 1/{int(quantum)}{film}")
         return keys, inverse.reshape(-1), keyed
 
     def _shader_for(self, key, keyed, linear) -> MaterialShader:
@@ -533,6 +537,8 @@ class MaterialShading:
             width = v.shape[1]
             value = key[col:col + width]
             col += width
+            if name in KEY_SCALE:
+                value = value / KEY_SCALE[name]
             setattr(closures[i], name, float(value[0]) if width == 1 else np.resize(value, 3))
         for i, d in linear.items():
             for name in d:
