@@ -97,6 +97,8 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         sampling_pattern=drt.sampling_pattern,
         max_depth=drt.max_depth,
         diffuse_bounces=drt.diffuse_bounces,
+        glossy_bounces=drt.glossy_bounces,
+        transmission_bounces=drt.transmission_bounces,
         min_light_bounces=drt.min_light_bounces,
         min_transparent_bounces=drt.min_transparent_bounces,
         max_transparent_bounces=drt.max_transparent_bounces,
@@ -186,6 +188,12 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     diffuse_bounces: IntProperty(**_bounces(
         "Diffuse", "Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse surfaces take "
         "direct light only, the classic distribution ray traced image", soft_max=32))
+    glossy_bounces: IntProperty(**_bounces(
+        "Glossy", "Glossy and mirror reflections a path may take (Cycles' Glossy bounces); the ray of one more "
+        "still sees what it hits", default=8, soft_max=32))
+    transmission_bounces: IntProperty(**_bounces(
+        "Transmission", "Refractions and diffuse transmissions a path may take (Cycles' Transmission bounces); "
+        "the ray of one more still sees what it hits", default=8, soft_max=32))
     min_light_bounces: IntProperty(**_bounces(
         "Min Light Bounces", "Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
         "only paths with diffuse bounces are ended so"))

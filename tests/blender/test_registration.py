@@ -94,6 +94,7 @@ def test_scene_settings_defaults(drt):
     assert drt_settings.seed == 0
     assert drt_settings.sampling_pattern == "SOBOL"
     assert drt_settings.max_depth == 8
+    assert drt_settings.glossy_bounces == drt_settings.transmission_bounces == 8  # never binding at Total 8
     assert drt_settings.clamp == 0.0
     assert drt_settings.threads == 0
     assert drt_settings.filter_type == "BLACKMAN_HARRIS"

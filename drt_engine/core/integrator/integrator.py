@@ -36,6 +36,7 @@ from ..settings import AOV_CHANNELS
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
+from .bounces import binding, ended
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_records
@@ -146,10 +147,14 @@ class Integrator:
         if plan.see_through:
             clear = self.geometry.of_triangles(np.array([see_through(m) for m in scene.materials]))
             self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count)
+        # the glossy and transmission limits, where they can end paths before the Total does
+        self.limited = binding(settings) and (plan.rays["reflection"] or plan.rays["refraction"]
+                                              or plan.rays["diffuse"])
         # paths carry their ray kind and depths only for a scene whose shader programs read them,
-        # with diffuse bounces, with transparent shadows (which count them) or with objects hidden
-        # from some kind of ray (whose masks they give)
-        self.carried = self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
+        # with diffuse bounces, with transparent shadows (which count them), with objects hidden
+        # from some kind of ray (whose masks they give) or with a glossy or transmission limit
+        self.carried = (self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
+                        or self.limited)
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
         self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)
@@ -218,6 +223,10 @@ class Integrator:
             self._emission_seen(surf, state, hits, out)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out)
+            if self.limited:  # paths past a glossy or transmission limit end here, with what they saw
+                surf = surf.take(np.flatnonzero(~ended(surf.bounces, s)))
+                if len(surf) == 0:
+                    break
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
