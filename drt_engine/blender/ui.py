@@ -186,7 +186,8 @@ class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
         col.prop(drt, "min_light_bounces")
         col.prop(drt, "min_transparent_bounces")
         col = layout.column()
-        col.prop(drt, "clamp")
+        col.prop(drt, "sample_clamp_direct", text="Clamp Direct")
+        col.prop(drt, "sample_clamp_indirect", text="Clamp Indirect")
         col.prop(drt, "shadow_estimator")
 
 

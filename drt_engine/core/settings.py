@@ -92,7 +92,10 @@ class RenderSettings:
     # Cycles' Max Transparent Bounces: transparent surfaces a shadow ray goes through, counted on
     # from its path's own transparent bounces; one more blocks it (core.integrator.shadows)
     max_transparent_bounces: int = 8
-    clamp: float = 0.0
+    # Cycles' Clamp Direct and Clamp Indirect: each contribution of a sample before (direct) and
+    # after (indirect) its path's first bounce kept within them (core.integrator.clamp); 0: off
+    sample_clamp_direct: float = 0.0
+    sample_clamp_indirect: float = 0.0
     threads: int = 0
     filter_type: str = "BLACKMAN_HARRIS"
     filter_size: float = 1.5
@@ -142,6 +145,9 @@ class RenderSettings:
                      "min_transparent_bounces", "max_transparent_bounces"):
             if getattr(self, name) < 0:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
+        for name in ("sample_clamp_direct", "sample_clamp_indirect"):
+            if not getattr(self, name) >= 0:
+                raise SettingsError(f"{name.replace('_', ' ')} must be 0 (off) or more, not {getattr(self, name)}")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         self.aovs = tuple((str(name), str(kind)) for name, kind in self.aovs)

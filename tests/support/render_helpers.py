@@ -89,8 +89,8 @@ def configure_cycles(scene, samples: int, seed: int, threshold: float | None = N
     cycles.caustics_reflective = True
     cycles.caustics_refractive = True
     cycles.blur_glossy = 0.0
-    cycles.sample_clamp_direct = 0.0
-    cycles.sample_clamp_indirect = 0.0
+    cycles.sample_clamp_direct = scene.drt.sample_clamp_direct
+    cycles.sample_clamp_indirect = scene.drt.sample_clamp_indirect
     cycles.pixel_filter_type = scene.drt.filter_type
     cycles.filter_width = scene.render.filter_size
 
@@ -102,7 +102,6 @@ def configure_drt(scene, samples: int, seed: int) -> None:
     drt.use_adaptive_sampling = False
     drt.time_limit = 0.0
     drt.target_error = 0.0
-    drt.clamp = 0.0
 
 
 def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name="render") -> Render:

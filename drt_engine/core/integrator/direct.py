@@ -17,6 +17,7 @@ from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
+from .clamp import clamped
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
@@ -72,11 +73,11 @@ def unlit_parts(restrict, k):
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, bounces,
-                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, exclude, scene,
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, scale, throughput, path, limit,
+                 bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, exclude, scene,
                  center, shadow_mask, times, radiance, f_diff, visibility, clear, allowed, qf, qi):
-    """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
-    traced and the rows queued.
+    """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
+    ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
@@ -168,7 +169,10 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, wo_l, inside, 
                 visibility[k, j] = BLOCKED if hidden else VISIBLE
             # area lights are not geometry: a nearer area light does not block (lights cast shadows
             # of each other's bodies in Cycles only when they are meshes, so it does not here)
-            if not hidden:
+            if not hidden:  # each strategy's light one contribution, clamped to its hit's ``limit``
+                c0, c1, c2, cut = clamped(c0, c1, c2, limit[j])
+                if keep:  # the ratio estimator's N stays the share of Combined it is
+                    f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0 * cut, d1 * cut, d2 * cut
                 s0 += c0
                 s1 += c1
                 s2 += c2
