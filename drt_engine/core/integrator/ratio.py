@@ -20,7 +20,10 @@ each sample's N, D and U (summed over these lights) to a wave output ``RATIO`` o
 columns; its N is also in Combined, as Monte Carlo has it. A render without the estimator has
 no hook and does none of this. The film keeps them as sums (core.film.ratio_sums), over all
 samples and over class A (the error estimate's half), and ``resolve`` replaces N by U N / D
-when the image is read. What stays Monte Carlo:
+when the image is read. With Clamp Direct or Indirect (core.integrator.clamp) a sample's N
+is its clamped contributions' (the direct-light kernel scales the diffuse part it hands over by
+each contribution's clamp factor), so U N / D is clamped as Combined is, and biased as it is.
+What stays Monte Carlo:
 glossy parts (with MIS), emission, the world, emissive meshes, delta lights (their E_u V
 is exact already), moving lights, lights chosen among many, and any light without a
 closed form.
