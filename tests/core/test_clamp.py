@@ -14,7 +14,7 @@ import pytest
 from drt_engine.core.errors import SettingsError
 from drt_engine.core.film.parts import Part
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import Closure, Instance, Material, SceneData, World
+from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
 from tests.support.scenes import top_camera, uv_sphere
 
@@ -53,3 +53,17 @@ def test_a_part_from_before_the_two_clamps_reads_its_one_clamp_as_both():
     old = Part(1, 1, np.ones(1), np.ones(1), np.zeros((1, 3)), {}, header={"settings": settings})
     read = old.settings()
     assert read.sample_clamp_direct == read.sample_clamp_indirect == 2.5
+
+
+def test_the_ratio_estimator_is_clamped_as_combined():
+    """A diffuse plane of albedo 0.5 under a soft sun of irradiance 100 (radiance 15.9): each light
+    sample is clamped to 1, and the ratio estimator's U N / D, with N the clamped samples, is too."""
+    from tests.support.scenes import lit_plane_scene
+
+    sun = Light("SUN", np.eye(4), irradiance=np.full(3, 100.0), angle=0.1)
+    values = {}
+    for estimator in ("MONTE_CARLO", "RATIO"):
+        settings = RenderSettings(samples=4, threads=1, sample_clamp_direct=1.0, shadow_estimator=estimator)
+        values[estimator] = Renderer(lit_plane_scene(sun), settings).render().passes["Combined"][..., :3].mean()
+    assert values["MONTE_CARLO"] == pytest.approx(1.0, rel=1e-4)
+    assert values["RATIO"] == pytest.approx(1.0, rel=1e-4)  # 15.9 when N and D both took the clamp

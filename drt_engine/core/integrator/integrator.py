@@ -499,6 +499,7 @@ class Integrator:
         n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
+        cuts = np.ones((light.strategies, keep))
         # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
         # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
         lifted = len(self.geometry.tables[3]) > 0 and any(lobe.diffuse for lobe in shader.lobes)
@@ -515,10 +516,10 @@ class Integrator:
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
-            wave.radiance, f_diff, visibility, clear, allowed, qf, qi)
+            wave.radiance, f_diff, visibility, cuts, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
-            wave.ratio.direct(shader, group, light.value, f_diff, visibility)
+            wave.ratio.direct(shader, group, light.value, f_diff, visibility, cuts)
         return stopped(qf, qi, m, group.bounces)
 
     # -- continuation through one lobe -------------------------------------------------
