@@ -3,9 +3,9 @@ bpy calls of the headless CLI (batch.py)."""
 import bpy
 
 from ..core.base import jit
-from . import engine, properties, ui
+from . import engine, properties, ui, versioning
 
-_modules = (properties, engine, ui)
+_modules = (properties, versioning, engine, ui)
 
 
 def _kernel_cache():

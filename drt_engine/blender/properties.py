@@ -97,10 +97,13 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         sampling_pattern=drt.sampling_pattern,
         max_depth=drt.max_depth,
         diffuse_bounces=drt.diffuse_bounces,
+        glossy_bounces=drt.glossy_bounces,
+        transmission_bounces=drt.transmission_bounces,
         min_light_bounces=drt.min_light_bounces,
         min_transparent_bounces=drt.min_transparent_bounces,
         max_transparent_bounces=drt.max_transparent_bounces,
-        clamp=drt.clamp,
+        sample_clamp_direct=drt.sample_clamp_direct,
+        sample_clamp_indirect=drt.sample_clamp_indirect,
         threads=drt.threads,
         filter_type=drt.filter_type,
         filter_size=scene.render.filter_size,
@@ -186,6 +189,12 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     diffuse_bounces: IntProperty(**_bounces(
         "Diffuse", "Diffuse reflections a path may take (Cycles' Diffuse bounces); 0: diffuse surfaces take "
         "direct light only, the classic distribution ray traced image", soft_max=32))
+    glossy_bounces: IntProperty(**_bounces(
+        "Glossy", "Glossy and mirror reflections a path may take (Cycles' Glossy bounces); the ray of one more "
+        "still sees what it hits", default=8, soft_max=32))
+    transmission_bounces: IntProperty(**_bounces(
+        "Transmission", "Refractions and diffuse transmissions a path may take (Cycles' Transmission bounces); "
+        "the ray of one more still sees what it hits", default=8, soft_max=32))
     min_light_bounces: IntProperty(**_bounces(
         "Min Light Bounces", "Bounces before Russian roulette may end a path (Cycles' Min Light Bounces); "
         "only paths with diffuse bounces are ended so"))
@@ -195,10 +204,19 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     max_transparent_bounces: IntProperty(**_bounces(
         "Transparent", "Transparent surfaces a shadow ray may pass through, counted on from its path's "
         "transparent bounces; one more blocks it (Cycles' Max Transparent Bounces)", default=8))
-    clamp: FloatProperty(
-        name="Clamp",
-        description="Largest radiance one sample may contribute, to tame fireflies at the "
-        "cost of bias; 0 turns clamping off",
+    sample_clamp_direct: FloatProperty(
+        name="Clamp Direct",
+        description="Largest value (as the mean of its RGB) one sample's light may add before the path's first "
+        "bounce: the camera's emission and world and the lights at its first hits (Cycles' Clamp Direct); "
+        "tames fireflies at the cost of bias, 0 turns it off",
+        default=0.0,
+        min=0.0,
+        soft_max=100.0,
+    )
+    sample_clamp_indirect: FloatProperty(
+        name="Clamp Indirect",
+        description="Largest value (as the mean of its RGB) one sample's light may add after the path's first "
+        "bounce (Cycles' Clamp Indirect); tames fireflies at the cost of bias, 0 turns it off",
         default=0.0,
         min=0.0,
         soft_max=100.0,

@@ -178,13 +178,16 @@ class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(drt, "max_depth", text="Total")
         col.prop(drt, "diffuse_bounces")
+        col.prop(drt, "glossy_bounces")
+        col.prop(drt, "transmission_bounces")
         col.prop(drt, "max_transparent_bounces")
         col = layout.column(align=True)
         col.active = drt.diffuse_bounces > 0  # Russian roulette ends only paths with diffuse bounces
         col.prop(drt, "min_light_bounces")
         col.prop(drt, "min_transparent_bounces")
         col = layout.column()
-        col.prop(drt, "clamp")
+        col.prop(drt, "sample_clamp_direct", text="Clamp Direct")
+        col.prop(drt, "sample_clamp_indirect", text="Clamp Indirect")
         col.prop(drt, "shadow_estimator")
 
 

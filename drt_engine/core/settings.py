@@ -80,6 +80,11 @@ class RenderSettings:
     # Cycles' Diffuse bounces: how many diffuse reflections a path may take (0: direct light only
     # on diffuse surfaces, DRT's classic image; core.integrator.bounces)
     diffuse_bounces: int = 0
+    # Cycles' Glossy and Transmission bounces: a path whose glossy (non-diffuse reflection) or
+    # transmission depth passes them ends at its next hit, which adds only the emission it sees
+    # (core.integrator.bounces.ended); at the default Total 8 a limit of 8 never binds
+    glossy_bounces: int = 8
+    transmission_bounces: int = 8
     # Cycles' Min Light Bounces and Min Transparent Bounces: Russian roulette ends paths after
     # them (only with diffuse bounces; core.integrator.continuation.roulette)
     min_light_bounces: int = 0
@@ -87,7 +92,10 @@ class RenderSettings:
     # Cycles' Max Transparent Bounces: transparent surfaces a shadow ray goes through, counted on
     # from its path's own transparent bounces; one more blocks it (core.integrator.shadows)
     max_transparent_bounces: int = 8
-    clamp: float = 0.0
+    # Cycles' Clamp Direct and Clamp Indirect: each contribution of a sample before (direct) and
+    # after (indirect) its path's first bounce kept within them (core.integrator.clamp); 0: off
+    sample_clamp_direct: float = 0.0
+    sample_clamp_indirect: float = 0.0
     threads: int = 0
     filter_type: str = "BLACKMAN_HARRIS"
     filter_size: float = 1.5
@@ -133,9 +141,13 @@ class RenderSettings:
         if self.denoising_quality not in DENOISING_QUALITIES:
             raise SettingsError(f"unknown denoising quality {self.denoising_quality!r} "
                                 f"(one of {', '.join(DENOISING_QUALITIES)})")
-        for name in ("diffuse_bounces", "min_light_bounces", "min_transparent_bounces", "max_transparent_bounces"):
+        for name in ("diffuse_bounces", "glossy_bounces", "transmission_bounces", "min_light_bounces",
+                     "min_transparent_bounces", "max_transparent_bounces"):
             if getattr(self, name) < 0:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
+        for name in ("sample_clamp_direct", "sample_clamp_indirect"):
+            if not getattr(self, name) >= 0:
+                raise SettingsError(f"{name.replace('_', ' ')} must be 0 (off) or more, not {getattr(self, name)}")
         if self.samples < 1:
             raise ValueError("samples must be at least 1")
         self.aovs = tuple((str(name), str(kind)) for name, kind in self.aovs)

@@ -13,5 +13,6 @@ def test_presets_set_the_light_paths_the_render_reads(drt):
         settings = settings_from_scene(scene, scene.view_layers[0])
         assert {name: getattr(settings, name) for name in values} == values
     assert settings.diffuse_bounces == 128 and settings.min_light_bounces == 3  # Full GI, as Cycles' preset
+    assert settings.glossy_bounces == settings.transmission_bounces == 128
     assert bpy.ops.drt.light_paths_preset(preset="DIRECT") == {"FINISHED"}
     assert scene.drt.diffuse_bounces == 0

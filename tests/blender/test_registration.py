@@ -94,7 +94,8 @@ def test_scene_settings_defaults(drt):
     assert drt_settings.seed == 0
     assert drt_settings.sampling_pattern == "SOBOL"
     assert drt_settings.max_depth == 8
-    assert drt_settings.clamp == 0.0
+    assert drt_settings.glossy_bounces == drt_settings.transmission_bounces == 8  # never binding at Total 8
+    assert drt_settings.sample_clamp_direct == drt_settings.sample_clamp_indirect == 0.0
     assert drt_settings.threads == 0
     assert drt_settings.filter_type == "BLACKMAN_HARRIS"
     assert drt_settings.use_adaptive_sampling is False
@@ -133,7 +134,7 @@ def test_settings_from_scene(drt):
     view_layer = scene.view_layers[0]
     d = scene.drt
     d.samples, d.seed, d.sampling_pattern, d.max_depth = 9, 7, "JITTERED", 3
-    d.clamp, d.threads, d.filter_type = 4.5, 2, "GAUSSIAN"
+    d.sample_clamp_direct, d.sample_clamp_indirect, d.threads, d.filter_type = 4.5, 1.5, 2, "GAUSSIAN"
     d.use_adaptive_sampling, d.adaptive_threshold, d.adaptive_min_samples = True, 0.05, 16
     d.adaptive_mode = "CONTRAST"
     d.time_limit, d.target_error = 12.0, 0.02
@@ -145,7 +146,8 @@ def test_settings_from_scene(drt):
     view_layer.pass_alpha_threshold = 0.25
     settings = properties.settings_from_scene(scene, view_layer)
     assert settings == RenderSettings(
-        samples=9, seed=7, sampling_pattern="JITTERED", max_depth=3, clamp=4.5, threads=2,
+        samples=9, seed=7, sampling_pattern="JITTERED", max_depth=3, sample_clamp_direct=4.5,
+        sample_clamp_indirect=1.5, threads=2,
         filter_type="GAUSSIAN", filter_size=2.25,
         passes=("Combined", "Depth", "Env", "Noise", "Mist", "IndexOB", "IndexMA"), pass_alpha_threshold=0.25,
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,

@@ -51,7 +51,7 @@ def test_gigawatt_from_a_tiny_light_is_finite_and_bounded_by_clamp(floor, tmp_pa
     """1e9 W from a point light of radius 1e-6 m, 1 mm above a glossy sphere and 1 cm above the floor."""
     bs.add_light(floor, "POINT", (0.3, 0, 0.01), energy=1e9, shadow_soft_size=1e-6)
     sphere = bpy_sphere(floor, (0, 0, 0.3), 0.2, bs.material("GLOSSY", Roughness=0.2))
-    floor.drt.clamp = clamp
+    floor.drt.sample_clamp_direct = floor.drt.sample_clamp_indirect = clamp
     floor.drt.samples = 8
     image = bs.render(floor, tmp_path, f"gw{clamp}")["Combined"][..., :3]
     assert image.max() > 0

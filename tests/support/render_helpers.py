@@ -63,9 +63,9 @@ def set_resolution(scene, width: int, height: int) -> None:
 
 
 def configure_cycles(scene, samples: int, seed: int, threshold: float | None = None) -> None:
-    """Cycles as a distribution ray tracer with DRT's depth, diffuse bounces, filter and no noise tricks; with a
-    ``threshold``, its adaptive sampling at that noise threshold and automatic min samples
-    (the benchmark's "Cycles adaptive")."""
+    """Cycles as a distribution ray tracer with DRT's Light Paths (Total, diffuse, glossy and
+    transmission bounces), filter and no noise tricks; with a ``threshold``, its adaptive sampling
+    at that noise threshold and automatic min samples (the benchmark's "Cycles adaptive")."""
     cycles = scene.cycles
     depth = scene.drt.max_depth
     cycles.device = "CPU"
@@ -81,16 +81,16 @@ def configure_cycles(scene, samples: int, seed: int, threshold: float | None = N
     cycles.diffuse_bounces = scene.drt.diffuse_bounces
     cycles.min_light_bounces = scene.drt.min_light_bounces
     cycles.min_transparent_bounces = scene.drt.min_transparent_bounces
-    cycles.glossy_bounces = depth
-    cycles.transmission_bounces = depth
+    cycles.glossy_bounces = scene.drt.glossy_bounces
+    cycles.transmission_bounces = scene.drt.transmission_bounces
     cycles.transparent_max_bounces = scene.drt.max_transparent_bounces
     cycles.volume_bounces = 0
     cycles.max_bounces = depth
     cycles.caustics_reflective = True
     cycles.caustics_refractive = True
     cycles.blur_glossy = 0.0
-    cycles.sample_clamp_direct = 0.0
-    cycles.sample_clamp_indirect = 0.0
+    cycles.sample_clamp_direct = scene.drt.sample_clamp_direct
+    cycles.sample_clamp_indirect = scene.drt.sample_clamp_indirect
     cycles.pixel_filter_type = scene.drt.filter_type
     cycles.filter_width = scene.render.filter_size
 
@@ -102,7 +102,6 @@ def configure_drt(scene, samples: int, seed: int) -> None:
     drt.use_adaptive_sampling = False
     drt.time_limit = 0.0
     drt.target_error = 0.0
-    drt.clamp = 0.0
 
 
 def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name="render") -> Render:

@@ -60,6 +60,10 @@ class Part:
         """The part's render settings with the full sample range (the merged render's)."""
         values = dict(self.header["settings"], threads=self.header.get("threads", 0))
         values["passes"] = tuple(values["passes"])
+        if "clamp" in values:  # a part from before Clamp Direct and Indirect: its one clamp was both
+            clamp = values.pop("clamp")
+            values.setdefault("sample_clamp_direct", clamp)
+            values.setdefault("sample_clamp_indirect", clamp)
         return RenderSettings(**values)
 
 

@@ -1,4 +1,5 @@
-"""Which diffuse lobes a path may continue through at a hit: Cycles' diffuse bounce limit.
+"""Cycles' bounce limits per kind: which diffuse lobes a path may continue through at a hit, and
+which paths the glossy and transmission limits end.
 
 With diffuse bounces k, a path continues through a diffuse reflection (Lambert, Oren-Nayar)
 while it has taken fewer than k of them (Cycles' path_state_next, whose kernel limit is the
@@ -6,12 +7,20 @@ setting + 1: with k = 0 a diffuse surface gets direct light only, DRT's classic 
 translucent lobe is a diffuse transmission, which Cycles counts as a transmission bounce: it is
 sampled whenever diffuse bounces are on, within the path's depth. The answer is the
 ``diffuse`` bits of core.bsdf.mixture, 0 where paths carry no depths (diffuse bounces 0).
+
+The glossy and transmission limits work as Cycles' path_state_next: every lobe is sampled as
+usual, and a bounce that takes the path's glossy (non-diffuse reflection) or transmission depth
+(refraction and diffuse transmission alike) past its limit (Cycles' kernel limit, the setting + 1)
+ends it at the next hit: that ray still sees emission and the world, the hit gets no direct light
+and no further bounce (Cycles' PATH_RAY_TERMINATE_AFTER_TRANSPARENT, which would still let it pass
+transparent surfaces; DRT ends it there too). The depths only reach a limit below the Total
+(max_depth), so only then do paths carry them for it (``binding``).
 """
 from __future__ import annotations
 
 from ..base.jit import kernel
 from ..bsdf.layout import SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT
-from ..shading.lightpath import DIFFUSE_DEPTH
+from ..shading.lightpath import DIFFUSE_DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH
 
 
 @kernel(inline="always")
@@ -22,3 +31,20 @@ def diffuse_bits(bounces, j, limit):
     if bounces[j, DIFFUSE_DEPTH] < limit:
         return SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT
     return SAMPLE_TRANSLUCENT
+
+LIMIT_TRANSPARENCY = ("paths ended by the Glossy or Transmission bounce limit stop at transparent surfaces, "
+                      "where Cycles lets them pass on")
+"""The warning for a scene with transparent surfaces and a glossy or transmission limit that binds."""
+
+
+def binding(settings) -> bool:
+    """Whether the glossy or transmission limit can end a path before the Total does: a bounce at
+    depth d < max_depth makes a depth of at most max_depth."""
+    return min(settings.glossy_bounces, settings.transmission_bounces) < settings.max_depth
+
+
+def ended(bounces, settings):
+    """Per path with depths ``bounces`` (core.shading.lightpath): it passed the glossy or the
+    transmission limit on its last bounce, so it ends at this hit."""
+    return ((bounces[:, GLOSSY_DEPTH] > settings.glossy_bounces)
+            | (bounces[:, TRANSMISSION_DEPTH] > settings.transmission_bounces))

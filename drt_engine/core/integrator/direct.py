@@ -18,6 +18,7 @@ from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
+from .clamp import clamped
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
@@ -73,11 +74,11 @@ def unlit_parts(restrict, k):
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path, bounces,
-                 diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict, exclude, scene,
-                 center, shadow_mask, times, radiance, f_diff, visibility, clear, allowed, qf, qi):
-    """Adds every hit's unblocked direct light to ``radiance[path[j]]``; returns the shadow rays
-    traced and the rows queued.
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path,
+                 limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
+                 exclude, scene, center, shadow_mask, times, radiance, f_diff, visibility, cuts, clear, allowed, qf, qi):
+    """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
+    ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
@@ -94,8 +95,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
     parts, and its shadow ray with NO_SHADOW; empty: nothing). Shadow rays see the objects whose
     Embree mask shares a bit with ``shadow_mask``. ``times``: each hit's shutter time (empty when
     nothing moves).
-    ``f_diff`` and ``visibility`` (strategy by hit) are filled when they have rows (the ratio
-    estimator reads them): the diffuse part toward each sample and what became of its ray.
+    ``f_diff``, ``visibility`` and ``cuts`` (strategy by hit) are filled when they have rows (the
+    ratio estimator reads them): the diffuse part toward each sample, what became of its ray and
+    the clamp's factor on what got through.
     With transparent shadows (``clear``, per mesh triangle row: its material can be transparent;
     empty: none can, and shadow rays are occlusion queries), a ray stopped by such a surface is
     queued in (``qf``, ``qi``) with its contribution, if hit j's rays may pass ``allowed[j]`` > 0
@@ -171,7 +173,10 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
                 visibility[k, j] = BLOCKED if hidden else VISIBLE
             # area lights are not geometry: a nearer area light does not block (lights cast shadows
             # of each other's bodies in Cycles only when they are meshes, so it does not here)
-            if not hidden:
+            if not hidden:  # each strategy's light one contribution, clamped to its hit's ``limit``
+                c0, c1, c2, cut = clamped(c0, c1, c2, limit[j])
+                if keep:  # the ratio estimator's N stays the share of Combined it is
+                    cuts[k, j] = cut
                 s0 += c0
                 s1 += c1
                 s2 += c2

@@ -22,7 +22,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..base import vectors as vec
-from ..base.constants import TINY
 from ..base.vectors import Frame
 from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
@@ -37,6 +36,8 @@ from ..settings import AOV_CHANNELS
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
+from .bounces import binding, ended
+from .clamp import limits as clamp_limits, row_limits
 from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_records
@@ -102,13 +103,8 @@ class WaveOutput:
     aov_reach: np.ndarray | None = None
     ratio: RatioEstimator | None = None
 
-    def values(self, clamp: float) -> dict:
+    def values(self) -> dict:
         radiance, ratio = self.radiance, None if self.ratio is None else self.ratio.ndu
-        if clamp > 0:
-            peak = vec.max3(radiance)
-            scale = np.where(peak > clamp, clamp / np.maximum(peak, TINY), 1.0)[:, None]
-            radiance = radiance * scale
-            ratio = None if ratio is None else ratio * scale  # N stays the share of Combined it is
         finite = np.isfinite(radiance)
         if ratio is not None:
             out_ratio = np.where((finite.all(axis=1) & np.isfinite(ratio).all(axis=1))[:, None], ratio, 0.0)
@@ -143,15 +139,21 @@ class Integrator:
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
+        self.clamp = clamp_limits(settings)  # Clamp Direct and Indirect (core.integrator.clamp)
+        self.clamping = bool(np.isfinite(self.clamp).any())
         # transparent shadows when some material lets shadow rays through (the plan lists them)
         self.shadows = None
         if plan.see_through:
             clear = self.geometry.of_triangles(np.array([see_through(m) for m in scene.materials]))
-            self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count)
+            self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count, self.clamp)
+        # the glossy and transmission limits, where they can end paths before the Total does
+        self.limited = binding(settings) and (plan.rays["reflection"] or plan.rays["refraction"]
+                                              or plan.rays["diffuse"])
         # paths carry their ray kind and depths only for a scene whose shader programs read them,
-        # with diffuse bounces, with transparent shadows (which count them) or with objects hidden
-        # from some kind of ray (whose masks they give)
-        self.carried = self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
+        # with diffuse bounces, with transparent shadows (which count them), with objects hidden
+        # from some kind of ray (whose masks they give) or with a glossy or transmission limit
+        self.carried = (self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
+                        or self.limited)
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
         self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)
@@ -220,6 +222,10 @@ class Integrator:
             self._emission_seen(surf, state, hits, out)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out)
+            if self.limited:  # paths past a glossy or transmission limit end here, with what they saw
+                surf = surf.take(np.flatnonzero(~ended(surf.bounces, s)))
+                if len(surf) == 0:
+                    break
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
             bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
@@ -252,7 +258,7 @@ class Integrator:
             if not continued:
                 break
             state = PathState.concat(continued)
-        return out.values(s.clamp)
+        return out.values()
 
     # -- camera ---------------------------------------------------------------------
     def _camera_rays(self, samples: Samples, sampler):
@@ -276,6 +282,11 @@ class Integrator:
                           mis_origin=cam.origins if self.shadows is not None else None)
         return state, cam
 
+    def _limits(self, straight: np.ndarray) -> np.ndarray | None:
+        """The clamp limit of each contribution of paths ``straight`` or not (direct: before their
+        first bounce), None when nothing is clamped."""
+        return row_limits(self.clamp, straight) if self.clamping else None
+
     # -- what rays see ----------------------------------------------------------------
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
         """Lights hit directly: always by reflected and refracted rays, by the camera if asked; the
@@ -287,7 +298,7 @@ class Integrator:
             origins, dist = rays.mis_ray(smooth, t[smooth])
             return self.lights.pdf(light_id[smooth], origins, rays.dirs[smooth], dist, rays.time[smooth])
 
-        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf)
+        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight))
 
     def _escaped(self, rays: PathState, out: WaveOutput):
         """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
@@ -310,11 +321,12 @@ class Integrator:
         if len(rays) and lights.world_seen:
             sampled = None if lights.world is None else (  # a world light sampling can find
                 lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
-            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled)
+            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled, self._limits(rays.straight))
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
-            add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth])
+            add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth],
+                        self._limits(bounced.straight))
 
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
@@ -342,7 +354,8 @@ class Integrator:
             origins, dist = state.mis_ray(rows, hits.t[rows])
             return self.lights.pdf_emissive(prim[smooth], origins, state.dirs[rows], dist)
 
-        e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit], emissive_pdf)
+        e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit], emissive_pdf,
+                        self._limits(surf.straight[glowing]))
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
@@ -490,6 +503,7 @@ class Integrator:
         n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
+        cuts = np.ones((light.strategies, keep))
         # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
         # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
         lifted = len(self.geometry.tables[3]) > 0 and any(lobe.diffuse for lobe in shader.lobes)
@@ -500,15 +514,17 @@ class Integrator:
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
-            _c(group.ng), _c(group.frame.m), _smooth(group), _c(group.wo_l), _c(group.inside), _c(group.scale), _c(group.throughput),
-            _c(group.path), _NO_BOUNCES if group.bounces is None else _c(group.bounces),
+            _c(group.ng), _c(group.frame.m), _smooth(group), _c(group.wo_l), _c(group.inside), _c(group.scale),
+            _c(group.throughput),
+            _c(group.path), row_limits(self.clamp, group.straight),
+            _NO_BOUNCES if group.bounces is None else _c(group.bounces),
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
-            wave.radiance, f_diff, visibility, clear, allowed, qf, qi)
+            wave.radiance, f_diff, visibility, cuts, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
-            wave.ratio.direct(shader, group, light.value, f_diff, visibility)
+            wave.ratio.direct(shader, group, light.value, f_diff, visibility, cuts)
         return stopped(qf, qi, m, group.bounces)
 
     # -- continuation through one lobe -------------------------------------------------

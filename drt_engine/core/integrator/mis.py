@@ -9,6 +9,7 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
+from .clamp import clamp_rows
 
 
 @kernel(inline="always")
@@ -29,18 +30,20 @@ def power_heuristic(a, b):
     return out
 
 
-def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf):
+def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf, limit=None):
     """Emission a BSDF-sampled ray found, any emitter: weighted by the power heuristic against
     light sampling where both could have produced the direction (``light_pdf(rows)``, the
     light-sampling density of those rows' directions; None if light sampling never picks this
     emitter; camera rays and delta lobes, prev_pdf = inf, take it whole). Adds it to the wave's
     radiance and denoising features (``out``, the wave's WaveOutput) and returns throughput x
-    weighted emission."""
+    weighted emission, each row clamped to its ``limit`` (core.integrator.clamp; None: no clamping)."""
     weight = np.ones(len(path))
     smooth = np.flatnonzero(~np.isinf(prev_pdf))
     if len(smooth) and light_pdf is not None:
         weight[smooth] = power_heuristic(prev_pdf[smooth], light_pdf(smooth))
     e = throughput * emitted * weight[:, None]
+    if limit is not None:
+        e = clamp_rows(e, limit)
     out.radiance[path] += e
     if out.features is not None:
         out.features.emitted(path, emitted * weight[:, None])

@@ -20,7 +20,10 @@ each sample's N, D and U (summed over these lights) to a wave output ``RATIO`` o
 columns; its N is also in Combined, as Monte Carlo has it. A render without the estimator has
 no hook and does none of this. The film keeps them as sums (core.film.ratio_sums), over all
 samples and over class A (the error estimate's half), and ``resolve`` replaces N by U N / D
-when the image is read. What stays Monte Carlo:
+when the image is read. With Clamp Direct or Indirect (core.integrator.clamp) a sample's N
+is its clamped contributions' (the direct-light kernel hands over each contribution's clamp
+factor), D and U are not, so U N / D is clamped as Combined is, and biased as it is.
+What stays Monte Carlo:
 glossy parts (with MIS), emission, the world, emissive meshes, delta lights (their E_u V
 is exact already), moving lights, lights chosen among many, and any light without a
 closed form.
@@ -78,10 +81,10 @@ class RatioEstimator:
         self.table, self.strategies = table, strategies
         self.ndu = np.zeros((n, NDU_CHANNELS))
 
-    def direct(self, shader, hits, value, f_diff, visibility):
+    def direct(self, shader, hits, value, f_diff, visibility, cuts):
         """Direct light computed at ``hits`` (lit by ``shader``): per strategy, the light samples'
-        values and the BSDF's diffuse part toward them, and what became of their shadow rays
-        (core.integrator.direct). For the estimator's strategies, D and U of every hit and the N of
+        values and the BSDF's diffuse part toward them, what became of their shadow rays and the
+        clamp's factor on those that got through (core.integrator.direct). For the estimator's strategies, D and U of every hit and the N of
         each ray that got through; a strategy whose samples all came back empty adds nothing."""
         if not shader.lambertian:  # the closed form E_u is of Lambert's cosine about the normal
             return
@@ -96,7 +99,7 @@ class RatioEstimator:
             diffuse = hits.throughput * value[k] * f_diff[k]
             add_unoccluded(self.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, self.ndu)
             seen = visibility[k] == VISIBLE
-            self.ndu[hits.path[seen], :3] += diffuse[seen]
+            self.ndu[hits.path[seen], :3] += diffuse[seen] * cuts[k][seen][:, None]
 
 
 def _diffuse_albedo(shader, hits):

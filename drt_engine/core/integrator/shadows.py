@@ -22,7 +22,8 @@ import numpy as np
 from ..base.jit import kernel
 from ..geometry import embree
 from ..geometry.accel import Hits, instance_of, refine, spawn_point
-from ..shading.lightpath import KIND, TRANSPARENT_DEPTH
+from ..shading.lightpath import DEPTH, KIND, TRANSPARENT_DEPTH
+from .clamp import clamped, row_limits
 from .hits import surface_records
 from .records import ShadowRays
 
@@ -72,11 +73,12 @@ def enqueue(qf, qi, m, c0, c1, c2, ox, oy, oz, dx, dy, dz, tmax, time, u, v, len
 
 
 @kernel
-def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, radiance, out_f, out_i):
+def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radiance, out_f, out_i):
     """Sends each queued ray (``mask``: the shadow rays' Embree mask) (its contribution already attenuated by its surface) on from the far
     side of the surface at ``pos`` (geometric normal ``ng`` facing the ray, offset ``scale``):
-    open, its contribution goes to ``radiance``; opaque, or see-through past its allowed count,
-    nothing; see-through within it, queued again in ``out``. Returns (rays traced, rows queued)."""
+    open, its contribution goes to ``radiance``, clamped to ``limit[r]`` (core.integrator.clamp);
+    opaque, or see-through past its allowed count, nothing; see-through within it, queued again in
+    ``out``. Returns (rays traced, rows queued)."""
     rayhit = embree.new_rayhit()
     scratch = np.empty((2, 3, 4))
     m = 0
@@ -90,9 +92,10 @@ def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, radiance, out_
                                             qf[r, 10], mask)
         if what == OPEN:
             p = qi[r, 0]
-            radiance[p, 0] += qf[r, 0]
-            radiance[p, 1] += qf[r, 1]
-            radiance[p, 2] += qf[r, 2]
+            c0, c1, c2, _ = clamped(qf[r, 0], qf[r, 1], qf[r, 2], limit[r])
+            radiance[p, 0] += c0
+            radiance[p, 1] += c1
+            radiance[p, 2] += c2
         elif what == SEE_THROUGH and qi[r, 3] + 1 < qi[r, 4]:
             enqueue(out_f, out_i, m, qf[r, 0], qf[r, 1], qf[r, 2], ox, oy, oz, dx, dy, dz, tmax, qf[r, 10], u, v,
                     qf[r, 13] + along + t, qi[r, 0], prim, r, qi[r, 3] + 1, qi[r, 4])
@@ -115,10 +118,11 @@ def stopped(qf, qi, m: int, bounces: np.ndarray) -> ShadowRays | None:
 
 class TransparentShadows:
     """Resolves the queued shadow rays of a wave (see the module's docstring): ``geometry`` and
-    ``clear`` (per mesh triangle row), ``bind`` the integrator's shaders per material group."""
+    ``clear`` (per mesh triangle row), ``bind`` the integrator's shaders per material group,
+    ``clamp`` the (direct, indirect) limits of a contribution (core.integrator.clamp)."""
 
-    def __init__(self, geometry, clear: np.ndarray, bind, count):
-        self.geometry, self.clear, self.bind, self.count = geometry, clear, bind, count
+    def __init__(self, geometry, clear: np.ndarray, bind, count, clamp):
+        self.geometry, self.clear, self.bind, self.count, self.clamp = geometry, clear, bind, count, clamp
 
     def resolve(self, rays: ShadowRays, radiance: np.ndarray, timed: bool):
         """Every queued ray taken through its surfaces until it is blocked or gets through."""
@@ -148,6 +152,7 @@ class TransparentShadows:
             out_f, out_i = new_queue(len(go), True)
             traced, m = pass_through(geo.handle, geo.tables, self.clear, geo.shadow_mask, qf,
                                      np.ascontiguousarray(i[go]),
-                                     surf.pos[go], surf.ng[go], surf.scale[go], radiance, out_f, out_i)
+                                     surf.pos[go], surf.ng[go], surf.scale[go],
+                                     row_limits(self.clamp, rays.bounces[go, DEPTH] == 0), radiance, out_f, out_i)
             self.count("shadow", traced)
             rays = ShadowRays(out_f[:m], out_i[:m], rays.bounces[go][out_i[:m, 2]])

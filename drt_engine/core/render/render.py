@@ -18,6 +18,7 @@ from ..errors import SceneError, SettingsError
 from ..film.denoising import PASSES as FEATURE_PASSES, with_features
 from ..film.film import Film
 from ..integrator.aovs import AOV_TRANSPARENCY
+from ..integrator.bounces import LIMIT_TRANSPARENCY
 from ..integrator.integrator import Integrator
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
@@ -96,11 +97,14 @@ class Renderer:
 
     def _setting_warnings(self) -> list[str]:
         """What these settings make DRT approximate in this scene: shader AOVs behind transparency
-        (core.integrator.aovs)."""
-        if self.integrator.aovs is not None and any(c.kind == "TRANSPARENT" for m in self.scene.materials
-                                                    for c in m.closures):
-            return [AOV_TRANSPARENCY]
-        return []
+        (core.integrator.aovs), paths a bounce limit ends before transparency (core.integrator.bounces)."""
+        transparent = any(c.kind == "TRANSPARENT" for m in self.scene.materials for c in m.closures)
+        warnings = []
+        if self.integrator.aovs is not None and transparent:
+            warnings.append(AOV_TRANSPARENCY)
+        if self.integrator.limited and transparent:
+            warnings.append(LIMIT_TRANSPARENCY)
+        return warnings
 
     def render(self, progress=None) -> RenderResult:
         """Render progressively (core.render.driver) and return the passes, stats and error log."""
