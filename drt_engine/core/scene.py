@@ -58,7 +58,7 @@ class Closure:
     """The Toon BSDF's Smooth, the angle past Size over which the intensity falls to 0 (0 to 1: 0 to 90 degrees)."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
-    "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``
+    "metallic", "ior", "transmission", "emission", "normal", "coat_normal", ...) -> output ``(node, socket)``
     of the material's ``program``; they replace the constant field per hit."""
 
     def __post_init__(self):

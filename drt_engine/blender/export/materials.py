@@ -41,7 +41,7 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth")
+           "diffuse_roughness", "normal", "coat_normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -66,12 +66,13 @@ class _Inputs:
         value = socket.default_value
         return float(value) if isinstance(value, (int, float)) else np.array(value[:], dtype=np.float64)
 
-    def normal(self):
-        socket = find_input(self.node, "Normal")
+    def normal(self, name="Normal", field="normal"):
+        """A linked normal socket as a per-hit input (unlinked: the shading normal, as Cycles)."""
+        socket = find_input(self.node, name)
         if socket is not None and socket.is_linked:
             value = self.compiler.value(socket, "vector")
             if is_ref(value):
-                self.varying["normal"] = value
+                self.varying[field] = value
 
     def anisotropy(self, closure, name, rotation_name):
         """The closure's anisotropy, its rotation and, when it is anisotropic, its tangent: the
@@ -129,6 +130,7 @@ def _principled(node, weight, issues, compiler):
     _oren_nayar_version(node, principled, value, issues)
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
     value.normal()
+    value.normal("Coat Normal", "coat_normal")
     if is_ref(alpha):
         opaque = compiler.scale(weight, compiler.clamp01(alpha))
         clear = compiler.scale(weight, compiler.one_minus(compiler.clamp01(alpha)))

@@ -40,7 +40,9 @@ P_ALPHA_X = 33
 P_ALPHA_Y = 34
 P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
 P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
-P = 37
+P_OWN_NORMAL = 37  # 1: the lobe has its own normal H_NORMAL (a Principled Coat Normal), tables read at H_PLACE
+P_UNDER_OWN = 38  # 1: the lobe's first layer term (the coat above it) is read at H_PLACE
+P = 39
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice
@@ -59,4 +61,6 @@ H_COLOUR = 3  # (3) diffuse / transparent / toon colour
 H_TINT_R = 6  # (3) glass reflection tint
 H_TINT_T = 9  # (3) glass transmission tint
 H_F0 = 12  # (3) Fresnel colour
-H = 15
+H_NORMAL = 15  # (3) P_OWN_NORMAL: the lobe's normal in the local shading frame
+H_PLACE = 18  # (2) P_OWN_NORMAL, P_UNDER_OWN: ``tables.locate`` of wo's cosine to that normal (j, t)
+H = 20

@@ -21,11 +21,11 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
+from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
                      TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
-from .reflection import reflect_eval, reflect_sample
+from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
 from .toon import toon_cone_sample, toon_diffuse_eval, toon_glossy_eval, toon_glossy_sample
 from .translucent import translucent_eval
@@ -125,7 +125,11 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd1 += d1
             fd2 += d2
             continue
-        if kind == REFLECT:
+        if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:  # its hemisphere is its own normal's, as Cycles'
+            if not above:
+                continue
+            f0, f1, f2, p = own_reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+        elif kind == REFLECT:
             if not refl:
                 continue
             f0, f1, f2, p = reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
@@ -153,6 +157,8 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     kind = int(lp[l, P_KIND])
     if kind == TRANSPARENT:
         return transparent_sample(hp, r, l, wox, woy, woz)
+    if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:
+        return own_reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
     if kind == REFLECT:
         return reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
     if kind == TOON_GLOSSY:
@@ -166,13 +172,14 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through.
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
-    the transparent lobe was taken, diffuse: a diffuse lobe was). For non-delta lobes the weight
+    the transparent lobe was taken, diffuse: a diffuse lobe was, crosses: wi leaves through the
+    surface (below the shading normal, but for a reflection about a lobe's own normal)). For non-delta lobes the weight
     and pdf are those of the whole mixture of the choice (one-sample MIS over lobes), as multiple
     importance sampling with light sampling requires.
     """
     n = sel.shape[1]
     if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False
     count = 0
     acc = 0.0
     for k in range(n):
@@ -210,8 +217,10 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     delta = lp[l, P_DELTA] != 0.0
     valid = ok and p_choice > 0.0
     pdf = 0.0
+    # a reflection about a lobe's own normal may leave below the shading normal, on wo's side still
+    crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
     if valid and not delta:
-        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
+        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, not crosses, inside,
                                               sel, si, diffuse, 0)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
@@ -221,4 +230,4 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     w0 = w0 if np.isfinite(w0) else 0.0
     w1 = w1 if np.isfinite(w1) else 0.0
     w2 = w2 if np.isfinite(w2) else 0.0
-    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind)
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses

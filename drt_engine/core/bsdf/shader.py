@@ -62,6 +62,8 @@ class Lobe:
     # | "toon"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
     alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
+    own_normal: bool = False  # the coat of a Principled whose Coat Normal varies: its own normal per hit
+    under_own: bool = False  # under such a coat: its first layer term read at the coat normal's cosine
 
     @property
     def delta(self) -> bool:
@@ -438,6 +440,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_REFRACT_ONLY] = lobe.refract_only
         row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
+        row[layout.P_OWN_NORMAL], row[layout.P_UNDER_OWN] = lobe.own_normal, lobe.under_own
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
@@ -469,6 +472,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         h[layout.H_TINT_R:layout.H_TINT_R + 3] = lobe.tint_r
         h[layout.H_TINT_T:layout.H_TINT_T + 3] = lobe.tint_t
         h[layout.H_F0:layout.H_F0 + 3] = lobe.f0
+        h[layout.H_NORMAL + 2] = 1.0
     return lp, lt, hp
 
 
@@ -505,6 +509,11 @@ class MaterialShader:
             elif "color" in names and lobe.role == "glossy":
                 lobe.affine = _affine(lobe, lambda c: np.ones((len(c), 3)), lambda c: np.zeros((len(c), 3)), tables,
                                       ("glossy",))
+            if "coat_normal" in names and any(m.role == "coat" and m.source == lobe.source for m in self.lobes):
+                lobe.own_normal = lobe.role == "coat"
+                lobe.under_own = lobe.role != "coat" and bool(lobe.layers)
+        self.coat_normal = any(lobe.own_normal for lobe in self.lobes)
+        """A lobe has its own normal per hit: a bound shader takes it with ``turn_coat``."""
         self.lp, self.lt, self.hp = _pack(self.lobes, self.sampled)
         self.mu = np.ascontiguousarray(mf.MU_TABLE, np.float64)
         self.bound = False
@@ -531,6 +540,8 @@ class MaterialShader:
             v = values.get(lobe.source, {})
             if "weight" in v:
                 hp[:, l, layout.H_SCALE:layout.H_SCALE + 3] = v["weight"]
+            if "coat_normal" in v and lobe.own_normal:
+                hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = v["coat_normal"]  # world, until turn_coat
             color = v.get("color")
             if color is None:
                 continue
@@ -554,6 +565,29 @@ class MaterialShader:
             bound.holdout = holdout
         return bound
 
+    def coat_normals(self) -> np.ndarray:
+        """(N, 3) the coat normal of each hit of its binding, as bound (world) or turned (local)."""
+        l = next(l for l, lobe in enumerate(self.lobes) if lobe.own_normal)
+        return self.hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3]
+
+    def turn_coat(self, normal_l: np.ndarray, wo_l: np.ndarray) -> "MaterialShader":
+        """The bound shader with its coat normal per hit in the local shading frame (``normal_l``, unit,
+        wo above it) and, for the coat and the lobes under it, where wo's cosine to it falls in the
+        tables (``tables.locate``), whose albedos Cycles reads there."""
+        hp = self.hp.copy()
+        mu = self.mu
+        c = np.clip(np.einsum("ij,ij->i", normal_l, wo_l), mu[0], mu[-1])
+        j = np.clip(np.searchsorted(mu, c, side="right") - 1, 0, len(mu) - 2)
+        t = (c - mu[j]) / (mu[j + 1] - mu[j])
+        for l, lobe in enumerate(self.lobes):
+            if lobe.own_normal:
+                hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = normal_l
+            if lobe.own_normal or lobe.under_own:
+                hp[:, l, layout.H_PLACE], hp[:, l, layout.H_PLACE + 1] = j, t
+        turned = copy.copy(self)
+        turned.hp = hp
+        return turned
+
     def take(self, rows) -> "MaterialShader":
         """The shader of the hits ``rows`` of its binding (itself when it is not bound)."""
         if not self.bound:
@@ -574,6 +608,7 @@ class MaterialShader:
         clear.lp[:, layout.P_SAMPLED] = np.arange(len(keep))
         clear.lt, clear.hp = np.ascontiguousarray(self.lt[keep]), np.ascontiguousarray(self.hp[:, keep])
         clear.emission, clear.has_glass, clear.holds_out, clear.holdout = np.zeros(3), False, False, np.zeros(3)
+        clear.coat_normal = False
         return clear
 
     def holdout_weights(self, n) -> np.ndarray:
