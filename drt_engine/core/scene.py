@@ -72,6 +72,7 @@ CLOSURE_KINDS = (
     "PRINCIPLED",  # full Principled BSDF
     "DIFFUSE",  # Lambert (Oren-Nayar with ``diffuse_roughness``), colour = albedo
     "TRANSLUCENT",  # Lambert on the side opposite the normal, colour = albedo
+    "SHEEN",  # Cycles' microfiber sheen (Zeltner et al. 2022) of ``roughness``, tinted by colour
     "GLOSSY",  # GGX reflection tinted by colour, no Fresnel (Blender's Glossy BSDF)
     "GLASS",  # smooth or rough dielectric, reflection + refraction tinted by colour
     "REFRACTION",  # refraction only, tinted by colour

@@ -177,6 +177,18 @@ def _toon(node, weight, issues, compiler):
     return [_weighted(closure, weight, value.varying)]
 
 
+def _sheen(node, weight, issues, compiler):
+    """The Sheen BSDF: Cycles' microfiber sheen; the legacy Ashikhmin velvet is not built (rendered
+    as microfiber, named in the warning)."""
+    value = _Inputs(node, compiler, issues)
+    if getattr(node, "distribution", "MICROFIBER") != "MICROFIBER":
+        issues.add(f"'{node.name}' Ashikhmin distribution (rendered as Microfiber)")
+    closure = Closure("SHEEN", color=rgb(value(0.8, "Color", field="color", kind="color")),
+                      roughness=value(0.5, "Roughness", field="roughness", kind="float"))
+    value.normal()
+    return [_weighted(closure, weight, value.varying)]
+
+
 OREN_NAYAR_MATCHED_FROM = (4, 3)
 """The first Blender taken to have the Oren-Nayar DRT computes (Fujii's with a multiple-scattering
 term, kernel/closure/bsdf_oren_nayar.h), the version that added the Principled BSDF's Diffuse
@@ -253,6 +265,7 @@ CLOSURE_NODES = {
     "ShaderNodeBsdfTranslucent": _bsdf("TRANSLUCENT"),
     "ShaderNodeHoldout": _holdout,
     "ShaderNodeBsdfToon": _toon,
+    "ShaderNodeBsdfSheen": _sheen,
 }
 
 

@@ -8,7 +8,7 @@
   ``hp[prow[i]]`` (``hp`` and the row ``r`` in the scalar functions).
 """
 # lobe kinds and Fresnel kinds
-DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
+DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY, SHEEN = 0, 1, 2, 3, 4, 5, 6, 7, 8
 F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
@@ -42,7 +42,8 @@ P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
 P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
 P_OWN_NORMAL = 37  # 1: the lobe has its own normal H_NORMAL (a Principled Coat Normal), tables read at H_PLACE
 P_UNDER_OWN = 38  # 1: the lobe's first layer term (the coat above it) is read at H_PLACE
-P = 39
+P_SHEEN_ROUGH = 39  # sheen: roughness (clamped to [1e-3, 1])
+P = 40
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice

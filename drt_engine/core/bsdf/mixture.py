@@ -21,11 +21,12 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
+from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SHEEN, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
                      TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
+from .sheen import sheen_eval, sheen_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
 from .toon import toon_cone_sample, toon_diffuse_eval, toon_glossy_eval, toon_glossy_sample
 from .translucent import translucent_eval
@@ -44,7 +45,7 @@ def slot(lp, l, diffuse):
     if diffuse == 0:
         return int(lp[l, P_SAMPLED])
     kind = int(lp[l, P_KIND])
-    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE:
+    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == SHEEN:
         return l if diffuse & SAMPLE_DIFFUSE else -1
     if kind == TRANSLUCENT:
         return l if diffuse & SAMPLE_TRANSLUCENT else -1
@@ -100,7 +101,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             continue
         kind = int(lp[l, P_KIND])
         if diffuse_kind(kind):
-            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone
+            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone and sheen's
             if kind == TRANSLUCENT:
                 if not trans:
                     continue
@@ -111,6 +112,8 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
             elif kind == TOON_DIFFUSE:
                 d0, d1, d2, p = toon_diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
+            elif kind == SHEEN:
+                d0, d1, d2, p = sheen_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
             else:
                 d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
             d0, d1, d2 = d0 * lit_diffuse, d1 * lit_diffuse, d2 * lit_diffuse
@@ -203,6 +206,10 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         wix, wiy, wiz = toon_cone_sample(lp, l, 0.0, 0.0, 1.0, u0, u1)
         w0 = w1 = w2 = 1.0
         ok = True
+    elif kind == SHEEN:
+        wix, wiy, wiz = sheen_sample(lp, l, wox, woy, woz, u0, u1)
+        w0 = w1 = w2 = 1.0
+        ok = wiz > 0.0
     elif diffuse_kind(kind):
         wix, wiy, wiz, _ = cosine_sample(u0, u1, -1.0 if kind == TRANSLUCENT else 1.0)
         w0 = w1 = w2 = 1.0

@@ -1,5 +1,5 @@
 """Materials as sums of lobes: Lambert, Oren-Nayar, translucent, GGX reflection, dielectric (glass),
-transparent, toon (diffuse and glossy).
+transparent, toon (diffuse and glossy), sheen.
 
 A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
 with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
@@ -29,6 +29,7 @@ from ..scene import Closure, Material
 from . import layout
 from . import microfacet as mf
 from .records import BsdfSample, BsdfValue
+from .sheen import ROUGH_MIN, sheen_albedo
 from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
                    weights_rows)
 
@@ -38,13 +39,14 @@ class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
     arrays of ``layout``."""
     kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent" | "toon_diffuse"
-    # | "toon_glossy"
+    # | "toon_glossy" | "sheen"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
     alpha: float = 0.0
     sigma: float = 0.0  # Oren-Nayar roughness
     toon: tuple = (0.0, 0.0)  # toon: (size, smooth) as angles in radians
+    sheen_rough: float = 0.0  # sheen: roughness
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
     fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
@@ -95,7 +97,7 @@ class Lobe:
         return self.alpha * min(1.0, abs(self.eta - 1.0))
 
 
-DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent", "toon_diffuse")
+DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent", "toon_diffuse", "sheen")
 
 
 def _alpha(roughness: float) -> float:
@@ -378,6 +380,16 @@ def toon_angles(size: float, smooth: float) -> tuple[float, float]:
     return float(np.clip(size, 1e-5, 1.0)) * np.pi / 2, float(np.clip(smooth, 0.0, 1.0)) * np.pi / 2
 
 
+def sheen_lobe(weight, colour, roughness) -> Lobe:
+    """Cycles' microfiber sheen (core.bsdf.sheen) of this roughness (clamped to [1e-3, 1] as
+    bsdf_sheen_setup), its albedo tabulated over the view cosines for lobe choice and the passes."""
+    rough = float(np.clip(roughness if np.isfinite(roughness) else 0.0, ROUGH_MIN, 1.0))
+    mu = mf.MU_TABLE
+    e = np.array([sheen_albedo(float(c), rough) for c in mu])[:, None] * np.ones(3)
+    return Lobe("sheen", np.asarray(weight, float), albedo=colour, sheen_rough=rough, table=(mu, e),
+                layer_table=(mu, e), role="sheen")
+
+
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     lobes = []
     for i, c in enumerate(material.closures):
@@ -402,6 +414,8 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
         elif c.kind in ("DIFFUSE_TOON", "GLOSSY_TOON"):
             new = [Lobe("toon_diffuse" if c.kind == "DIFFUSE_TOON" else "toon_glossy", c.weight,
                         albedo=np.clip(c.color, 0, 1), toon=toon_angles(c.toon_size, c.toon_smooth), role="toon")]
+        elif c.kind == "SHEEN":
+            new = [sheen_lobe(c.weight, np.clip(c.color, 0, 1), c.roughness)]
         elif c.kind == "TRANSPARENT":
             new = [Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1), role="transparent")]
         else:
@@ -422,7 +436,7 @@ def see_through(material: Material) -> bool:
 
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
           "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR,
-          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY}
+          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY, "sheen": layout.SHEEN}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -441,6 +455,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
         row[layout.P_OWN_NORMAL], row[layout.P_UNDER_OWN] = lobe.own_normal, lobe.under_own
+        row[layout.P_SHEEN_ROUGH] = lobe.sheen_rough
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
@@ -546,7 +561,7 @@ class MaterialShader:
             if color is None:
                 continue
             base = np.clip(color, 0.0, 1.0)
-            if lobe.role in ("diffuse", "transparent", "translucent", "toon"):
+            if lobe.role in ("diffuse", "transparent", "translucent", "toon", "sheen"):
                 hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = base
             elif lobe.role == "glass":
                 hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = np.sqrt(base)

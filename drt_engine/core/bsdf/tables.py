@@ -11,7 +11,7 @@ import numpy as np
 from ..base.jit import kernel
 from . import microfacet as mf
 from .layout import (GLASS, H_COLOUR, H_F0, H_PLACE, H_SCALE, H_TINT_R, H_TINT_T, P_A_AVG, P_AFFINE, P_B_AVG,
-                     P_E_AVG, P_KIND, P_LAYER_TINT, P_LAYERS, P_MS, P_OWN_NORMAL, P_UNDER_OWN, P_WEIGHT, REFLECT, T_E,
+                     P_E_AVG, P_KIND, P_LAYER_TINT, SHEEN, P_LAYERS, P_MS, P_OWN_NORMAL, P_UNDER_OWN, P_WEIGHT, REFLECT, T_E,
                      T_E1, T_EA, T_EB, T_LAYER_E, T_MS, T_UNDER)
 
 
@@ -124,4 +124,7 @@ def lobe_albedo(lp, lt, hp, r, j, t, l):
         return (s0 * max(hp[r, l, H_TINT_R], hp[r, l, H_TINT_T]),
                 s1 * max(hp[r, l, H_TINT_R + 1], hp[r, l, H_TINT_T + 1]),
                 s2 * max(hp[r, l, H_TINT_R + 2], hp[r, l, H_TINT_T + 2]))
+    if kind == SHEEN:  # its colour times its tabulated albedo
+        e = at(lt, l, T_E, j, t)
+        return s0 * hp[r, l, H_COLOUR] * e, s1 * hp[r, l, H_COLOUR + 1] * e, s2 * hp[r, l, H_COLOUR + 2] * e
     return s0 * hp[r, l, H_COLOUR], s1 * hp[r, l, H_COLOUR + 1], s2 * hp[r, l, H_COLOUR + 2]
