@@ -40,6 +40,10 @@ class Closure:
     coat_roughness: float = 0.03
     coat_ior: float = 1.5
     coat_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    sheen_weight: float = 0.0
+    """Principled's Sheen Weight: a microfiber sheen layered over the coat and the rest (as Cycles)."""
+    sheen_roughness: float = 0.5
+    sheen_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
     diffuse_roughness: float = 0.0
     """DIFFUSE's and Principled's diffuse: Lambert, or from 1e-5 up Oren-Nayar of this sigma (Cycles')."""
     emission: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -64,7 +68,7 @@ class Closure:
     def __post_init__(self):
         if self.kind not in CLOSURE_KINDS:
             raise ValueError(f"unknown closure kind {self.kind!r}")
-        for name in ("weight", "color", "specular_tint", "coat_tint", "emission"):
+        for name in ("weight", "color", "specular_tint", "coat_tint", "sheen_tint", "emission"):
             setattr(self, name, _vec3(getattr(self, name)))
 
 

@@ -111,3 +111,24 @@ def test_colour_and_albedo_in_the_passes():
     albedo = sheen.sheen_albedo(0.6, 0.5)
     assert diff[0] == pytest.approx(np.array([0.8, 0.4, 0.2]) * albedo, rel=5e-3)  # the table interpolates
     assert np.all(gloss == 0.0)
+
+
+@pytest.mark.parametrize("coat", [0.0, 1.0])
+def test_principled_sheen_layers_over_the_rest(coat):
+    """Principled's sheen is the top layer (Cycles' closure.h): its weight Sheen Weight x tint, and
+    every lobe below (the coat too) weighed by 1 - Sheen Weight x max(tint) x albedo(mu) on top of
+    what it had without the sheen; with Sheen Weight 0 nothing changes."""
+    tint = np.array([1.0, 0.6, 0.8])
+    base = dict(color=(0.05, 0.03, 0.02), roughness=0.5, coat_weight=coat, coat_roughness=0.2)
+    plain = MaterialShader(Material("plain", [Closure("PRINCIPLED", **base)]))
+    none = MaterialShader(Material("none", [Closure("PRINCIPLED", sheen_weight=0.0, **base)]))
+    sheened = MaterialShader(Material("sheen", [Closure("PRINCIPLED", sheen_weight=0.7, sheen_roughness=0.4,
+                                                        sheen_tint=tint, **base)]))
+    mu = np.array([0.9, 0.5, 0.1])
+    assert np.array_equal(none.lp, plain.lp) and np.array_equal(none.lt, plain.lt)
+    assert sheened.lobes[0].kind == "sheen"
+    w_plain, w_sheen = plain.lobe_weights(mu), sheened.lobe_weights(mu)
+    np.testing.assert_allclose(w_sheen[:, 0], 0.7 * tint * np.ones((3, 1)))
+    albedo = np.array([sheen.sheen_albedo(m, 0.4) for m in mu])
+    under = 1.0 - 0.7 * tint.max() * albedo
+    np.testing.assert_allclose(w_sheen[:, 1:], w_plain * under[:, None, None], rtol=5e-3)

@@ -41,7 +41,8 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal", "coat_normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth")
+           "sheen_weight", "sheen_roughness", "sheen_tint", "diffuse_roughness", "normal", "coat_normal", "anisotropy",
+           "anisotropic_rotation", "toon_size", "toon_smooth")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -105,7 +106,6 @@ def _principled(node, weight, issues, compiler):
     alpha = compiler.value(alpha_socket, "float") if alpha_socket is not None else 1.0
     for feature, names in (
         ("Subsurface", ("Subsurface Weight", "Subsurface")),
-        ("Sheen", ("Sheen Weight", "Sheen")),
         ("Thin Film", ("Thin Film Thickness",)),
     ):
         if value(0.0, *names) > 0.0:
@@ -123,6 +123,9 @@ def _principled(node, weight, issues, compiler):
         coat_roughness=value(0.03, "Coat Roughness", field="coat_roughness", kind="float"),
         coat_ior=value(1.5, "Coat IOR", field="coat_ior", kind="float"),
         coat_tint=rgb(value(1.0, "Coat Tint", field="coat_tint", kind="color")),
+        sheen_weight=value(0.0, "Sheen Weight", "Sheen", field="sheen_weight", kind="float"),
+        sheen_roughness=value(0.5, "Sheen Roughness", field="sheen_roughness", kind="float"),
+        sheen_tint=rgb(value(1.0, "Sheen Tint", field="sheen_tint", kind="color")),
         diffuse_roughness=value(0.0, "Diffuse Roughness", field="diffuse_roughness", kind="float"),
         multiscatter=_multiscatter(node, issues),
     )
@@ -131,6 +134,11 @@ def _principled(node, weight, issues, compiler):
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
     value.normal()
     value.normal("Coat Normal", "coat_normal")
+    sheen = principled.sheen_weight > 0.0 or "sheen_weight" in value.varying
+    coated = principled.coat_weight > 0.0 or "coat_weight" in value.varying
+    if sheen and coated and "coat_normal" in value.varying:
+        issues.add(f"'{node.name}' Sheen with a Coat Normal (the sheen shades about the main Normal, not "
+                   "Cycles' blend of the two by Coat Weight)")
     if is_ref(alpha):
         opaque = compiler.scale(weight, compiler.clamp01(alpha))
         clear = compiler.scale(weight, compiler.one_minus(compiler.clamp01(alpha)))

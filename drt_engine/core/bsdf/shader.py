@@ -308,19 +308,48 @@ def _key(*parts):
     return tuple(tuple(np.round(np.atleast_1d(p), 9).tolist()) if not isinstance(p, str) else p for p in parts)
 
 
+SHEEN_CUTOFF = 1e-5
+"""Cycles' CLOSURE_WEIGHT_CUTOFF: a Principled sheen weight at or below it adds no sheen."""
+
+
+def _principled_sheen(c: Closure) -> tuple[Lobe | None, tuple | None]:
+    """Principled's sheen, the first layer as in Cycles' closure.h (weight Sheen Weight x Sheen Tint)
+    and its layer term over the rest: Cycles' closure_layering_weight, one minus the sheen's albedo
+    over the closure's weight, its largest channel (Sheen Weight x max(tint) x albedo(mu))."""
+    weight = max(float(c.sheen_weight), 0.0)
+    if not weight > SHEEN_CUTOFF:
+        return None, None
+    tint = np.clip(c.sheen_tint, 0, None)
+    sheen = sheen_lobe(c.weight * weight * tint, np.ones(3), c.sheen_roughness)
+    sheen.role = "principled_sheen"  # the base colour is not its colour
+    return sheen, (weight * float(tint.max()) * sheen.table[1][:, 0], np.ones(3))
+
+
+def _over(upper: tuple, lower: tuple) -> tuple:
+    """One layer term for two layers one over the other: (1 - a)(1 - b), each clamped as Cycles
+    clamps each layering weight, as 1 - emax; tints multiply."""
+    keep = np.clip(1.0 - upper[0], 0.0, 1.0) * np.clip(1.0 - lower[0], 0.0, 1.0)
+    return 1.0 - keep, upper[1] * lower[1]
+
+
 def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
     lobes = []
     w = c.weight
+    sheen, sheen_layer = _principled_sheen(c)
     base_layers = []
+    if sheen is not None:
+        lobes.append(sheen)
+        base_layers = [sheen_layer]
     if c.coat_weight > 0:
         coat_ior = max(c.coat_ior, 1.0 + 1e-4)
         coat = _reflect_lobe(w * c.coat_weight, _alpha(c.coat_roughness), _dielectric_fresnel(coat_ior, np.ones(3)),
-                             tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
+                             list(base_layers), tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
                              fresnel_kind=layout.F_DIELECTRIC, fresnel_eta=coat_ior)
         coat.role = "coat"
         lobes.append(coat)
         tint = 1.0 + c.coat_weight * (np.clip(c.coat_tint, 0, None) - 1.0)
-        base_layers = [_layer_under(coat, tint)]
+        coat_layer = _layer_under(coat, tint)
+        base_layers = [coat_layer if sheen is None else _over(sheen_layer, coat_layer)]
     alpha = _alpha(c.roughness)
     base = np.clip(c.color, 0.0, 1.0)
     metallic = float(np.clip(c.metallic, 0, 1))
