@@ -1,5 +1,5 @@
 """Sheen lobe (core.bsdf.sheen): the transformed cosine is a density (its white furnace is its
-tabulated albedo, at most 1), sampling draws from the density the evaluation gives, and both stay
+albedo from the paper's table, at most 1), sampling draws from the density the evaluation gives, and both stay
 finite at grazing views and at roughness 0 and 1."""
 import numpy as np
 import pytest
@@ -49,7 +49,7 @@ def test_white_furnace_is_the_albedo(rough, cos_o):
     wo = _wo(cos_o)
     dirs, d_omega = _hemisphere(300 * 300)
     total = sum(_eval(shader, wo, w)[0] * d for w, d in zip(dirs, d_omega))
-    albedo = sheen.sheen_albedo(cos_o, max(rough, sheen.ROUGH_MIN))
+    albedo = float(sheen.sheen_albedo(sheen.sheen_rows(rough), cos_o))
     assert np.isfinite(total) and total <= 1.0 + 1e-6
     assert total == pytest.approx(albedo, rel=0.03, abs=2e-4)
 
@@ -108,7 +108,7 @@ def test_colour_and_albedo_in_the_passes():
     """DiffCol is the colour times the albedo at the view (the sheen counts as diffuse, as in Cycles)."""
     shader = _shader(0.5, colour=(0.8, 0.4, 0.2))
     diff, gloss = shader.colors(np.array([0.6]))
-    albedo = sheen.sheen_albedo(0.6, 0.5)
+    albedo = float(sheen.sheen_albedo(sheen.sheen_rows(0.5), 0.6))
     assert diff[0] == pytest.approx(np.array([0.8, 0.4, 0.2]) * albedo, rel=5e-3)  # the table interpolates
     assert np.all(gloss == 0.0)
 
@@ -129,6 +129,6 @@ def test_principled_sheen_layers_over_the_rest(coat):
     assert sheened.lobes[0].kind == "sheen"
     w_plain, w_sheen = plain.lobe_weights(mu), sheened.lobe_weights(mu)
     np.testing.assert_allclose(w_sheen[:, 0], 0.7 * tint * np.ones((3, 1)))
-    albedo = np.array([sheen.sheen_albedo(m, 0.4) for m in mu])
+    albedo = sheen.sheen_albedo(sheen.sheen_rows(0.4), mu)
     under = 1.0 - 0.7 * tint.max() * albedo
     np.testing.assert_allclose(w_sheen[:, 1:], w_plain * under[:, None, None], rtol=5e-3)

@@ -915,6 +915,11 @@ def _toon(component, size, smooth):
     return build
 
 
+def _sheen(tree):
+    """A Sheen BSDF (Microfiber), roughness 0.3: the rim light of the sun from behind."""
+    return _link(tree, _node(tree, "ShaderNodeBsdfSheen"), Color=(0.9, 0.8, 0.6, 1.0), Roughness=0.3)
+
+
 def _principled_sheen(tree):
     """A Principled BSDF over a dark base with Sheen Weight 1 (roughness 0.5, pinkish tint)."""
     return _link(tree, _node(tree, "ShaderNodeBsdfPrincipled"), Roughness=0.5,
@@ -960,6 +965,7 @@ CLOSURES = (
     ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
                 lambda tree: _rough_diffuse(tree, _generated_z(tree, 1.0, 0.0)), True),
     ClosureCase("Principled BSDF, Diffuse Roughness 1", "sphere", _principled_rough, True, (4, 3)),
+    ClosureCase("Sheen BSDF, roughness 0.3", "sphere", _sheen),
     ClosureCase("Principled BSDF, Sheen Weight 1 over a dark base", "sphere", _principled_sheen),
     ClosureCase("Translucent", "square", _translucent),
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
@@ -969,7 +975,8 @@ diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere (these first:
 neighbour would light the translucent squares through Cycles' transmission bounces, which DRT
 does not trace through a Translucent), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
-textured, and a Principled BSDF's Diffuse Roughness), a Principled's sheen over a dark base and upright squares lit through from behind
+textured, and a Principled BSDF's Diffuse Roughness), sheen spheres (the Sheen BSDF, a Principled's
+sheen over a dark base) and upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front)."""
 
 

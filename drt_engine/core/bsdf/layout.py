@@ -42,8 +42,9 @@ P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
 P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
 P_OWN_NORMAL = 37  # 1: the lobe has its own normal H_NORMAL (a Principled Coat Normal), tables read at H_PLACE
 P_UNDER_OWN = 38  # 1: the lobe's first layer term (the coat above it) is read at H_PLACE
-P_SHEEN_ROUGH = 39  # sheen: roughness (clamped to [1e-3, 1])
-P = 40
+P_SHEEN_TABLE = 39  # (3 x SHEEN_N) sheen: a, b and albedo over the view cosines k / (SHEEN_N - 1), at its roughness
+SHEEN_N = 32
+P = 39 + 3 * SHEEN_N
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice

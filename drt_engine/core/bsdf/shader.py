@@ -29,7 +29,7 @@ from ..scene import Closure, Material
 from . import layout
 from . import microfacet as mf
 from .records import BsdfSample, BsdfValue
-from .sheen import ROUGH_MIN, sheen_albedo
+from .sheen import sheen_albedo, sheen_rows
 from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
                    weights_rows)
 
@@ -46,7 +46,7 @@ class Lobe:
     alpha: float = 0.0
     sigma: float = 0.0  # Oren-Nayar roughness
     toon: tuple = (0.0, 0.0)  # toon: (size, smooth) as angles in radians
-    sheen_rough: float = 0.0  # sheen: roughness
+    sheen: np.ndarray | None = None  # sheen: (3, layout.SHEEN_N) a, b, albedo over the view cosines
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
     fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
@@ -412,11 +412,11 @@ def toon_angles(size: float, smooth: float) -> tuple[float, float]:
 def sheen_lobe(weight, colour, roughness) -> Lobe:
     """Cycles' microfiber sheen (core.bsdf.sheen) of this roughness (clamped to [1e-3, 1] as
     bsdf_sheen_setup), its albedo tabulated over the view cosines for lobe choice and the passes."""
-    rough = float(np.clip(roughness if np.isfinite(roughness) else 0.0, ROUGH_MIN, 1.0))
+    rows = sheen_rows(roughness if np.isfinite(roughness) else 0.0)
     mu = mf.MU_TABLE
-    e = np.array([sheen_albedo(float(c), rough) for c in mu])[:, None] * np.ones(3)
-    return Lobe("sheen", np.asarray(weight, float), albedo=colour, sheen_rough=rough, table=(mu, e),
-                layer_table=(mu, e), role="sheen")
+    e = sheen_albedo(rows, mu)[:, None] * np.ones(3)
+    return Lobe("sheen", np.asarray(weight, float), albedo=colour, sheen=rows, table=(mu, e), layer_table=(mu, e),
+                role="sheen")
 
 
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
@@ -484,7 +484,8 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
         row[layout.P_OWN_NORMAL], row[layout.P_UNDER_OWN] = lobe.own_normal, lobe.under_own
-        row[layout.P_SHEEN_ROUGH] = lobe.sheen_rough
+        if lobe.sheen is not None:
+            row[layout.P_SHEEN_TABLE:layout.P_SHEEN_TABLE + 3 * layout.SHEEN_N] = lobe.sheen.reshape(-1)
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
