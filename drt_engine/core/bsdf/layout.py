@@ -8,7 +8,8 @@
   ``hp[prow[i]]`` (``hp`` and the row ``r`` in the scalar functions).
 """
 # lobe kinds and Fresnel kinds
-DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY, SHEEN = 0, 1, 2, 3, 4, 5, 6, 7, 8
+DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
+SHEEN = 8
 F_DIELECTRIC, F_F82, F_TINT = 0, 1, 2
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it

@@ -21,8 +21,8 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SHEEN, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
-                     TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
+                     SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample

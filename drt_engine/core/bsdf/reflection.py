@@ -12,8 +12,8 @@ from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, H_NORMAL, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y, P_ANISO, P_DELTA,
-                     P_ETA_F, P_F82, P_FRESNEL, P_KIND, T_WHITE)
+from .layout import (F_DIELECTRIC, F_F82, GLASS, H_F0, H_NORMAL, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y, P_ANISO,
+                     P_DELTA, P_ETA_F, P_F82, P_FRESNEL, P_KIND, T_WHITE)
 from .tables import at, place
 
 

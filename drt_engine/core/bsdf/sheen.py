@@ -8,7 +8,8 @@ ships (``sheen_table``), read as Cycles' lookup_table_read_2D reads it: linear i
 lobe (``sheen_rows``, into the lobe's constants), linear in the view cosine per ray. (MaterialX's
 analytic fits of that table were tried first: their a is up to about 10% off the table's, which put
 a rim lit from behind 0.020 off Cycles against a limit of 0.016.) A diffuse closure in Cycles:
-light-sampled, and a path continues through it only with diffuse bounces on, as the other diffuse lobes here."""
+light-sampled, and a path continues through it only with diffuse bounces on, as the other diffuse
+lobes here."""
 from __future__ import annotations
 
 import math

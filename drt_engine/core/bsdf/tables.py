@@ -11,8 +11,8 @@ import numpy as np
 from ..base.jit import kernel
 from . import microfacet as mf
 from .layout import (GLASS, H_COLOUR, H_F0, H_PLACE, H_SCALE, H_TINT_R, H_TINT_T, P_A_AVG, P_AFFINE, P_B_AVG,
-                     P_E_AVG, P_KIND, P_LAYER_TINT, SHEEN, P_LAYERS, P_MS, P_OWN_NORMAL, P_UNDER_OWN, P_WEIGHT, REFLECT, T_E,
-                     T_E1, T_EA, T_EB, T_LAYER_E, T_MS, T_UNDER)
+                     P_E_AVG, P_KIND, P_LAYER_TINT, P_LAYERS, P_MS, P_OWN_NORMAL, P_UNDER_OWN, P_WEIGHT, REFLECT, SHEEN,
+                     T_E, T_E1, T_EA, T_EB, T_LAYER_E, T_MS, T_UNDER)
 
 
 @kernel(inline="always")
