@@ -40,6 +40,10 @@ class Closure:
     coat_roughness: float = 0.03
     coat_ior: float = 1.5
     coat_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    sheen_weight: float = 0.0
+    """Principled's Sheen Weight: a microfiber sheen layered over the coat and the rest (as Cycles)."""
+    sheen_roughness: float = 0.5
+    sheen_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
     diffuse_roughness: float = 0.0
     """DIFFUSE's and Principled's diffuse: Lambert, or from 1e-5 up Oren-Nayar of this sigma (Cycles')."""
     emission: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -65,13 +69,13 @@ class Closure:
     """The film covers the metal lobe too (Cycles 5.0 on; 4.x leaves metal bare)."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
-    "metallic", "ior", "transmission", "emission", "normal", ...) -> output ``(node, socket)``
+    "metallic", "ior", "transmission", "emission", "normal", "coat_normal", ...) -> output ``(node, socket)``
     of the material's ``program``; they replace the constant field per hit."""
 
     def __post_init__(self):
         if self.kind not in CLOSURE_KINDS:
             raise ValueError(f"unknown closure kind {self.kind!r}")
-        for name in ("weight", "color", "specular_tint", "coat_tint", "emission"):
+        for name in ("weight", "color", "specular_tint", "coat_tint", "sheen_tint", "emission"):
             setattr(self, name, _vec3(getattr(self, name)))
 
 
@@ -79,6 +83,7 @@ CLOSURE_KINDS = (
     "PRINCIPLED",  # full Principled BSDF
     "DIFFUSE",  # Lambert (Oren-Nayar with ``diffuse_roughness``), colour = albedo
     "TRANSLUCENT",  # Lambert on the side opposite the normal, colour = albedo
+    "SHEEN",  # Cycles' microfiber sheen (Zeltner et al. 2022) of ``roughness``, tinted by colour
     "GLOSSY",  # GGX reflection tinted by colour, no Fresnel (Blender's Glossy BSDF)
     "GLASS",  # smooth or rough dielectric, reflection + refraction tinted by colour
     "REFRACTION",  # refraction only, tinted by colour

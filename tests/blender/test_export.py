@@ -805,14 +805,35 @@ def test_view_layer_material_and_world_overrides():
 
 def test_unsupported_shader_node_renders_default_grey_with_one_warning():
     scene = empty_scene()
-    material, tree, output = _new_node_material("Sheen")
-    tree.links.new(tree.nodes.new("ShaderNodeBsdfSheen").outputs[0], output.inputs["Surface"])
+    material, tree, output = _new_node_material("Hair")
+    tree.links.new(tree.nodes.new("ShaderNodeBsdfHair").outputs[0], output.inputs["Surface"])
     data = render_export(_material_scene(material))
-    closures = _closures(data, "Sheen")
+    closures = _closures(data, "Hair")
     assert [(c.kind, tuple(c.color)) for c in closures] == [
         (c.kind, tuple(c.color)) for c in DEFAULT_MATERIAL.closures
     ]
-    assert len(data.warnings) == 1 and "Sheen" in data.warnings[0]
+    assert len(data.warnings) == 1 and "Hair BSDF" in data.warnings[0]
+
+
+@pytest.mark.parametrize("distribution", ["MICROFIBER", "ASHIKHMIN"])
+def test_sheen_bsdf_exports_colour_and_roughness(distribution):
+    """The Sheen BSDF is Cycles' microfiber sheen without a warning; the legacy Ashikhmin velvet is
+    rendered as microfiber and named."""
+    empty_scene()
+    material, tree, output = _new_node_material("Sheen")
+    node = tree.nodes.new("ShaderNodeBsdfSheen")
+    node.distribution = distribution
+    node.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1.0)
+    node.inputs["Roughness"].default_value = 0.3
+    tree.links.new(node.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Sheen")
+    assert closure.kind == "SHEEN" and closure.roughness == pytest.approx(0.3)
+    np.testing.assert_allclose(closure.color, [0.2, 0.4, 0.6], rtol=1e-6)
+    if distribution == "MICROFIBER":
+        assert data.warnings == []
+    else:
+        assert len(data.warnings) == 1 and "Ashikhmin" in data.warnings[0]
 
 
 @pytest.mark.parametrize("component, kind", [("DIFFUSE", "DIFFUSE_TOON"), ("GLOSSY", "GLOSSY_TOON")])

@@ -925,6 +925,18 @@ def _toon(component, size, smooth):
     return build
 
 
+def _sheen(tree):
+    """A Sheen BSDF (Microfiber), roughness 0.3: the rim light of the sun from behind."""
+    return _link(tree, _node(tree, "ShaderNodeBsdfSheen"), Color=(0.9, 0.8, 0.6, 1.0), Roughness=0.3)
+
+
+def _principled_sheen(tree):
+    """A Principled BSDF over a dark base with Sheen Weight 1 (roughness 0.5, pinkish tint)."""
+    return _link(tree, _node(tree, "ShaderNodeBsdfPrincipled"), Roughness=0.5,
+                 **{"Base Color": (0.05, 0.03, 0.02, 1.0), "Sheen Weight": 1.0, "Sheen Roughness": 0.5,
+                    "Sheen Tint": (1.0, 0.6, 0.8, 1.0)})
+
+
 def _translucent(tree, colour=(0.3, 0.9, 0.4, 1.0)):
     return _link(tree, _node(tree, "ShaderNodeBsdfTranslucent"), Color=colour)
 
@@ -967,6 +979,8 @@ CLOSURES = (
     ClosureCase("Oren-Nayar, roughness from a texture", "sphere",
                 lambda tree: _rough_diffuse(tree, _generated_z(tree, 1.0, 0.0)), True),
     ClosureCase("Principled BSDF, Diffuse Roughness 1", "sphere", _principled_rough, True, (4, 3)),
+    ClosureCase("Sheen BSDF, roughness 0.3", "sphere", _sheen),
+    ClosureCase("Principled BSDF, Sheen Weight 1 over a dark base", "sphere", _principled_sheen),
     ClosureCase("Translucent", "square", _translucent),
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
 )
@@ -976,7 +990,8 @@ Cycles computes the film as DRT does; these first: a glossy
 neighbour would light the translucent squares through Cycles' transmission bounces, which DRT
 does not trace through a Translucent), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
-textured, and a Principled BSDF's Diffuse Roughness) and upright squares lit through from behind
+textured, and a Principled BSDF's Diffuse Roughness), sheen spheres (the Sheen BSDF, a Principled's
+sheen over a dark base) and upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front)."""
 
 

@@ -41,8 +41,8 @@ def _multiscatter(node, issues) -> bool:
 
 VARYING = ("emission_color", "emission_strength", "color", "roughness", "metallic", "ior", "specular_ior_level",
            "specular_tint", "transmission", "coat_weight", "coat_roughness", "coat_ior", "coat_tint",
-           "diffuse_roughness", "normal", "anisotropy", "anisotropic_rotation", "toon_size", "toon_smooth",
-           "thin_film_thickness", "thin_film_ior")
+           "sheen_weight", "sheen_roughness", "sheen_tint", "diffuse_roughness", "normal", "coat_normal", "anisotropy",
+           "anisotropic_rotation", "toon_size", "toon_smooth", "thin_film_thickness", "thin_film_ior")
 """Closure fields the core evaluates per hit (core.shading); other linked inputs use their default."""
 
 
@@ -67,12 +67,13 @@ class _Inputs:
         value = socket.default_value
         return float(value) if isinstance(value, (int, float)) else np.array(value[:], dtype=np.float64)
 
-    def normal(self):
-        socket = find_input(self.node, "Normal")
+    def normal(self, name="Normal", field="normal"):
+        """A linked normal socket as a per-hit input (unlinked: the shading normal, as Cycles)."""
+        socket = find_input(self.node, name)
         if socket is not None and socket.is_linked:
             value = self.compiler.value(socket, "vector")
             if is_ref(value):
-                self.varying["normal"] = value
+                self.varying[field] = value
 
     def anisotropy(self, closure, name, rotation_name):
         """The closure's anisotropy, its rotation and, when it is anisotropic, its tangent: the
@@ -103,12 +104,8 @@ def _principled(node, weight, issues, compiler):
     value = _Inputs(node, compiler, issues)
     alpha_socket = find_input(node, "Alpha")
     alpha = compiler.value(alpha_socket, "float") if alpha_socket is not None else 1.0
-    for feature, names in (
-        ("Subsurface", ("Subsurface Weight", "Subsurface")),
-        ("Sheen", ("Sheen Weight", "Sheen")),
-    ):
-        if value(0.0, *names) > 0.0:
-            issues.add(f"'{node.name}' {feature}")
+    if value(0.0, "Subsurface Weight", "Subsurface") > 0.0:
+        issues.add(f"'{node.name}' Subsurface")
     principled = Closure(
         "PRINCIPLED",
         color=rgb(value(0.8, "Base Color", field="color", kind="color")),
@@ -122,6 +119,9 @@ def _principled(node, weight, issues, compiler):
         coat_roughness=value(0.03, "Coat Roughness", field="coat_roughness", kind="float"),
         coat_ior=value(1.5, "Coat IOR", field="coat_ior", kind="float"),
         coat_tint=rgb(value(1.0, "Coat Tint", field="coat_tint", kind="color")),
+        sheen_weight=value(0.0, "Sheen Weight", "Sheen", field="sheen_weight", kind="float"),
+        sheen_roughness=value(0.5, "Sheen Roughness", field="sheen_roughness", kind="float"),
+        sheen_tint=rgb(value(1.0, "Sheen Tint", field="sheen_tint", kind="color")),
         diffuse_roughness=value(0.0, "Diffuse Roughness", field="diffuse_roughness", kind="float"),
         multiscatter=_multiscatter(node, issues),
     )
@@ -130,6 +130,12 @@ def _principled(node, weight, issues, compiler):
     _oren_nayar_version(node, principled, value, issues)
     _emission_input(principled, value, compiler, 0.0, ("Emission Color", "Emission"), ("Emission Strength",))
     value.normal()
+    value.normal("Coat Normal", "coat_normal")
+    sheen = principled.sheen_weight > 0.0 or "sheen_weight" in value.varying
+    coated = principled.coat_weight > 0.0 or "coat_weight" in value.varying
+    if sheen and coated and "coat_normal" in value.varying:
+        issues.add(f"'{node.name}' Sheen with a Coat Normal (the sheen shades about the main Normal, not "
+                   "Cycles' blend of the two by Coat Weight)")
     if is_ref(alpha):
         opaque = compiler.scale(weight, compiler.clamp01(alpha))
         clear = compiler.scale(weight, compiler.one_minus(compiler.clamp01(alpha)))
@@ -191,6 +197,18 @@ def _toon(node, weight, issues, compiler):
     closure = Closure(kind, color=rgb(value(0.8, "Color", field="color", kind="color")),
                       toon_size=value(0.5, "Size", field="toon_size", kind="float"),
                       toon_smooth=value(0.0, "Smooth", field="toon_smooth", kind="float"))
+    value.normal()
+    return [_weighted(closure, weight, value.varying)]
+
+
+def _sheen(node, weight, issues, compiler):
+    """The Sheen BSDF: Cycles' microfiber sheen; the legacy Ashikhmin velvet is not built (rendered
+    as microfiber, named in the warning)."""
+    value = _Inputs(node, compiler, issues)
+    if getattr(node, "distribution", "MICROFIBER") != "MICROFIBER":
+        issues.add(f"'{node.name}' Ashikhmin distribution (rendered as Microfiber)")
+    closure = Closure("SHEEN", color=rgb(value(0.8, "Color", field="color", kind="color")),
+                      roughness=value(0.5, "Roughness", field="roughness", kind="float"))
     value.normal()
     return [_weighted(closure, weight, value.varying)]
 
@@ -286,6 +304,7 @@ CLOSURE_NODES = {
     "ShaderNodeBsdfTranslucent": _bsdf("TRANSLUCENT"),
     "ShaderNodeHoldout": _holdout,
     "ShaderNodeBsdfToon": _toon,
+    "ShaderNodeBsdfSheen": _sheen,
 }
 
 

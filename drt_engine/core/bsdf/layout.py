@@ -10,6 +10,7 @@
 # lobe kinds and Fresnel kinds
 DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
 F_DIELECTRIC, F_F82, F_TINT, F_FILM, F_F82_FILM = 0, 1, 2, 3, 4  # F_FILM: thin film over a dielectric
+SHEEN = 8
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
 # covers every lobe (slot = lobe index) and the diffuse lobes outside the bits get no share
@@ -43,7 +44,11 @@ P_TOON_SIZE = 35  # toon: angle (radians) of full intensity
 P_TOON_SMOOTH = 36  # toon: angle over which the intensity falls to 0
 P_FILM = 37  # thin film's thickness (nm; reflect lobes of F_FILM / F_F82_FILM, glass above thin_film.CUTOFF)
 P_FILM_IOR = 38  # thin film's IOR
-P = 39
+P_OWN_NORMAL = 39  # 1: the lobe has its own normal H_NORMAL (a Principled Coat Normal), tables read at H_PLACE
+P_UNDER_OWN = 40  # 1: the lobe's first layer term (the coat above it) is read at H_PLACE
+P_SHEEN_TABLE = 41  # (3 x SHEEN_N) sheen: a, b and albedo over the view cosines k / (SHEEN_N - 1), at its roughness
+SHEEN_N = 32
+P = 41 + 3 * SHEEN_N
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice
@@ -62,4 +67,6 @@ H_COLOUR = 3  # (3) diffuse / transparent / toon colour
 H_TINT_R = 6  # (3) glass reflection tint
 H_TINT_T = 9  # (3) glass transmission tint
 H_F0 = 12  # (3) Fresnel colour
-H = 15
+H_NORMAL = 15  # (3) P_OWN_NORMAL: the lobe's normal in the local shading frame
+H_PLACE = 18  # (2) P_OWN_NORMAL, P_UNDER_OWN: ``tables.locate`` of wo's cosine to that normal (j, t)
+H = 20

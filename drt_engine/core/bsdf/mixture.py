@@ -22,11 +22,12 @@ from ..base.jit import kernel
 from .bump_shadowing import bump_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT,
-                     TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
+                     SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
-from .reflection import reflect_eval, reflect_sample
+from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
+from .sheen import sheen_eval, sheen_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
 from .toon import toon_cone_sample, toon_diffuse_eval, toon_glossy_eval, toon_glossy_sample
 from .translucent import translucent_eval
@@ -45,7 +46,7 @@ def slot(lp, l, diffuse):
     if diffuse == 0:
         return int(lp[l, P_SAMPLED])
     kind = int(lp[l, P_KIND])
-    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE:
+    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == SHEEN:
         return l if diffuse & SAMPLE_DIFFUSE else -1
     if kind == TRANSLUCENT:
         return l if diffuse & SAMPLE_TRANSLUCENT else -1
@@ -104,7 +105,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             continue
         kind = int(lp[l, P_KIND])
         if diffuse_kind(kind):
-            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone
+            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone and sheen's
             if kind == TRANSLUCENT:
                 if not trans:
                     continue
@@ -115,6 +116,8 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
             elif kind == TOON_DIFFUSE:
                 d0, d1, d2, p = toon_diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
+            elif kind == SHEEN:
+                d0, d1, d2, p = sheen_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
             else:
                 d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
             d0, d1, d2 = d0 * lit_diffuse, d1 * lit_diffuse, d2 * lit_diffuse
@@ -129,7 +132,11 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd1 += d1
             fd2 += d2
             continue
-        if kind == REFLECT:
+        if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:  # its hemisphere is its own normal's, as Cycles'
+            if not above:
+                continue
+            f0, f1, f2, p = own_reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+        elif kind == REFLECT:
             if not refl:
                 continue
             f0, f1, f2, p = reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
@@ -157,6 +164,8 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     kind = int(lp[l, P_KIND])
     if kind == TRANSPARENT:
         return transparent_sample(hp, r, l, wox, woy, woz)
+    if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:
+        return own_reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
     if kind == REFLECT:
         return reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1)
     if kind == TOON_GLOSSY:
@@ -172,13 +181,14 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     (sx, sy, sz, model) the smooth normal as ``eval_lobes`` takes it.
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
-    the transparent lobe was taken, diffuse: a diffuse lobe was). For non-delta lobes the weight
+    the transparent lobe was taken, diffuse: a diffuse lobe was, crosses: wi leaves through the
+    surface (below the shading normal, but for a reflection about a lobe's own normal)). For non-delta lobes the weight
     and pdf are those of the whole mixture of the choice (one-sample MIS over lobes), as multiple
     importance sampling with light sampling requires.
     """
     n = sel.shape[1]
     if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False
     count = 0
     acc = 0.0
     for k in range(n):
@@ -202,6 +212,10 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         wix, wiy, wiz = toon_cone_sample(lp, l, 0.0, 0.0, 1.0, u0, u1)
         w0 = w1 = w2 = 1.0
         ok = True
+    elif kind == SHEEN:
+        wix, wiy, wiz = sheen_sample(lp, l, wox, woy, woz, u0, u1)
+        w0 = w1 = w2 = 1.0
+        ok = wiz > 0.0
     elif diffuse_kind(kind):
         wix, wiy, wiz, _ = cosine_sample(u0, u1, -1.0 if kind == TRANSLUCENT else 1.0)
         w0 = w1 = w2 = 1.0
@@ -216,8 +230,10 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     delta = lp[l, P_DELTA] != 0.0
     valid = ok and p_choice > 0.0
     pdf = 0.0
+    # a reflection about a lobe's own normal may leave below the shading normal, on wo's side still
+    crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
     if valid and not delta:
-        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, wiz > 0.0, inside,
+        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, not crosses, inside,
                                               sel, si, diffuse, 0, sx, sy, sz, model)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
@@ -227,4 +243,4 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     w0 = w0 if np.isfinite(w0) else 0.0
     w1 = w1 if np.isfinite(w1) else 0.0
     w2 = w2 if np.isfinite(w2) else 0.0
-    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind)
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses

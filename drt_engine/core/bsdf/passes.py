@@ -5,15 +5,15 @@ from __future__ import annotations
 from ..base.jit import kernel
 from . import microfacet as mf
 from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND, P_REFRACT_ONLY, REFLECT,
-                     TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+                     SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
 
 
 @kernel(inline="always")
 def diffuse_kind(kind):
-    """Lambert, Oren-Nayar, diffuse toon or translucent: Cycles' diffuse closures
+    """Lambert, Oren-Nayar, diffuse toon, sheen or translucent: Cycles' diffuse closures
     (CLOSURE_IS_BSDF_DIFFUSE), which its DiffCol pass and the diffuse side of its denoising albedo take."""
-    return kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == TRANSLUCENT
+    return kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == SHEEN or kind == TRANSLUCENT
 
 
 @kernel(inline="always")

@@ -13,9 +13,9 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
 from . import thin_film as tf
-from .layout import (F_DIELECTRIC, F_F82, F_F82_FILM, F_FILM, GLASS, H_F0, P_ALPHA, P_ALPHA_T, P_ALPHA_X, P_ALPHA_Y,
-                     P_ANISO, P_DELTA, P_ETA_F, P_F82, P_FILM, P_FILM_IOR, P_FRESNEL, P_KIND, T_WHITE)
-from .tables import at
+from .layout import (F_DIELECTRIC, F_F82, F_F82_FILM, F_FILM, GLASS, H_F0, H_NORMAL, P_ALPHA, P_ALPHA_T, P_ALPHA_X,
+                     P_ALPHA_Y, P_ANISO, P_DELTA, P_ETA_F, P_F82, P_FILM, P_FILM_IOR, P_FRESNEL, P_KIND, T_WHITE)
+from .tables import at, place
 
 
 @kernel(inline="always")
@@ -107,3 +107,37 @@ def reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1):
     f0, f1, f2 = fresnel(lp, hp, r, l, min(max(c, 0.0), 1.0))
     g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz)
     return rx, ry, rz, f0 * g, f1 * g, f2 * g, rz > 0.0
+
+
+@kernel(inline="always")
+def own_frame(hp, r, l):
+    """(t, b, n) of the frame about a lobe's own normal (``H_NORMAL``, local to the shading frame):
+    an isotropic lobe needs only its normal, any tangent does."""
+    nx, ny, nz = hp[r, l, H_NORMAL], hp[r, l, H_NORMAL + 1], hp[r, l, H_NORMAL + 2]
+    tx, ty, tz, bx, by, bz = vec.basis(nx, ny, nz)
+    return tx, ty, tz, bx, by, bz, nx, ny, nz
+
+
+@kernel(inline="always")
+def own_reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
+    """``reflect_eval`` about the lobe's own normal (a Coat Normal): nothing where wo or wi is below it."""
+    tx, ty, tz, bx, by, bz, nx, ny, nz = own_frame(hp, r, l)
+    oz, iz = wox * nx + woy * ny + woz * nz, wix * nx + wiy * ny + wiz * nz
+    if oz <= 0.0 or iz <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    return reflect_eval(lp, hp, r, l, wox * tx + woy * ty + woz * tz, wox * bx + woy * by + woz * bz, oz,
+                        wix * tx + wiy * ty + wiz * tz, wix * bx + wiy * by + wiz * bz, iz)
+
+
+@kernel(inline="always")
+def own_reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1):
+    """``reflect_sample`` about the lobe's own normal, its tables read at wo's cosine to it."""
+    tx, ty, tz, bx, by, bz, nx, ny, nz = own_frame(hp, r, l)
+    oz = wox * nx + woy * ny + woz * nz
+    if oz <= 0.0:
+        return 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, False
+    j, t = place(lp, hp, r, l, j, t)
+    x, y, z, w0, w1, w2, ok = reflect_sample(lp, lt, hp, r, j, t, l, wox * tx + woy * ty + woz * tz,
+                                             wox * bx + woy * by + woz * bz, oz, u0, u1)
+    wix, wiy, wiz = x * tx + y * bx + z * nx, x * ty + y * by + z * ny, x * tz + y * bz + z * nz
+    return wix, wiy, wiz, w0, w1, w2, ok

@@ -1,5 +1,5 @@
 """Materials as sums of lobes: Lambert, Oren-Nayar, translucent, GGX reflection, dielectric (glass),
-transparent, toon (diffuse and glossy).
+transparent, toon (diffuse and glossy), sheen.
 
 A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
 with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
@@ -30,6 +30,7 @@ from . import layout
 from . import microfacet as mf
 from . import thin_film as tf
 from .records import BsdfSample, BsdfValue
+from .sheen import sheen_albedo, sheen_rows
 from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
                    weights_rows)
 
@@ -39,13 +40,14 @@ class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
     arrays of ``layout``."""
     kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent" | "toon_diffuse"
-    # | "toon_glossy"
+    # | "toon_glossy" | "sheen"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
     alpha: float = 0.0
     sigma: float = 0.0  # Oren-Nayar roughness
     toon: tuple = (0.0, 0.0)  # toon: (size, smooth) as angles in radians
+    sheen: np.ndarray | None = None  # sheen: (3, layout.SHEEN_N) a, b, albedo over the view cosines
     fresnel: Callable | None = None  # cos_h -> (N, 3) for "reflect", for its tables
     fresnel_kind: int = layout.F_TINT  # the same Fresnel for the kernels (reflection.fresnel)
     fresnel_eta: float = 1.0
@@ -64,6 +66,8 @@ class Lobe:
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
     alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
     film: tuple = (0.0, 1.0)  # thin film (thickness nm, IOR): reflect lobes of F_FILM / F_F82_FILM, glass
+    own_normal: bool = False  # the coat of a Principled whose Coat Normal varies: its own normal per hit
+    under_own: bool = False  # under such a coat: its first layer term read at the coat normal's cosine
 
     @property
     def delta(self) -> bool:
@@ -95,7 +99,7 @@ class Lobe:
         return self.alpha * min(1.0, abs(self.eta - 1.0))
 
 
-DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent", "toon_diffuse")
+DIFFUSE_KINDS = ("diffuse", "oren_nayar", "translucent", "toon_diffuse", "sheen")
 
 
 def _alpha(roughness: float) -> float:
@@ -321,19 +325,48 @@ def _key(*parts):
     return tuple(tuple(np.round(np.atleast_1d(p), 9).tolist()) if not isinstance(p, str) else p for p in parts)
 
 
+SHEEN_CUTOFF = 1e-5
+"""Cycles' CLOSURE_WEIGHT_CUTOFF: a Principled sheen weight at or below it adds no sheen."""
+
+
+def _principled_sheen(c: Closure) -> tuple[Lobe | None, tuple | None]:
+    """Principled's sheen, the first layer as in Cycles' closure.h (weight Sheen Weight x Sheen Tint)
+    and its layer term over the rest: Cycles' closure_layering_weight, one minus the sheen's albedo
+    over the closure's weight, its largest channel (Sheen Weight x max(tint) x albedo(mu))."""
+    weight = max(float(c.sheen_weight), 0.0)
+    if not weight > SHEEN_CUTOFF:
+        return None, None
+    tint = np.clip(c.sheen_tint, 0, None)
+    sheen = sheen_lobe(c.weight * weight * tint, np.ones(3), c.sheen_roughness)
+    sheen.role = "principled_sheen"  # the base colour is not its colour
+    return sheen, (weight * float(tint.max()) * sheen.table[1][:, 0], np.ones(3))
+
+
+def _over(upper: tuple, lower: tuple) -> tuple:
+    """One layer term for two layers one over the other: (1 - a)(1 - b), each clamped as Cycles
+    clamps each layering weight, as 1 - emax; tints multiply."""
+    keep = np.clip(1.0 - upper[0], 0.0, 1.0) * np.clip(1.0 - lower[0], 0.0, 1.0)
+    return 1.0 - keep, upper[1] * lower[1]
+
+
 def _principled_lobes(c: Closure, tables: Tables) -> list[Lobe]:
     lobes = []
     w = c.weight
+    sheen, sheen_layer = _principled_sheen(c)
     base_layers = []
+    if sheen is not None:
+        lobes.append(sheen)
+        base_layers = [sheen_layer]
     if c.coat_weight > 0:
         coat_ior = max(c.coat_ior, 1.0 + 1e-4)
         coat = _reflect_lobe(w * c.coat_weight, _alpha(c.coat_roughness), _dielectric_fresnel(coat_ior, np.ones(3)),
-                             tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
+                             list(base_layers), tables=tables, key=_key("dielectric", coat_ior, np.ones(3)),
                              fresnel_kind=layout.F_DIELECTRIC, fresnel_eta=coat_ior)
         coat.role = "coat"
         lobes.append(coat)
         tint = 1.0 + c.coat_weight * (np.clip(c.coat_tint, 0, None) - 1.0)
-        base_layers = [_layer_under(coat, tint)]
+        coat_layer = _layer_under(coat, tint)
+        base_layers = [coat_layer if sheen is None else _over(sheen_layer, coat_layer)]
     alpha = _alpha(c.roughness)
     base = np.clip(c.color, 0.0, 1.0)
     metallic = float(np.clip(c.metallic, 0, 1))
@@ -415,6 +448,16 @@ def toon_angles(size: float, smooth: float) -> tuple[float, float]:
     return float(np.clip(size, 1e-5, 1.0)) * np.pi / 2, float(np.clip(smooth, 0.0, 1.0)) * np.pi / 2
 
 
+def sheen_lobe(weight, colour, roughness) -> Lobe:
+    """Cycles' microfiber sheen (core.bsdf.sheen) of this roughness (clamped to [1e-3, 1] as
+    bsdf_sheen_setup), its albedo tabulated over the view cosines for lobe choice and the passes."""
+    rows = sheen_rows(roughness if np.isfinite(roughness) else 0.0)
+    mu = mf.MU_TABLE
+    e = sheen_albedo(rows, mu)[:, None] * np.ones(3)
+    return Lobe("sheen", np.asarray(weight, float), albedo=colour, sheen=rows, table=(mu, e), layer_table=(mu, e),
+                role="sheen")
+
+
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     lobes = []
     for i, c in enumerate(material.closures):
@@ -439,6 +482,8 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
         elif c.kind in ("DIFFUSE_TOON", "GLOSSY_TOON"):
             new = [Lobe("toon_diffuse" if c.kind == "DIFFUSE_TOON" else "toon_glossy", c.weight,
                         albedo=np.clip(c.color, 0, 1), toon=toon_angles(c.toon_size, c.toon_smooth), role="toon")]
+        elif c.kind == "SHEEN":
+            new = [sheen_lobe(c.weight, np.clip(c.color, 0, 1), c.roughness)]
         elif c.kind == "TRANSPARENT":
             new = [Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1), role="transparent")]
         else:
@@ -459,7 +504,7 @@ def see_through(material: Material) -> bool:
 
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
           "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR,
-          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY}
+          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY, "sheen": layout.SHEEN}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -478,6 +523,9 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_SIGMA] = lobe.sigma
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
         row[layout.P_FILM], row[layout.P_FILM_IOR] = lobe.film
+        row[layout.P_OWN_NORMAL], row[layout.P_UNDER_OWN] = lobe.own_normal, lobe.under_own
+        if lobe.sheen is not None:
+            row[layout.P_SHEEN_TABLE:layout.P_SHEEN_TABLE + 3 * layout.SHEEN_N] = lobe.sheen.reshape(-1)
         if lobe.anisotropic:
             row[layout.P_ANISO] = 1.0
             row[layout.P_ALPHA_X], row[layout.P_ALPHA_Y] = lobe.alpha_xy
@@ -509,6 +557,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         h[layout.H_TINT_R:layout.H_TINT_R + 3] = lobe.tint_r
         h[layout.H_TINT_T:layout.H_TINT_T + 3] = lobe.tint_t
         h[layout.H_F0:layout.H_F0 + 3] = lobe.f0
+        h[layout.H_NORMAL + 2] = 1.0
     return lp, lt, hp
 
 
@@ -545,6 +594,11 @@ class MaterialShader:
             elif "color" in names and lobe.role == "glossy":
                 lobe.affine = _affine(lobe, lambda c: np.ones((len(c), 3)), lambda c: np.zeros((len(c), 3)), tables,
                                       ("glossy",))
+            if "coat_normal" in names and any(m.role == "coat" and m.source == lobe.source for m in self.lobes):
+                lobe.own_normal = lobe.role == "coat"
+                lobe.under_own = lobe.role != "coat" and bool(lobe.layers)
+        self.coat_normal = any(lobe.own_normal for lobe in self.lobes)
+        """A lobe has its own normal per hit: a bound shader takes it with ``turn_coat``."""
         self.lp, self.lt, self.hp = _pack(self.lobes, self.sampled)
         self.mu = np.ascontiguousarray(mf.MU_TABLE, np.float64)
         self.bound = False
@@ -571,11 +625,13 @@ class MaterialShader:
             v = values.get(lobe.source, {})
             if "weight" in v:
                 hp[:, l, layout.H_SCALE:layout.H_SCALE + 3] = v["weight"]
+            if "coat_normal" in v and lobe.own_normal:
+                hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = v["coat_normal"]  # world, until turn_coat
             color = v.get("color")
             if color is None:
                 continue
             base = np.clip(color, 0.0, 1.0)
-            if lobe.role in ("diffuse", "transparent", "translucent", "toon"):
+            if lobe.role in ("diffuse", "transparent", "translucent", "toon", "sheen"):
                 hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = base
             elif lobe.role == "glass":
                 hp[:, l, layout.H_TINT_T:layout.H_TINT_T + 3] = np.sqrt(base)
@@ -593,6 +649,29 @@ class MaterialShader:
                     holdout += values.get(i, {}).get("weight", c.weight)
             bound.holdout = holdout
         return bound
+
+    def coat_normals(self) -> np.ndarray:
+        """(N, 3) the coat normal of each hit of its binding, as bound (world) or turned (local)."""
+        l = next(l for l, lobe in enumerate(self.lobes) if lobe.own_normal)
+        return self.hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3]
+
+    def turn_coat(self, normal_l: np.ndarray, wo_l: np.ndarray) -> "MaterialShader":
+        """The bound shader with its coat normal per hit in the local shading frame (``normal_l``, unit,
+        wo above it) and, for the coat and the lobes under it, where wo's cosine to it falls in the
+        tables (``tables.locate``), whose albedos Cycles reads there."""
+        hp = self.hp.copy()
+        mu = self.mu
+        c = np.clip(np.einsum("ij,ij->i", normal_l, wo_l), mu[0], mu[-1])
+        j = np.clip(np.searchsorted(mu, c, side="right") - 1, 0, len(mu) - 2)
+        t = (c - mu[j]) / (mu[j + 1] - mu[j])
+        for l, lobe in enumerate(self.lobes):
+            if lobe.own_normal:
+                hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = normal_l
+            if lobe.own_normal or lobe.under_own:
+                hp[:, l, layout.H_PLACE], hp[:, l, layout.H_PLACE + 1] = j, t
+        turned = copy.copy(self)
+        turned.hp = hp
+        return turned
 
     def take(self, rows) -> "MaterialShader":
         """The shader of the hits ``rows`` of its binding (itself when it is not bound)."""
@@ -614,6 +693,7 @@ class MaterialShader:
         clear.lp[:, layout.P_SAMPLED] = np.arange(len(keep))
         clear.lt, clear.hp = np.ascontiguousarray(self.lt[keep]), np.ascontiguousarray(self.hp[:, keep])
         clear.emission, clear.has_glass, clear.holds_out, clear.holdout = np.zeros(3), False, False, np.zeros(3)
+        clear.coat_normal = False
         return clear
 
     def holdout_weights(self, n) -> np.ndarray:

@@ -10,9 +10,9 @@ import numpy as np
 
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import (GLASS, H_COLOUR, H_F0, H_SCALE, H_TINT_R, H_TINT_T, P_A_AVG, P_AFFINE, P_B_AVG, P_E_AVG,
-                     P_KIND, P_LAYER_TINT, P_LAYERS, P_MS, P_WEIGHT, REFLECT, T_E, T_E1, T_EA, T_EB, T_LAYER_E, T_MS,
-                     T_UNDER)
+from .layout import (GLASS, H_COLOUR, H_F0, H_PLACE, H_SCALE, H_TINT_R, H_TINT_T, P_A_AVG, P_AFFINE, P_B_AVG,
+                     P_E_AVG, P_KIND, P_LAYER_TINT, P_LAYERS, P_MS, P_OWN_NORMAL, P_UNDER_OWN, P_WEIGHT, REFLECT, SHEEN,
+                     T_E, T_E1, T_EA, T_EB, T_LAYER_E, T_MS, T_UNDER)
 
 
 @kernel(inline="always")
@@ -42,11 +42,24 @@ def at(lt, l, k, j, t):
 
 
 @kernel(inline="always")
+def place(lp, hp, r, l, j, t):
+    """Where lobe l reads its own tables: at the ray's (j, t), or for a lobe with its own normal
+    (a Coat Normal) at wo's cosine to that normal, located once per hit (``H_PLACE``)."""
+    if lp[l, P_OWN_NORMAL] != 0.0:
+        return int(hp[r, l, H_PLACE]), hp[r, l, H_PLACE + 1]
+    return j, t
+
+
+@kernel(inline="always")
 def lobe_scale(lp, lt, hp, r, j, t, l):
-    """RGB weight of lobe l: constant weight, attenuation by the layers above, per-hit scale."""
+    """RGB weight of lobe l: constant weight, attenuation by the layers above (the coat's read at
+    the coat normal's cosine, as Cycles takes the coat's albedo, where it has its own), per-hit scale."""
     a0 = a1 = a2 = 1.0
     for m in range(int(lp[l, P_LAYERS])):
-        att = min(max(1.0 - at(lt, l, T_UNDER + m, j, t), 0.0), 1.0)
+        if m == 0 and lp[l, P_UNDER_OWN] != 0.0:
+            att = min(max(1.0 - at(lt, l, T_UNDER, int(hp[r, l, H_PLACE]), hp[r, l, H_PLACE + 1]), 0.0), 1.0)
+        else:
+            att = min(max(1.0 - at(lt, l, T_UNDER + m, j, t), 0.0), 1.0)
         k = P_LAYER_TINT + 3 * m
         a0 *= att * lp[l, k]
         a1 *= att * lp[l, k + 1]
@@ -76,6 +89,7 @@ def affine_albedo(lp, lt, hp, r, j, t, l):
 @kernel(inline="always")
 def ms_factor(lp, lt, hp, r, j, t, l):
     """Multiple-scattering compensation of lobe l's single-scatter f (1: none)."""
+    j, t = place(lp, hp, r, l, j, t)
     if lp[l, P_AFFINE] != 0.0:
         return affine_albedo(lp, lt, hp, r, j, t, l)[3]
     if lp[l, P_MS] != 0.0:
@@ -87,6 +101,7 @@ def ms_factor(lp, lt, hp, r, j, t, l):
 def reflect_albedo(lp, lt, hp, r, j, t, l, layering):
     """Albedo of a reflect lobe without its weight: total, or as Cycles estimates it for
     layering and GlossCol (``layering``)."""
+    j, t = place(lp, hp, r, l, j, t)
     if lp[l, P_AFFINE] == 0.0:
         k = T_LAYER_E if layering else T_E
         return at(lt, l, k, j, t), at(lt, l, k + 1, j, t), at(lt, l, k + 2, j, t)
@@ -109,4 +124,7 @@ def lobe_albedo(lp, lt, hp, r, j, t, l):
         return (s0 * max(hp[r, l, H_TINT_R], hp[r, l, H_TINT_T]),
                 s1 * max(hp[r, l, H_TINT_R + 1], hp[r, l, H_TINT_T + 1]),
                 s2 * max(hp[r, l, H_TINT_R + 2], hp[r, l, H_TINT_T + 2]))
+    if kind == SHEEN:  # its colour times its tabulated albedo
+        e = at(lt, l, T_E, j, t)
+        return s0 * hp[r, l, H_COLOUR] * e, s1 * hp[r, l, H_COLOUR + 1] * e, s2 * hp[r, l, H_COLOUR + 2] * e
     return s0 * hp[r, l, H_COLOUR], s1 * hp[r, l, H_COLOUR + 1], s2 * hp[r, l, H_COLOUR + 2]

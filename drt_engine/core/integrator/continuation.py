@@ -53,7 +53,7 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside,
         wy = x * frame[j, 0, 1] + y * frame[j, 1, 1] + z * frame[j, 2, 1]
         wz = x * frame[j, 0, 2] + y * frame[j, 1, 2] + z * frame[j, 2, 2]
         # a sampled direction on the wrong side of the geometric surface would leak light
-        crosses = z < 0
+        crosses = s[11]
         if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0) != crosses:
             continue
         if min_bounces[0] >= 0 and len(bounces):

@@ -461,7 +461,8 @@ class Integrator:
                     smooth = _smooth_rows(smooth, shading.material)
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo), smooth=smooth)
             for sub, shader in groups:
-                yield g.start + sub, group.take(sub), shader
+                taken = group.take(sub)
+                yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
 
     def _context(self, group: SurfaceHits, hits, shadow: bool = False) -> SurfaceContext:
         """The hits ``group`` as shader programs read them (core.shading.surface); ``shadow``:
@@ -582,3 +583,43 @@ def _smooth_rows(smooth, material) -> np.ndarray:
 def _smooth(hits) -> np.ndarray:
     """The smooth normals of ``hits`` whose shading normal a bump replaced, for the kernels."""
     return _NO_BUMP if hits.smooth is None else _c(hits.smooth)
+
+
+def _coat_turned(shader, hits: SurfaceHits):
+    """The bound shader with its coat normal (world, from the material's program) in each hit's
+    shading frame: unit (Cycles' safe_normalize_fallback to the frame's normal), raised toward the
+    geometric normal until wo's mirror image leaves above the surface (Cycles' coat takes its normal
+    through ensure_valid_specular_reflection; it may start below the surface), the frame's normal
+    where wo is still not above it."""
+    n = hits.frame.n
+    nc = shader.coat_normals()
+    length = vec.norm(nc)
+    nc = np.where((length > 1e-20)[:, None], nc / np.maximum(length, 1e-20)[:, None], n)
+    ng = np.where((vec.dot(hits.wo, hits.ng) < 0)[:, None], -hits.ng, hits.ng)
+    nc = valid_specular_reflection(ng, hits.wo, nc)
+    nc = np.where((vec.dot(hits.wo, nc) <= 1e-6)[:, None], n, nc)
+    return shader.turn_coat(hits.frame.to_local(nc), hits.wo_l)
+
+
+def valid_specular_reflection(ng, wo, n):
+    """Cycles' ensure_valid_specular_reflection (kernel/closure/bsdf_util.h) over rows: where wo
+    mirrored about the shading normal ``n`` leaves below min(0.9 cos(wo, ng), 0.01) of the
+    geometric normal ``ng`` (facing wo), ``n`` turned toward ``ng`` in their plane just enough
+    that the mirror image leaves at that threshold."""
+    r = 2.0 * vec.dot(n, wo)[:, None] * n - wo
+    iz = vec.dot(wo, ng)
+    threshold = np.minimum(0.9 * iz, 0.01)
+    bad = vec.dot(ng, r) < threshold
+    if not np.any(bad):
+        return n
+    x = n - vec.dot(n, ng)[:, None] * ng
+    length = vec.norm(x)
+    x = np.where((length > 1e-20)[:, None], x / np.maximum(length, 1e-20)[:, None], n)
+    ix = vec.dot(wo, x)
+    a = ix * ix + iz * iz
+    b = 2.0 * (a + iz * threshold)
+    c = (threshold + iz) ** 2
+    root = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
+    nz2 = 0.25 * np.where(ix < 0, b + root, b - root) / np.maximum(a, 1e-30)
+    raised = np.sqrt(np.maximum(1.0 - nz2, 0.0))[:, None] * x + np.sqrt(np.maximum(nz2, 0.0))[:, None] * ng
+    return np.where(bad[:, None], raised, n)

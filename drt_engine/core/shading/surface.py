@@ -23,8 +23,9 @@ from . import geometrynodes as gn
 from .nodes import Evaluator
 from .textures import Texture
 
-LINEAR_INPUTS = ("weight", "color")
-"""Inputs that enter the lobes per hit; the others key a cached shader, but for ``PER_HIT_INPUTS``."""
+LINEAR_INPUTS = ("weight", "color", "coat_normal")
+"""Inputs that enter the lobes per hit (a coat normal as it is, its frame set by the integrator);
+the others key a cached shader, but for ``PER_HIT_INPUTS``."""
 PER_HIT_INPUTS = ("normal", "emission", "tangent", "anisotropic_rotation")
 """Inputs read per hit outside the lobes: the shading frame's normal and tangent, emission."""
 QUANTUM = 256.0
