@@ -67,3 +67,16 @@ def bump_shadowing(sx, sy, sz, model, wix, wiy, wiz):
     alpha2 = min(max(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0), 1.0)  # GGX roughness from the tilt
     lam = 0.5 * (math.sqrt(1.0 + alpha2 * max(1.0 / (cos_i * cos_i) - 1.0, 0.0)) - 1.0)
     return 1.0 / (1.0 + lam), 1.0
+
+
+@kernel(inline="always")
+def own_normal_shadowing(sx, sy, sz, model, nx, ny, nz, wix, wiy, wiz):
+    """The factor of a glossy lobe with its own normal n (a coat's; local) toward wi: Cycles 5 drops
+    light on the other side of the smooth surface than n sees it (as ``bump_shadowing`` does for the
+    shading normal's lobes), 1 otherwise and under 4.x."""
+    if model < GGX:
+        return 1.0
+    if (sx * wix + sy * wiy + sz * wiz) * (sx * nx + sy * ny + sz * nz) * (nx * wix + ny * wiy + nz * wiz) < 0.0:
+        return 0.0
+    return 1.0
+

@@ -19,10 +19,10 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
-from .bump_shadowing import bump_shadowing
+from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
+from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
                      SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
@@ -98,7 +98,8 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     refl = above and wiz > 0.0
     trans = (not above) and wiz < 0.0
     shade_diffuse, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
-    lit = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else shade
+    lit_part = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else 1.0
+    lit = lit_part * shade
     lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else shade_diffuse
     for l in range(lp.shape[0]):
         if lp[l, P_DELTA] != 0.0:
@@ -132,10 +133,13 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd1 += d1
             fd2 += d2
             continue
+        seen = lit
         if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:  # its hemisphere is its own normal's, as Cycles'
             if not above:
                 continue
             f0, f1, f2, p = own_reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+            seen = lit_part * own_normal_shadowing(sx, sy, sz, model, hp[r, l, H_NORMAL], hp[r, l, H_NORMAL + 1],
+                                                   hp[r, l, H_NORMAL + 2], wix, wiy, wiz)
         elif kind == REFLECT:
             if not refl:
                 continue
@@ -150,9 +154,9 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 continue
         s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
         ms = ms_factor(lp, lt, hp, r, j, t, l)
-        fn0 += s0 * f0 * ms * lit
-        fn1 += s1 * f1 * ms * lit
-        fn2 += s2 * f2 * ms * lit
+        fn0 += s0 * f0 * ms * seen
+        fn1 += s1 * f1 * ms * seen
+        fn2 += s2 * f2 * ms * seen
         pdf += sel[si, slot(lp, l, diffuse)] * p
     return fd0, fd1, fd2, fn0, fn1, fn2, pdf
 

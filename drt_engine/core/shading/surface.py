@@ -413,6 +413,7 @@ class MaterialShading:
         self.displaced = material.program is not None and material.displacement is not None
         self.varying = material.program is not None and (any(c.inputs for c in material.closures) or self.displaced)
         self.normal_ref = next((c.inputs["normal"] for c in material.closures if "normal" in c.inputs), None)
+        self.coat_normal = any("coat_normal" in c.inputs for c in material.closures)
         self.tangent_of = next((c for c in material.closures if "tangent" in c.inputs), None)
         """The anisotropic closure whose tangent, turned about the normal, the hits' shading frame
         takes (export names any other anisotropic closure whose tangent differs)."""
@@ -461,7 +462,7 @@ class MaterialShading:
         ctx = self._displaced(ctx)
         ev = Evaluator(self.material.program, ctx, self.textures)
         normal = ev(self.normal_ref) if self.normal_ref is not None else ctx.normal if self.displaced else None
-        smooth = ctx.normal if self.normal_ref is not None else None
+        smooth = ctx.normal if self.normal_ref is not None or self.coat_normal else None
         tangent = None if self.tangent_of is None else self.tangent(ev, ctx.normal if normal is None else normal)
         linear = {}
         keyed = []
