@@ -57,24 +57,14 @@ def _tilted_coat():
     return material
 
 
-def _light(scene, name, kind, energy, location, size=0.0):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = 0.0
-    ps.aim(light, location)
-    scene.collection.objects.link(light)
-
 
 def coat_normal_scene():
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -7.0, 1.5))
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
-    _light(scene, "Area", "AREA", 200.0, (1.5, -3.0, 3.0), size=1.5)
-    _light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
+    ps.add_light(scene, "Area", "AREA", 200.0, (1.5, -3.0, 3.0), size=1.5)
+    ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     ps.smooth_sphere("Banded", -1.1, _banded_coat())
     ps.smooth_sphere("Tilted", 1.1, _tilted_coat())
     return scene

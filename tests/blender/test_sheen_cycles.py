@@ -22,24 +22,14 @@ WIDTH, HEIGHT = 64, 32
 SAMPLES = 256
 
 
-def _light(scene, name, kind, energy, location, size=0.0):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = 0.0
-    ps.aim(light, location)
-    scene.collection.objects.link(light)
-
 
 def sheen_scene(floor=False):
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -7.0, 1.5))
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
-    _light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
-    _light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
+    ps.add_light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
+    ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     for name, x, rough, colour in (("Fine sheen", -1.1, 0.2, (0.9, 0.7, 0.5, 1.0)),
                                    ("Rough sheen", 1.1, 0.8, (0.5, 0.7, 0.9, 1.0))):
         material, _ = ps.closure_material(name, "ShaderNodeBsdfSheen", Color=colour, Roughness=rough)
@@ -51,17 +41,10 @@ def sheen_scene(floor=False):
     return scene
 
 
-def _parity(scene, tmp_path, name):
-    drt, cycles0, cycles1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=name) for engine, seed in ps.RUNS]
-    figures = ps.parity(drt.rgb, cycles0.rgb, cycles1.rgb)
-    print(name, figures)
-    assert figures["ok"], ps.message(name, figures)
-    return cycles0, cycles1
-
 
 def test_sheen_bsdf_matches_cycles(drt, tmp_path, monkeypatch):
     scene = sheen_scene()
-    cycles0, cycles1 = _parity(scene, tmp_path, "sheen")
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, "sheen")
     monkeypatch.delitem(export_materials.CLOSURE_NODES, "ShaderNodeBsdfSheen")
     grey = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="grey")
     off = ps.parity(grey.rgb, cycles0.rgb, cycles1.rgb)
@@ -73,7 +56,7 @@ def test_sheen_bsdf_with_diffuse_bounces_matches_cycles(drt, tmp_path):
     """With diffuse bounces on, paths continue through the sheen too, over a grey floor."""
     scene = sheen_scene(floor=True)
     scene.drt.diffuse_bounces = 2
-    _parity(scene, tmp_path, "sheen-bounces")
+    ps.assert_parity(scene, SAMPLES, tmp_path, "sheen-bounces")
 
 
 def principled_sheen_scene():
@@ -81,8 +64,8 @@ def principled_sheen_scene():
     ps.aim(scene.camera, (0.0, -7.0, 1.5))
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
-    _light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
-    _light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
+    ps.add_light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
+    ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     for name, x, coat, tint in (("Velvet", -1.1, 0.0, (1.0, 0.6, 0.8, 1.0)), ("Coated velvet", 1.1, 1.0,
                                                                                (0.7, 0.9, 1.0, 1.0))):
         material, _ = ps.closure_material(name, "ShaderNodeBsdfPrincipled", Base_Color=(0.05, 0.03, 0.02, 1.0),
@@ -94,7 +77,7 @@ def principled_sheen_scene():
 
 def test_principled_sheen_matches_cycles(drt, tmp_path):
     scene = principled_sheen_scene()
-    cycles0, cycles1 = _parity(scene, tmp_path, "principled-sheen")
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, "principled-sheen")
     for material in bpy.data.materials:
         node = material.node_tree.nodes.get("Principled BSDF") if material.node_tree else None
         if node is not None:

@@ -27,16 +27,6 @@ pytestmark = pytest.mark.skipif(bpy.app.version < export_materials.THIN_FILM_MAT
 FILM = {"Thin_Film_Thickness": 500.0, "Thin_Film_IOR": 1.33}
 
 
-def _light(scene, name, kind, energy, location, size=0.0):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = 0.0
-    ps.aim(light, location)
-    scene.collection.objects.link(light)
-
 
 def _thickness_from_height(material, low, high):
     """The Principled's Thin Film Thickness from ``low`` nm at the sphere's bottom to ``high`` at its
@@ -57,8 +47,8 @@ def film_scene():
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.4
-    _light(scene, "Area", "AREA", 200.0, (1.5, -3.0, 3.0), size=2.0)
-    _light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
+    ps.add_light(scene, "Area", "AREA", 200.0, (1.5, -3.0, 3.0), size=2.0)
+    ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     principled = "ShaderNodeBsdfPrincipled"
     dielectric, _ = ps.closure_material("Film dielectric", principled, Base_Color=(0.05, 0.05, 0.05, 1.0),
                                         Roughness=0.2, **FILM)

@@ -47,16 +47,6 @@ def _stepped_size(material):
     return material
 
 
-def _light(scene, name, kind, energy, location, size=0.0):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = 0.0
-    ps.aim(light, location)
-    scene.collection.objects.link(light)
-
 
 def _floor():
     """A 20 m grey Diffuse floor under the spheres, which lights them from below through diffuse bounces."""
@@ -70,8 +60,8 @@ def toon_scene(floor=False):
     ps.aim(scene.camera, (0.0, -7.0, 1.5))
     scene.camera.data.lens = 50.0
     ps.black_world(scene)
-    _light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
-    _light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
+    ps.add_light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
+    ps.add_light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
     ps.smooth_sphere("Diffuse toon", -1.1,
                      _stepped_size(_toon_material("Diffuse toon", "DIFFUSE", (0.9, 0.6, 0.3, 1.0), 0.5, 0.1)))
     ps.smooth_sphere("Glossy toon", 1.1, _toon_material("Glossy toon", "GLOSSY", (0.6, 0.8, 0.9, 1.0), 0.15, 0.1))
@@ -80,17 +70,10 @@ def toon_scene(floor=False):
     return scene
 
 
-def _parity(scene, tmp_path, name):
-    drt, cycles0, cycles1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=name) for engine, seed in ps.RUNS]
-    figures = ps.parity(drt.rgb, cycles0.rgb, cycles1.rgb)
-    print(name, figures)
-    assert figures["ok"], ps.message(name, figures)
-    return cycles0, cycles1
-
 
 def test_toon_bsdf_matches_cycles(drt, tmp_path, monkeypatch):
     scene = toon_scene()
-    cycles0, cycles1 = _parity(scene, tmp_path, "toon")
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, "toon")
     monkeypatch.delitem(export_materials.CLOSURE_NODES, "ShaderNodeBsdfToon")
     grey = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="grey")
     off = ps.parity(grey.rgb, cycles0.rgb, cycles1.rgb)
@@ -103,7 +86,7 @@ def test_toon_bsdf_with_diffuse_bounces_matches_cycles(drt, tmp_path):
     over a grey floor that lights the spheres from below; without the bounces DRT must fail."""
     scene = toon_scene(floor=True)
     scene.drt.diffuse_bounces = 2
-    cycles0, cycles1 = _parity(scene, tmp_path, "toon-bounces")
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, "toon-bounces")
     scene.drt.diffuse_bounces = 0
     direct = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="direct")
     off = ps.parity(direct.rgb, cycles0.rgb, cycles1.rgb)

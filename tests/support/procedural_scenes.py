@@ -259,6 +259,29 @@ def smooth_sphere(name, x, material) -> None:
     bpy.ops.object.shade_smooth()
 
 
+def add_light(scene, name, kind, energy, location, size=0.0):
+    """A light of ``kind`` aimed at the origin from ``location``: an area light ``size`` across, any
+    other a point source (radius 0)."""
+    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
+    light.data.energy = energy
+    if kind == "AREA":
+        light.data.size = size
+    else:
+        light.data.shadow_soft_size = 0.0
+    aim(light, location)
+    scene.collection.objects.link(light)
+
+
+def assert_parity(scene, samples, out, name):
+    """DRT's render of ``scene`` within ``parity``'s limit of Cycles' (asserted); Cycles' seeds 0
+    and 1 (render_helpers.Render), for the comparisons of the feature left out."""
+    drt, cycles0, cycles1 = [rh.render(scene, engine, samples, seed, out, name=name) for engine, seed in RUNS]
+    figures = parity(drt.rgb, cycles0.rgb, cycles1.rgb)
+    print(name, figures)
+    assert figures["ok"], message(name, figures)
+    return cycles0, cycles1
+
+
 def closure_material(name, bl_idname, **inputs):
     """A material of one closure node ``bl_idname`` with these input values (underscores for
     spaces), and the node."""
