@@ -19,9 +19,22 @@ def limits(settings) -> tuple[float, float]:
     return tuple(3.0 * c if c > 0 else np.inf for c in (settings.sample_clamp_direct, settings.sample_clamp_indirect))
 
 
+UNCLAMPED = np.zeros(0)
+"""The kernels' limits when nothing is clamped: no array per ray (an 8K image's hits are 33M rows)."""
+
+
 def row_limits(pair, direct: np.ndarray) -> np.ndarray:
-    """Per row the limit of its contributions: ``direct`` rows (paths before their first bounce) and the rest."""
+    """Per row the limit of its contributions: ``direct`` rows (paths before their first bounce) and
+    the rest; ``UNCLAMPED`` when neither limit is finite."""
+    if not np.isfinite(pair).any():
+        return UNCLAMPED
     return np.where(direct, pair[0], pair[1])
+
+
+@kernel(inline="always")
+def limit_at(limit, j):
+    """Row j's limit of ``row_limits``' array (infinite where it is ``UNCLAMPED``)."""
+    return limit[j] if limit.shape[0] > 0 else np.inf
 
 
 @kernel(inline="always")

@@ -18,7 +18,7 @@ from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
-from .clamp import clamped
+from .clamp import clamped, limit_at
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
@@ -174,8 +174,8 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
             # area lights are not geometry: a nearer area light does not block (lights cast shadows
             # of each other's bodies in Cycles only when they are meshes, so it does not here)
             if not hidden:  # each strategy's light one contribution, clamped to its hit's ``limit``
-                c0, c1, c2, cut = clamped(c0, c1, c2, limit[j])
-                if keep:  # the ratio estimator's N stays the share of Combined it is
+                c0, c1, c2, cut = clamped(c0, c1, c2, limit_at(limit, j))
+                if cuts.shape[1] > 0:  # the ratio estimator's N stays the share of Combined it is
                     cuts[k, j] = cut
                 s0 += c0
                 s1 += c1

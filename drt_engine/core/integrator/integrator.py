@@ -504,7 +504,7 @@ class Integrator:
         n = len(group)
         keep = 0 if wave.ratio is None else n
         f_diff, visibility = np.zeros((light.strategies, keep, 3)), np.zeros((light.strategies, keep), np.int8)
-        cuts = np.ones((light.strategies, keep))
+        cuts = np.ones((light.strategies, keep if self.clamping else 0))  # the ratio estimator's, under a clamp
         # the terminator lift is for diffuse shading over coarse facets (measured on Ignis'
         # rough-glass cylinder, lifting glass as well doubled its highlights' noise)
         lifted = len(self.geometry.tables[3]) > 0 and any(lobe.diffuse for lobe in shader.lobes)

@@ -84,7 +84,7 @@ class RatioEstimator:
     def direct(self, shader, hits, value, f_diff, visibility, cuts):
         """Direct light computed at ``hits`` (lit by ``shader``): per strategy, the light samples'
         values and the BSDF's diffuse part toward them, what became of their shadow rays and the
-        clamp's factor on those that got through (core.integrator.direct). For the estimator's strategies, D and U of every hit and the N of
+        clamp's factor on those that got through (core.integrator.direct; no columns: nothing clamped). For the estimator's strategies, D and U of every hit and the N of
         each ray that got through; a strategy whose samples all came back empty adds nothing."""
         if not shader.lambertian:  # the closed form E_u is of Lambert's cosine about the normal
             return
@@ -99,7 +99,7 @@ class RatioEstimator:
             diffuse = hits.throughput * value[k] * f_diff[k]
             add_unoccluded(self.table, k, hits.pos, hits.ns, hits.path, albedo, diffuse, self.ndu)
             seen = visibility[k] == VISIBLE
-            self.ndu[hits.path[seen], :3] += diffuse[seen] * cuts[k][seen][:, None]
+            self.ndu[hits.path[seen], :3] += diffuse[seen] * cuts[k][seen][:, None] if cuts.shape[1] else diffuse[seen]
 
 
 def _diffuse_albedo(shader, hits):

@@ -23,7 +23,7 @@ from ..base.jit import kernel
 from ..geometry import embree
 from ..geometry.accel import Hits, instance_of, refine, spawn_point
 from ..shading.lightpath import DEPTH, KIND, TRANSPARENT_DEPTH
-from .clamp import clamped, row_limits
+from .clamp import clamped, limit_at, row_limits
 from .hits import surface_records
 from .records import ShadowRays
 
@@ -92,7 +92,7 @@ def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radianc
                                             qf[r, 10], mask)
         if what == OPEN:
             p = qi[r, 0]
-            c0, c1, c2, _ = clamped(qf[r, 0], qf[r, 1], qf[r, 2], limit[r])
+            c0, c1, c2, _ = clamped(qf[r, 0], qf[r, 1], qf[r, 2], limit_at(limit, r))
             radiance[p, 0] += c0
             radiance[p, 1] += c1
             radiance[p, 2] += c2
