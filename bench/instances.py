@@ -4,7 +4,7 @@ Each render runs in a fresh process (``--child ENGINE COUNT``) that builds the s
 60 m plane, a 1,280-triangle ico-sphere pebble instanced COUNT times on a jittered grid, a sun and
 an area light, 160x120, 16 samples, 2 threads, Cycles without denoising or adaptive sampling) and
 renders it with ``bpy.ops.render.render`` as a user's F12 would: whole render time (export and BVH
-build included) and the growth of the peak resident memory (ru_maxrss) over the process's before
+build included) and the growth of the peak resident memory (VmHWM, tests/support/memory.py) over the process's before
 the render. Engines alternate, best of ``--repeat`` each; the load average is printed beside.
 Target (issue 22): DRT's time at most 1.5x Cycles', memory growing with the instances' count, not
 their triangles. Writes the bench:instances block of docs/performance.md.
@@ -16,7 +16,6 @@ import json
 import math
 import os
 import random
-import resource
 import subprocess
 import sys
 import time
@@ -69,14 +68,15 @@ def child(engine: str, count: int) -> None:
     sys.path.insert(0, str(ROOT))
     import bpy
     import drt_engine
+    from tests.support.memory import peak_resident_mb
     drt_engine.register()
     build(engine, count)
     bpy.context.view_layer.update()
-    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    before = peak_resident_mb()
     start = time.perf_counter()
     bpy.ops.render.render()
     seconds = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    peak = peak_resident_mb()
     print("RESULT " + json.dumps({"seconds": seconds, "grew_mb": peak - before}), flush=True)
 
 

@@ -12,8 +12,8 @@ For each sample scene, in one run:
     every core against 1 thread (target: at least 1.8 on 2 cores), raw Embree's own beside it;
 (d) time to relMSE 1e-3, DRT (best of its curves) against Cycles with adaptive sampling,
     taken from bench/run.py's per-scene results (bench/results/<scene>.json) when they exist;
-(e) peak memory (ru_maxrss) of a 1920x1080 render in a fresh process, and of the same
-    process before the renderer is made (bpy, the scene, the export);
+(e) peak memory (VmHWM, the process's own: tests/support/memory.py) of a 1920x1080 render in a
+    fresh process, and of the same process before the renderer is made (bpy, the scene, the export);
 (f) cold and warm start (bench/startup.py): the first render with an empty kernel cache and
     with the cache filled, each in a fresh process.
 The scene is prepared once (core.render.prepared) and shared by the raw rays and both DRT renders.
@@ -123,18 +123,19 @@ def time_to_error(name, level=1e-3):
 
 
 MEMORY_SCRIPT = """
-import resource, sys
+import sys
 sys.path[:0] = [{root!r}, {root!r} + '/bench']
 sys.argv = ["x"]
 from scenes import load, settings
 from drt_engine.core.render.render import Renderer
 import drt_engine
+from tests.support.memory import peak_resident_mb
 drt_engine.register()
 scene, data = load({name!r}, 1920, 1080)
-before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+before = peak_resident_mb()
 result = Renderer(data, settings(scene, samples={samples}, threads=0,
                                  passes=("Combined", "Noise"))).render()
-after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+after = peak_resident_mb()
 print("MEMORY", before, after, result.stats["elapsed"], result.passes["Combined"].shape)
 """
 
@@ -145,7 +146,7 @@ def peak_memory(name, samples):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     line = next(x for x in out.splitlines() if x.startswith("MEMORY"))
     _, before, after, seconds, *shape = line.split(maxsplit=4)
-    return int(before) / 1024, int(after) / 1024, float(seconds), " ".join(shape)
+    return float(before), float(after), float(seconds), " ".join(shape)
 
 
 def fmt(x, spec=".2f"):
@@ -189,7 +190,7 @@ def table(rows, memory, startup, width, samples, cores, memory_scene, memory_sam
     if memory is not None:
         before, after, seconds, shape = memory
         lines += ["", f"Peak memory, {memory_scene} at 1920x1080, {memory_samples} spp, every core: {after:.0f} MB "
-                  f"(ru_maxrss; {before:.0f} MB of it before the renderer: Python, bpy, the scene and its export; "
+                  f"(VmHWM; {before:.0f} MB of it before the renderer: Python, bpy, the scene and its export; "
                   f"render {seconds:.1f} s, image {shape}): the render's own {after - before:.0f} MB. Target: the "
                   f"render's own under {TARGET_MEMORY} MB."]
     lines += ["", f"Start-up (bench/startup.py, {startup['where']}; each line a fresh process; start-up = first render "

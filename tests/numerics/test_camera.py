@@ -94,22 +94,23 @@ def test_four_by_four_through_blender(drt, tmp_path):
 
 
 BIG = """
-import resource, sys, numpy as np
+import sys, numpy as np
 sys.path.insert(0, {root!r})
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 from drt_engine.core.settings import RenderSettings
+from tests.support.memory import peak_resident_mb
 from tests.support.scenes import plane, translation
 cam = Camera(translation(0, 0, 5)[None], (-0.16, 0.16, -0.09, 0.09), (7680, 4320))
 scene = SceneData(cam, [plane(4.0)], [Instance(0, np.eye(4))], [Material("e", [Closure("EMISSION", emission=(2, 2, 2))])])
 image = Renderer(scene, RenderSettings(samples=1, max_depth=0, threads=2)).render().passes["Combined"]
 assert image.shape == (4320, 7680, 4) and np.allclose(image[::97, ::89, :3], 2.0)
-print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20)
+print(peak_resident_mb() / 1024)
 """
 
 
 def test_8k_image_in_bounded_memory():
-    """7680x4320, one sample, max depth 0, in a fresh process: peak resident memory under 4 GB."""
+    """7680x4320, one sample, max depth 0, in a fresh process: its own peak resident memory under 4 GB."""
     root = Path(__file__).resolve().parents[2]
     code = BIG.format(root=str(root))
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
@@ -160,3 +161,14 @@ def test_focus_distance_zero_gives_finite_rays():
     rng = np.random.default_rng(0)
     rays = camera_rays.generate(cam, rng.random(64) * 4, rng.random(64) * 4, rng.random((64, 2)))
     assert np.isfinite(rays.origins).all() and np.isfinite(rays.directions).all() and np.isfinite(rays.tmax).all()
+
+
+def test_a_child_process_reports_its_own_peak_memory():
+    """The 8K bound reads the child's own peak: a child of a process that held 1 GB reports far less
+    (getrusage's ru_maxrss would have reported the parent's peak)."""
+    held = np.ones(1 << 27)  # 1 GiB, every page touched
+    code = f"import sys; sys.path.insert(0, {str(Path(__file__).resolve().parents[2])!r}); " \
+           "from tests.support.memory import peak_resident_mb; print(peak_resident_mb())"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    del held
+    assert float(result.stdout) < 256
