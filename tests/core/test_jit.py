@@ -12,12 +12,15 @@ from drt_engine.core.base import jit
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _folder(base: Path, name: str, used: float | None) -> Path:
+def _folder(base: Path, name: str, used: float | None, changed: float = 1.0) -> Path:
+    """A cache folder stamped at ``used`` (None: never stamped) whose files last changed at ``changed``."""
     folder = base / name
-    folder.mkdir()
+    (folder / "base_0123").mkdir(parents=True)
     if used is not None:
         (folder / "compiled").touch()
         os.utime(folder / "compiled", (used, used))
+    os.utime(folder / "base_0123", (changed, changed))
+    os.utime(folder, (changed, changed))
     return folder
 
 
@@ -26,15 +29,18 @@ def test_the_most_recently_used_versions_stay(tmp_path, monkeypatch):
     mine = tmp_path / jit._FINGERPRINT
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(mine))
     older = [_folder(tmp_path, f"{python}-{i:016x}", used=1_000_000 + i) for i in range(6)]
-    unstamped = _folder(tmp_path, f"{python}-{'f' * 16}", used=None)
+    abandoned = _folder(tmp_path, f"{python}-{'f' * 16}", used=None)
+    filling = _folder(tmp_path, f"{python}-{'e' * 16}", used=None)  # another render compiling into it now
+    os.utime(filling / "base_0123")
     other_python = _folder(tmp_path, "py27-0123456789abcdef", used=1.0)
     not_ours = _folder(tmp_path, "notes", used=1.0)
     assert jit.first_run()
     jit.mark_compiled()
     assert not jit.first_run()
     kept = sorted(p.name for p in tmp_path.iterdir())
-    assert kept == sorted([mine.name, other_python.name, not_ours.name] + [f.name for f in older[-(jit.KEEP - 1):]])
-    assert not unstamped.exists()
+    newest = [filling.name] + [f.name for f in older[-(jit.KEEP - 2):]]
+    assert kept == sorted([mine.name, other_python.name, not_ours.name] + newest)
+    assert not abandoned.exists()
 
 
 KERNEL = """
@@ -74,3 +80,21 @@ def test_a_vanished_cache_folder_costs_a_recompile_not_an_error(tmp_path):
     cache.rmdir()
     assert _run(cache) == 0
     assert _run(cache) == 1
+
+
+def test_a_cache_folder_pruned_while_a_kernel_saves_leaves_it_unsaved(tmp_path, monkeypatch):
+    """Another checkout's mark_compiled may remove this render's folder while a kernel compiles: the
+    kernel runs and is not saved (Numba alone raised FileNotFoundError mid-render)."""
+    cache = tmp_path / "kernels"
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(cache))
+
+    @jit.kernel
+    def quadruple(x):
+        return 4 * x
+
+    for f in sorted(cache.rglob("*"), reverse=True):
+        f.unlink() if f.is_file() else f.rmdir()
+    cache.rmdir()
+    cache.write_text("not a folder")  # so the save cannot make the folder again either
+    assert quadruple(10.5) == 42.0
+    assert cache.read_text() == "not a folder"

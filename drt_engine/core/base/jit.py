@@ -10,10 +10,11 @@ Numba checks a cached kernel against its own source file only, not against the f
 kernels it calls: a kernel cached before ``microfacet.py`` changed would be loaded stale. So
 the cache lives in a folder named by a fingerprint of all of DRT's core sources (every file
 under ``core/``, subpackages included), Numba and
-Python (``_fingerprint``); a changed source means a new folder. The newest few folders of one
-Python are kept (``KEEP``), so that two checkouts or extension versions sharing the user's cache
-folder do not wipe each other's kernels; a folder removed while a render loads from it costs a
-recompile, never an error (Numba treats a missing file as a cache miss).
+Python (``_fingerprint``); a changed source means a new folder. The most recently used folders of
+one Python are kept (``KEEP``; a folder being filled counts as used now), so that two checkouts or
+extension versions sharing the user's cache folder do not wipe each other's kernels; a file or
+folder removed while a render loads from it or saves into it costs a recompile, never an error
+(``_SharedFolderCache``).
 
 The cache's base folder must be chosen before the modules that define kernels are imported:
 the Blender layer calls ``use_cache_dir`` with the extension's user folder; the CLI and the
@@ -30,6 +31,7 @@ import sys
 from pathlib import Path
 
 import numba
+from numba.core.caching import FunctionCache
 
 _STAMP = "compiled"  # written into a cache folder once a render has filled it; touched by each render
 KEEP = 4
@@ -87,9 +89,33 @@ def kernel(fn=None, **options):
     """
     opts = {"cache": True, "nogil": True, "error_model": "numpy"}
     opts.update(options)
-    if fn is None:
-        return lambda f: numba.njit(**opts)(f)
-    return numba.njit(**opts)(fn)
+
+    def compile_(f):
+        dispatcher = numba.njit(**opts)(f)
+        if opts["cache"]:
+            dispatcher._cache = _SharedFolderCache(dispatcher.py_func)
+        return dispatcher
+
+    return compile_ if fn is None else compile_(fn)
+
+
+class _SharedFolderCache(FunctionCache):
+    """Numba's on-disk cache of one kernel, in a folder another process may prune at any moment
+    (``mark_compiled`` of another checkout): Numba itself tolerates a data file gone under its
+    index but raises when the folder goes while it saves (FileNotFoundError mid-render, seen with
+    two checkouts). Here any OSError while loading is a miss and while saving leaves it unsaved."""
+
+    def load_overload(self, sig, target_context):
+        try:
+            return super().load_overload(sig, target_context)
+        except OSError:
+            return None
+
+    def save_overload(self, sig, data):
+        try:
+            super().save_overload(sig, data)
+        except OSError:
+            pass
 
 
 def first_run() -> bool:
@@ -116,8 +142,13 @@ def mark_compiled() -> None:
 
 
 def _last_use(folder: Path) -> float:
-    """When a render last used ``folder`` (its stamp's time; a folder without one counts as oldest)."""
+    """When a render last used ``folder``: its stamp's time, or the latest change of the folder and
+    its per-package subfolders if later (Numba's writes land there, so a folder another process is
+    compiling into now, stamped only when that render ends, is not taken for an old one)."""
+    times = [0.0]
     try:
-        return (folder / _STAMP).stat().st_mtime
+        for path in (folder, *folder.iterdir()):
+            times.append(path.stat().st_mtime)
     except OSError:
-        return 0.0
+        pass
+    return max(times)
