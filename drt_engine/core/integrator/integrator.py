@@ -450,18 +450,23 @@ class Integrator:
                 yield g, group, shading.shader
                 continue
             groups, normal, tangent, smooth = shading.bind(self._context(group, hits, shadow))
+            facing_away = None  # the program's normals that wo lies below, where some do
             if normal is not None or tangent is not None:
                 ns, wo = group.ns, group.wo
                 if normal is not None:
-                    ng = group.ng
-                    ns = np.where((vec.dot(normal, ng) * vec.dot(wo, ng) > 0)[:, None], normal, ns)
-                    ns = np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
+                    ns = np.where((vec.dot(normal, group.ng) * vec.dot(wo, group.ng) > 0)[:, None], normal, ns)
+                    below = vec.dot(wo, ns) <= 1e-6
+                    if np.any(below):
+                        facing_away = ns
+                        ns = _raised_above(ns, group.ng, wo, below)
                 frame = Frame.about(ns) if tangent is None else Frame.along(ns, tangent)
                 if smooth is not None:
                     smooth = _smooth_rows(smooth, shading.material)
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo), smooth=smooth)
             for sub, shader in groups:
                 taken = group.take(sub)
+                if facing_away is not None and shader.lambertian and not shader.sampled:
+                    taken = _about(taken, facing_away[sub])
                 yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
 
     def _context(self, group: SurfaceHits, hits, shadow: bool = False) -> SurfaceContext:
@@ -583,6 +588,24 @@ def _smooth_rows(smooth, material) -> np.ndarray:
 def _smooth(hits) -> np.ndarray:
     """The smooth normals of ``hits`` whose shading normal a bump replaced, for the kernels."""
     return _NO_BUMP if hits.smooth is None else _c(hits.smooth)
+
+
+def _raised_above(ns, ng, wo, below):
+    """Program normals ``ns`` that ``wo`` lies below (``below``) raised as Cycles raises a specular
+    closure's (ensure_valid_specular_reflection, about ``ng`` facing wo), the geometric normal where
+    that still leaves wo below: one frame serves every lobe of a hit, and the glossy, glass and
+    wo-dependent diffuse lobes need wo above their normal."""
+    ns = np.where(below[:, None], valid_specular_reflection(ng, wo, ns), ns)
+    return np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
+
+
+def _about(hits: SurfaceHits, normal) -> SurfaceHits:
+    """``hits`` shaded about ``normal`` as it is, wo below it or not: a Lambert-only shader's
+    (Cycles keeps a diffuse closure's bumped normal even facing away from the viewer, and
+    Lambert's light does not depend on wo; raising it lit the rim of a bumped sphere 0.096 brighter
+    than Cycles in its worst block)."""
+    frame = Frame.about(normal)
+    return replace(hits, frame=frame, wo_l=frame.to_local(hits.wo))
 
 
 def _coat_turned(shader, hits: SurfaceHits):
