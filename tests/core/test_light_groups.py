@@ -72,3 +72,28 @@ def test_group_passes_leave_combined_as_it_was():
     with_groups = render(scene())["Combined"]
     without = render(scene(), passes=("Combined",))["Combined"]
     assert np.array_equal(with_groups, without)
+
+
+def test_group_passes_travel_through_parts_and_merge(tmp_path):
+    """A split render's parts carry the group passes; merged, they are the whole render's."""
+    from drt_engine.core.film import parts
+    from drt_engine.core.render import merge, report
+
+    def part(start, end):
+        data = scene()
+        settings = RenderSettings(samples=8, threads=1, max_depth=4, passes=PASSES, sample_start=start,
+                                  sample_end=end)
+        renderer = Renderer(data, settings)
+        result = renderer.render()
+        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data),
+                  "report": report.report_dict(settings, result.stats, result.log, report.scene_summary(data))}
+        return parts.from_film(renderer.film, settings, header), result
+
+    _, whole = part(0, 0)
+    for i, (a, b) in enumerate(((0, 3), (3, 8))):
+        parts.write(tmp_path / f"{i}.exr", part(a, b)[0])
+    merged = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).film.images()
+    for group in GROUPS:
+        name = lightgroup_pass(group)
+        np.testing.assert_allclose(merged[name], whole.passes[name], rtol=1e-5, atol=1e-7)
+    merge.write_exr(tmp_path / "merged.exr", merged, "ViewLayer")

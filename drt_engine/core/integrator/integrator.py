@@ -300,9 +300,10 @@ class Integrator:
         first bounce), None when nothing is clamped."""
         return row_limits(self.clamp, straight) if self.clamping else None
 
-    def _group(self, group: np.ndarray) -> np.ndarray | None:
-        """The wave's light group columns of emitters in scene light groups ``group`` (None: no groups)."""
-        return None if self.groups is None else self.groups.column(group)
+    def _group(self, group) -> np.ndarray | None:
+        """The wave's light group columns of the emitters in the scene light groups ``group()``
+        gives (None, and nothing asked of ``group``, without light groups)."""
+        return None if self.groups is None else self.groups.column(group())
 
     # -- what rays see ----------------------------------------------------------------
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
@@ -316,7 +317,7 @@ class Integrator:
             return self.lights.pdf(light_id[smooth], origins, rays.dirs[smooth], dist, rays.time[smooth])
 
         add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight),
-                    self._group(self.lights.light_group[light_id]))
+                    self._group(lambda: self.lights.light_group[light_id]))
 
     def _escaped(self, rays: PathState, out: WaveOutput):
         """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
@@ -340,7 +341,7 @@ class Integrator:
             sampled = None if lights.world is None else (  # a world light sampling can find
                 lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
             add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled, self._limits(rays.straight),
-                        self._group(np.full(len(rays), lights.world_group)))
+                        self._group(lambda: np.full(len(rays), lights.world_group)))
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             # with light groups, each group's suns apart (a sun's light goes to its group)
@@ -348,7 +349,7 @@ class Integrator:
                 sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group)
                 add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
                             lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
-                            None if group is None else self._group(np.full(len(bounced), group)))
+                            None if group is None else self._group(lambda: np.full(len(bounced), group)))
 
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
@@ -377,7 +378,7 @@ class Integrator:
             return self.lights.pdf_emissive(prim[smooth], origins, state.dirs[rows], dist)
 
         e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit], emissive_pdf,
-                        self._limits(surf.straight[glowing]), self._group(self.lights.group_of_triangles(prim)))
+                        self._limits(surf.straight[glowing]), self._group(lambda: self.lights.group_of_triangles(prim)))
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
