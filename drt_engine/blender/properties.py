@@ -13,7 +13,7 @@ from bpy.props import (
     PointerProperty,
 )
 
-from ..core.settings import NOISY_IMAGE, PASSES, RenderSettings, pass_channels
+from ..core.settings import NOISY_IMAGE, PASSES, RenderSettings, lightgroup_pass, pass_channels
 from .oidn import oidn_library
 
 BLENDER_PASS_TOGGLES = {
@@ -70,6 +70,17 @@ def view_layer_aovs(view_layer) -> tuple[tuple[str, str], ...]:
     return tuple((aov.name, aov.type) for aov in getattr(view_layer, "aovs", ()) if aov.is_valid)
 
 
+def view_layer_lightgroups(view_layer) -> tuple[str, ...]:
+    """The view layer's light groups' names (Cycles writes a pass ``Combined_<name>`` for each)."""
+    return tuple(group.name for group in getattr(view_layer, "lightgroups", ()))
+
+
+def lightgroup_of(idblock, groups: dict) -> int:
+    """The index among the view layer's light groups ``groups`` (name -> index) of the object's or
+    world's light group, -1 for none or a name the view layer has no group of (as Cycles)."""
+    return groups.get(getattr(idblock, "lightgroup", "") or "", -1) if idblock is not None else -1
+
+
 def denoising_active(scene) -> bool:
     """Whether final renders of ``scene`` are denoised: asked for, and this Blender has OIDN."""
     return bool(scene.drt.use_denoising) and oidn_library() is not None
@@ -78,7 +89,12 @@ def denoising_active(scene) -> bool:
 def registered_passes(scene, view_layer) -> tuple[str, ...]:
     """The passes a render of this view layer writes: the enabled ones, and Noisy Image when denoising."""
     extra = (NOISY_IMAGE,) if scene is not None and denoising_active(scene) else ()
-    return enabled_passes(view_layer) + tuple(name for name, _ in view_layer_aovs(view_layer)) + extra
+    return enabled_passes(view_layer) + tuple(name for name, _ in view_layer_aovs(view_layer)) + \
+        _lightgroup_passes(view_layer) + extra
+
+
+def _lightgroup_passes(view_layer) -> tuple[str, ...]:
+    return tuple(dict.fromkeys(lightgroup_pass(name) for name in view_layer_lightgroups(view_layer)))
 
 
 def pass_layout(name: str, aovs=()) -> tuple[int, str, str]:
@@ -107,7 +123,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         threads=drt.threads,
         filter_type=drt.filter_type,
         filter_size=scene.render.filter_size,
-        passes=enabled_passes(view_layer),
+        passes=enabled_passes(view_layer) + _lightgroup_passes(view_layer),
         aovs=view_layer_aovs(view_layer),
         use_adaptive_sampling=drt.use_adaptive_sampling,
         adaptive_threshold=drt.adaptive_threshold,

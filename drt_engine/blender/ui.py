@@ -323,6 +323,59 @@ class DRT_PT_passes_aov(DRTButtonsPanel, bpy.types.Panel):
             self.layout.label(text="Conflicts with another render pass with the same name", icon="ERROR")
 
 
+class DRT_PT_passes_lightgroups(DRTButtonsPanel, bpy.types.Panel):
+    """The view layer's light groups: a pass Combined_<group> each (as Cycles' panel)."""
+
+    bl_label = "Light Groups"
+    bl_context = "view_layer"
+    bl_parent_id = "DRT_PT_passes"
+
+    def draw(self, context):
+        view_layer = context.view_layer
+        row = split(self.layout).row()
+        row.template_list("UI_UL_list", "lightgroups", view_layer, "lightgroups", view_layer,
+                          "active_lightgroup_index", rows=3)
+        buttons = row.column(align=True)
+        buttons.operator("scene.view_layer_add_lightgroup", icon="ADD", text="")
+        buttons.operator("scene.view_layer_remove_lightgroup", icon="REMOVE", text="")
+
+
+def _lightgroup_field(layout, idblock, view_layer) -> None:
+    """An object's or world's Light Group, chosen among the view layer's (a new name can be added)."""
+    row = split(layout).row(align=True)
+    row.prop_search(idblock, "lightgroup", view_layer, "lightgroups", text="Light Group",
+                    results_are_suggestions=True)
+    add = row.column(align=True)
+    add.enabled = bool(idblock.lightgroup) and idblock.lightgroup not in view_layer.lightgroups
+    add.operator("scene.view_layer_add_lightgroup", icon="ADD", text="").name = idblock.lightgroup
+
+
+class DRT_PT_object_lightgroup(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Light Group"
+    bl_context = "object"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.object is not None
+
+    def draw(self, context):
+        _lightgroup_field(self.layout, context.object, context.view_layer)
+
+
+class DRT_PT_world_lightgroup(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Light Group"
+    bl_context = "world"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.world is not None
+
+    def draw(self, context):
+        _lightgroup_field(self.layout, context.world, context.view_layer)
+
+
 PRESET_CLASSES = (DRT_OT_light_paths_preset, DRT_MT_light_paths_presets)
 """The Light Paths panel's preset menu and what it runs."""
 
@@ -339,6 +392,9 @@ classes = (
     DRT_PT_performance,
     DRT_PT_passes,
     DRT_PT_passes_aov,
+    DRT_PT_passes_lightgroups,
+    DRT_PT_object_lightgroup,
+    DRT_PT_world_lightgroup,
 )
 
 

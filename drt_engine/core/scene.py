@@ -248,6 +248,8 @@ class Instance:
     visible_transmission: bool = True
     """Blender's ray visibility: the ray kinds that see the object (the others pass through it, and
     an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
+    lightgroup: int = -1
+    """The light group its emission counts to (an index into ``SceneData.light_groups``; -1: none)."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
@@ -306,6 +308,8 @@ class Light:
     """(S, 4, 4) light-to-world transforms at S evenly spaced shutter times for a light
     that moves (scale removed, like ``matrix``), else None."""
     name: str = ""
+    lightgroup: int = -1
+    """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:
@@ -355,6 +359,8 @@ class World:
     """The world's mist settings as Cycles reads them: the Mist pass ramps from 0 at ``mist_start``
     to 1 at ``mist_start + mist_depth`` from the camera, raised to ``mist_falloff`` (quadratic 2,
     linear 1, inverse quadratic 0.5). The defaults are Cycles' film's, what it uses without a world."""
+    lightgroup: int = -1
+    """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
 
     @property
     def visible_lighting(self) -> bool:
@@ -464,6 +470,9 @@ class SceneData:
     """Images the programs' "image" nodes index."""
     warnings: list[str] = field(default_factory=list)
     """Messages for the user gathered during export (unsupported nodes and the like)."""
+    light_groups: list[str] = field(default_factory=list)
+    """The view layer's light groups (Cycles'): each has a pass ``Combined_<name>`` of the light its
+    emitters (lights, emissive objects, the world: their ``lightgroup``) give to Combined."""
 
     def triangle_count(self) -> int:
         return sum(len(self.meshes[i.mesh].triangles) for i in self.instances)

@@ -55,10 +55,25 @@ AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 writes: 1 per sample whose camera path wrote the AOV)."""
 
 
+LIGHTGROUP_PREFIX = "Combined_"
+"""A light group's pass is ``Combined_<group>``, RGB, as Cycles names and registers it: the share of
+Combined its emitters give (core.integrator.lightgroups)."""
+
+
+def lightgroup_pass(group: str) -> str:
+    """The pass of light group ``group``."""
+    return LIGHTGROUP_PREFIX + group
+
+
 def pass_channels(name: str, aovs=()) -> str:
-    """The channel ids of pass ``name``: a built-in pass's, or of one of the shader AOVs ``aovs``
-    ((name, type) pairs, ``RenderSettings.aovs``)."""
-    return PASS_CHANNELS.get(name) or AOV_CHANNELS[dict(aovs)[name]]
+    """The channel ids of pass ``name``: a built-in pass's, a light group's, or of one of the shader
+    AOVs ``aovs`` ((name, type) pairs, ``RenderSettings.aovs``)."""
+    if name in PASS_CHANNELS:
+        return PASS_CHANNELS[name]
+    aov = dict(aovs).get(name)
+    if aov is None and name.startswith(LIGHTGROUP_PREFIX):
+        return "RGB"
+    return AOV_CHANNELS[aov]
 
 
 NOISY_IMAGE = "Noisy Image"
@@ -152,7 +167,8 @@ class RenderSettings:
             raise ValueError("samples must be at least 1")
         self.aovs = tuple((str(name), str(kind)) for name, kind in self.aovs)
         self._check_aovs()
-        unknown = set(self.passes) - set(PASSES) - {name for name, _ in self.aovs}
+        unknown = {name for name in set(self.passes) - set(PASSES) - {name for name, _ in self.aovs}
+                   if not name.startswith(LIGHTGROUP_PREFIX)}
         if unknown:
             raise ValueError(f"unknown passes {sorted(unknown)}")
         self.passes = tuple(self.passes) + tuple(name for name, _ in self.aovs if name not in self.passes)

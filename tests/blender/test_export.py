@@ -932,25 +932,46 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
 
 
 def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Shadow catcher, light linking and light groups change Cycles' image; until DRT reads them,
-    a scene using them says so (objects named, a long list cut short)."""
+    """Shadow catcher and light linking change Cycles' image; until DRT reads them, a scene using
+    them says so (objects named, a long list cut short). Light groups are read: not named."""
     scene = empty_scene()
     cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
     for cube in cubes[:5]:
+        cube.is_shadow_catcher = True
         cube.lightgroup = "key"
-    cubes[1].is_shadow_catcher = True
     cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
     data = render_export(scene)
     (warning,) = data.warnings
-    for expected in ("light group ('Cube0', 'Cube1', 'Cube2' and 2 more)", "shadow catcher ('Cube1')",
-                     "light or shadow linking ('Cube3')"):
+    for expected in ("shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)", "light or shadow linking ('Cube3')"):
         assert expected in warning, warning
     assert "Cube5" not in warning and "visibility" not in warning and "holdout" not in warning
+    assert "light group" not in warning
     for cube in cubes[:5]:
-        cube.lightgroup = ""
-    cubes[1].is_shadow_catcher = False
+        cube.is_shadow_catcher = False
     cubes[3].light_linking.receiver_collection = None
     assert not render_export(scene).warnings
+
+
+def test_light_groups_are_exported():
+    """The view layer's light groups, and each object's, light's and the world's group as an index
+    among them (-1: none, or a name the view layer has no group of, as Cycles)."""
+    scene = empty_scene()
+    layer = scene.view_layers[0]
+    for name in ("key", "fill"):
+        layer.lightgroups.add(name=name)
+    cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(3)]
+    cubes[0].lightgroup, cubes[1].lightgroup = "fill", "elsewhere"
+    lamp = add_object(scene, "Lamp", bpy.data.lights.new("Lamp", "POINT"), (0.0, 0.0, 3.0))
+    lamp.lightgroup = "key"
+    scene.world = bpy.data.worlds.new("World")
+    scene.world.lightgroup = "fill"
+    data = render_export(scene)
+    assert data.light_groups == ["key", "fill"]
+    groups = {i.name: i.lightgroup for i in data.instances}
+    assert groups == {"Cube0": 1, "Cube1": -1, "Cube2": -1}
+    assert [light.lightgroup for light in data.lights] == [0]
+    assert data.world.lightgroup == 1
+    assert not data.warnings
 
 
 def test_ray_visibility_and_cast_shadow_are_exported():

@@ -179,12 +179,17 @@ class RecordingLayout:
         self.prop(data, name)
         self.prop(active_data, active_name)
 
+    def prop_search(self, data, name, search_data, search_name, **kwargs):
+        self.prop(data, name)
+        self.prop(search_data, search_name)
+
     def template_curve_mapping(self, data, name, **kwargs):
         self.prop(data, name)
 
     def operator(self, idname, **kwargs):
         module, name = idname.split(".")
         assert name in dir(getattr(bpy.ops, module)), f"no operator {idname}"
+        return SimpleNamespace()  # its properties, which a panel may set
 
     def separator(self, **kwargs):
         pass
@@ -198,7 +203,8 @@ def test_drt_panels_draw_existing_properties(drt):
     scene = bpy.context.scene
     camera = bpy.data.cameras.new("Panorama")
     camera.type = "PANO"
-    context = SimpleNamespace(scene=scene, view_layer=scene.view_layers[0], engine="DRT", camera=camera)
+    context = SimpleNamespace(scene=scene, view_layer=scene.view_layers[0], engine="DRT", camera=camera,
+                              object=bpy.data.objects.new("Empty", None), world=bpy.data.worlds.new("World"))
     drawn = set()
     for panel in ui.classes:
         assert panel.poll(context)
@@ -210,6 +216,7 @@ def test_drt_panels_draw_existing_properties(drt):
     assert scene_settings <= drawn
     assert set(properties.BLENDER_PASS_TOGGLES.values()) | set(properties.DRT_PASS_TOGGLES.values()) <= drawn
     assert "aovs" in drawn  # the Shader AOV list
+    assert {"lightgroups", "lightgroup"} <= drawn  # the Light Groups list, an object's and the world's group
     assert {"use_motion_blur", "motion_blur_shutter", "motion_blur_position", "filter_size",
             "film_transparent", "panorama_type", "motion_blur_shutter_curve", "rolling_shutter_type"} <= drawn
     for panorama, settings in ui.PANORAMA_SETTINGS.items():  # each type's settings are the camera's

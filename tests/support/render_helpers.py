@@ -106,7 +106,7 @@ def configure_drt(scene, samples: int, seed: int) -> None:
 
 def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name="render") -> Render:
     """Render ``scene`` with ``engine`` ('DRT' or 'CYCLES') to a multilayer EXR and read it back, with
-    the view layer's shader AOVs (by name, channels as Cycles registers them)."""
+    the view layer's shader AOVs and light groups (by name, channels as Cycles registers them)."""
     if engine == "CYCLES":
         configure_cycles(scene, samples, seed)
     else:
@@ -128,6 +128,9 @@ def render(scene, engine: str, samples: int, seed: int, out_dir, passes=(), name
         images[pass_name] = _pass(channels, view_layer.name, pass_name, PASS_TOGGLES[pass_name][1])
     for aov in view_layer.aovs:
         images[aov.name] = _pass(channels, view_layer.name, aov.name, "RGBA" if aov.type == "COLOR" else "X")
+    for group in view_layer.lightgroups:  # Cycles' light group passes, Combined_<group> (RGB)
+        name = f"Combined_{group.name}"
+        images[name] = _pass(channels, view_layer.name, name, "RGB")
     return Render(images, seconds, samples)
 
 

@@ -7,11 +7,13 @@ is disabled for render or excluded from the view layer.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
 from ...core.errors import RenderCancelled
 from ...core.scene import SceneData
+from ..properties import lightgroup_of, view_layer_lightgroups
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
 from .left_out import LeftOut
@@ -47,7 +49,10 @@ def export_scene(
     warnings: list[str] = []
     images = ImageTable(warnings)
     materials = MaterialTable(warnings, images, (scene, depsgraph.view_layer))
-    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes, depsgraph.view_layer_eval)
+    light_groups = view_layer_lightgroups(depsgraph.view_layer)
+    group_of = {name: i for i, name in enumerate(light_groups)}
+    geometry = GeometryExporter(materials, depsgraph.view_layer.material_override, meshes, depsgraph.view_layer_eval,
+                                group_of)
     lights = []
     light_keys = []
     left_out = LeftOut(depsgraph.mode == "RENDER")
@@ -62,6 +67,7 @@ def export_scene(
         if obj.type == "LIGHT":
             light = export_light(obj, matrix, warnings)
             if light is not None:
+                light.lightgroup = lightgroup_of(obj, group_of)
                 lights.append(light)
                 light_keys.append(instance_key(instance))
         elif rendered:
@@ -69,7 +75,6 @@ def export_scene(
                          instance.random_id if instance.is_instance else None)
     geometry.finish()
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
-    left_out.look_at_world(world)
     warnings.extend(left_out.warnings())
     scene_data = SceneData(
         camera=camera,
@@ -77,10 +82,12 @@ def export_scene(
         instances=geometry.instances,
         materials=materials.materials,
         lights=lights,
-        world=export_world(world, warnings, images, depsgraph.view_layer),
+        world=replace(export_world(world, warnings, images, depsgraph.view_layer),
+                      lightgroup=lightgroup_of(world, group_of)),
         images=images.images,
         film_transparent=scene.render.film_transparent,
         warnings=warnings,
+        light_groups=list(light_groups),
     )
     if frame_set is not None:
         add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)

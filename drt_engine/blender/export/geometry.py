@@ -18,6 +18,7 @@ import numpy as np
 
 from ...core.scene import Instance, Mesh
 from ...core.shading.proctex.hash import hash_uint, hash_uint2, to_unit
+from ..properties import lightgroup_of
 from .materials import MaterialTable
 from .shader_graph import ISLANDS, POINTINESS, find_rgba
 
@@ -317,9 +318,10 @@ class GeometryExporter:
     """
 
     def __init__(self, materials: MaterialTable, material_override=None, cache: MeshCache | None = None,
-                 view_layer=None):
+                 view_layer=None, light_groups: dict | None = None):
         self.materials = materials
         self.view_layer = view_layer  # whose holdout collections make their objects holdouts
+        self.light_groups = light_groups or {}  # the view layer's light groups, name -> index
         self.cache = cache
         self.material_override = material_override
         self.meshes: list[Mesh] = []
@@ -393,7 +395,9 @@ class GeometryExporter:
             self.instances.append(Instance(mesh=index, matrices=matrix[None], name=obj.name,
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
                                            color=tuple(obj.color), pass_index=obj.pass_index, random=random,
-                                           holdout=self._holdout(parent or obj), **ray_visibility(obj, parent)))
+                                           holdout=self._holdout(parent or obj),
+                                           lightgroup=lightgroup_of(obj, self.light_groups),
+                                           **ray_visibility(obj, parent)))
             self.keys.append(key)
 
     def _holdout(self, obj) -> bool:

@@ -49,12 +49,6 @@ class LeftOut:
         linking = getattr(obj, "light_linking", None)  # Blender 4.0+
         if linking is not None and (linking.receiver_collection is not None or linking.blocker_collection is not None):
             self._add("light or shadow linking", name)
-        if getattr(obj, "lightgroup", ""):
-            self._add("light group", name)
-
-    def look_at_world(self, world) -> None:
-        if world is not None and getattr(world, "lightgroup", ""):
-            self._add("light group", f"world '{world.name}'")
 
     def _shows_hair(self, obj) -> bool:
         """Whether the object shows hair particles as strands (Cycles renders them as curves)."""

@@ -76,7 +76,8 @@ def unlit_parts(restrict, k):
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path,
                  limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
-                 exclude, scene, center, shadow_mask, times, radiance, f_diff, visibility, cuts, clear, allowed, qf, qi):
+                 exclude, group, scene, center, shadow_mask, times, radiance, grouped, f_diff, visibility, cuts, clear,
+                 allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
     ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 
@@ -92,7 +93,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
     Light samples, strategy by hit: direction, distance, value (radiance / pdf), pdf, distance
     to stop short of an emitter that is geometry, the BSDF parts each strategy lights
     (``restrict``) and what each sample's light leaves out (``exclude``, lights.strategies: BSDF
-    parts, and its shadow ray with NO_SHADOW; empty: nothing). Shadow rays see the objects whose
+    parts, and its shadow ray with NO_SHADOW; empty: nothing) and each sample's light group
+    (``group``; empty: no light groups): what gets through is added to ``grouped[path[j], group]``
+    as well (core.integrator.lightgroups; no group: -1). Shadow rays see the objects whose
     Embree mask shares a bit with ``shadow_mask``. ``times``: each hit's shutter time (empty when
     nothing moves).
     ``f_diff``, ``visibility`` and ``cuts`` (strategy by hit) are filled when they have rows (the
@@ -110,6 +113,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
     keep = f_diff.shape[1] > 0
     see_through = len(clear) > 0
     excluding = exclude.size > 0
+    grouping = group.size > 0
     traced = queued = 0
     for j in range(len(pos)):
         bits = diffuse_bits(bounces, j, diffuse_limit)
@@ -164,7 +168,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
                 hidden = what != OPEN
                 if what == SEE_THROUGH and allowed[j] > 0:
                     enqueue(qf, qi, queued, c0, c1, c2, ox, oy, oz, wx, wy, wz, tmax, time, hu, hv, t, path[j], hit,
-                            j, 0, allowed[j])
+                            j, 0, allowed[j], group[k, j] if grouping else -1)
                     queued += 1
             else:
                 traced += 1
@@ -180,6 +184,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
                 s0 += c0
                 s1 += c1
                 s2 += c2
+                if grouping and group[k, j] >= 0:
+                    g = group[k, j]
+                    grouped[path[j], g, 0] += c0
+                    grouped[path[j], g, 1] += c1
+                    grouped[path[j], g, 2] += c2
         p = path[j]
         radiance[p, 0] += s0
         radiance[p, 1] += s1

@@ -32,7 +32,7 @@ from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
-from ..settings import AOV_CHANNELS
+from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
@@ -42,6 +42,7 @@ from .continuation import continue_paths
 from .direct import direct_light
 from .hits import surface_records
 from .holdout import Holdouts
+from .lightgroups import NO_GROUPS, light_groups
 from .masks import ray_masks
 from .mis import add_emitted
 from .ratio import RatioEstimator
@@ -102,6 +103,9 @@ class WaveOutput:
     # throughput's (core.integrator.aovs)
     aov_reach: np.ndarray | None = None
     ratio: RatioEstimator | None = None
+    # per path, with light groups: each group's share of the radiance (core.integrator.lightgroups)
+    grouped: np.ndarray | None = None
+    group_names: tuple = ()
 
     def values(self) -> dict:
         radiance, ratio = self.radiance, None if self.ratio is None else self.ratio.ndu
@@ -109,6 +113,8 @@ class WaveOutput:
         if ratio is not None:
             out_ratio = np.where((finite.all(axis=1) & np.isfinite(ratio).all(axis=1))[:, None], ratio, 0.0)
         radiance = np.where(finite, radiance, 0.0)
+        for column, name in enumerate(self.group_names):  # a path Combined drops, its groups drop too
+            self.aux[name] = np.where(finite, self.grouped[:, column], 0.0)
         out = {"Combined": np.concatenate([radiance, np.clip(self.alpha, 0.0, 1.0)[:, None]], axis=1)}
         if ratio is not None:
             out[RATIO] = out_ratio
@@ -163,6 +169,9 @@ class Integrator:
         held = np.array([i.holdout for i in scene.instances], bool)
         self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
             m.shader.holds_out for m in prepared.shading) else None
+        self.groups = light_groups(scene, self.lights, settings.passes)  # None: no group to fill
+        self.group_passes = [name for name in settings.passes if name.startswith(LIGHTGROUP_PREFIX)
+                             and name not in dict(settings.aovs)]
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
         self._rays_lock = threading.Lock()
 
@@ -179,8 +188,11 @@ class Integrator:
         n = len(state)
         aux = {name: np.zeros((n, len(ch))) for name, ch in _AUX if name in s.passes}
         aux.update((name, np.zeros((n, len(AOV_CHANNELS[kind])))) for name, kind in s.aovs)
+        aux.update((name, np.zeros((n, 3))) for name in self.group_passes)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
+        if self.groups is not None:
+            out.grouped, out.group_names = self.groups.new(n), tuple(self.groups.names)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
@@ -254,7 +266,8 @@ class Integrator:
                     if nxt is not None:
                         continued.append(nxt)
             if queued:
-                self.shadows.resolve(ShadowRays.concat(queued), out.radiance, self.timed)
+                self.shadows.resolve(ShadowRays.concat(queued), out.radiance,
+                                     NO_GROUPS if out.grouped is None else out.grouped, self.timed)
             if not continued:
                 break
             state = PathState.concat(continued)
@@ -287,6 +300,11 @@ class Integrator:
         first bounce), None when nothing is clamped."""
         return row_limits(self.clamp, straight) if self.clamping else None
 
+    def _group(self, group) -> np.ndarray | None:
+        """The wave's light group columns of the emitters in the scene light groups ``group()``
+        gives (None, and nothing asked of ``group``, without light groups)."""
+        return None if self.groups is None else self.groups.column(group())
+
     # -- what rays see ----------------------------------------------------------------
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
         """Lights hit directly: always by reflected and refracted rays, by the camera if asked; the
@@ -298,7 +316,8 @@ class Integrator:
             origins, dist = rays.mis_ray(smooth, t[smooth])
             return self.lights.pdf(light_id[smooth], origins, rays.dirs[smooth], dist, rays.time[smooth])
 
-        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight))
+        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight),
+                    self._group(lambda: self.lights.light_group[light_id]))
 
     def _escaped(self, rays: PathState, out: WaveOutput):
         """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
@@ -321,12 +340,16 @@ class Integrator:
         if len(rays) and lights.world_seen:
             sampled = None if lights.world is None else (  # a world light sampling can find
                 lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
-            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled, self._limits(rays.straight))
+            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled, self._limits(rays.straight),
+                        self._group(lambda: np.full(len(rays), lights.world_group)))
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
-            sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time)
-            add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf, lambda smooth: pdf_sun[smooth],
-                        self._limits(bounced.straight))
+            # with light groups, each group's suns apart (a sun's light goes to its group)
+            for group in [None] if self.groups is None else np.unique(lights.light_group):
+                sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group)
+                add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
+                            lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
+                            None if group is None else self._group(lambda: np.full(len(bounced), group)))
 
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
@@ -355,7 +378,7 @@ class Integrator:
             return self.lights.pdf_emissive(prim[smooth], origins, state.dirs[rows], dist)
 
         e = add_emitted(out, surf.path[glowing], surf.throughput[glowing], emission, state.prev_pdf[hit], emissive_pdf,
-                        self._limits(surf.straight[glowing]))
+                        self._limits(surf.straight[glowing]), self._group(lambda: self.lights.group_of_triangles(prim)))
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
@@ -494,10 +517,14 @@ class Integrator:
             return arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
 
         hits = [group for group, _ in lit]
-        return self.lights.sample_all(joined([h.pos for h in hits]), joined([h.ns for h in hits]),
-                                      joined([u.light for _, u in lit]),
-                                      joined([h.time for h in hits]) if self.timed else None,
-                                      joined([h.bounces for h in hits]) if self.light_path else None)
+        out = self.lights.sample_all(joined([h.pos for h in hits]), joined([h.ns for h in hits]),
+                                     joined([u.light for _, u in lit]),
+                                     joined([h.time for h in hits]) if self.timed else None,
+                                     joined([h.bounces for h in hits]) if self.light_path else None,
+                                     groups=self.groups is not None)
+        if self.groups is not None:
+            out.group = self.groups.column(out.group)
+        return out
 
     def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, continues: bool):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
@@ -527,7 +554,8 @@ class Integrator:
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
-            wave.radiance, f_diff, visibility, cuts, clear, allowed, qf, qi)
+            wave.radiance, NO_GROUPS if wave.grouped is None else wave.grouped, f_diff, visibility, cuts, clear,
+            allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility, cuts)

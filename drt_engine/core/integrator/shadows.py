@@ -29,10 +29,10 @@ from .records import ShadowRays
 
 OPEN, OPAQUE, SEE_THROUGH = 0, 1, 2
 """What a shadow ray meets first: nothing, a surface that blocks it, a surface that may not."""
-QF, QI = 14, 5
+QF, QI = 14, 6
 """Columns of a queue's float rows (contribution RGB, origin, direction, distance left, time,
 u, v, length from the shaded point) and int rows (path, triangle, the row of its paths' depths in
-the batch that queued it, surfaces passed, surfaces allowed)."""
+the batch that queued it, surfaces passed, surfaces allowed, light group or -1)."""
 _FAR = np.float32(3.0e38)
 
 
@@ -63,20 +63,21 @@ def first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tm
 
 @kernel(inline="always")
 def enqueue(qf, qi, m, c0, c1, c2, ox, oy, oz, dx, dy, dz, tmax, time, u, v, length, path, prim, hit, passed,
-            allowed):
+            allowed, group):
     """Row m of a queue: a shadow ray stopped on a see-through surface (QF, QI)."""
     qf[m, 0], qf[m, 1], qf[m, 2] = c0, c1, c2
     qf[m, 3], qf[m, 4], qf[m, 5] = ox, oy, oz
     qf[m, 6], qf[m, 7], qf[m, 8] = dx, dy, dz
     qf[m, 9], qf[m, 10], qf[m, 11], qf[m, 12], qf[m, 13] = tmax, time, u, v, length
-    qi[m, 0], qi[m, 1], qi[m, 2], qi[m, 3], qi[m, 4] = path, prim, hit, passed, allowed
+    qi[m, 0], qi[m, 1], qi[m, 2], qi[m, 3], qi[m, 4], qi[m, 5] = path, prim, hit, passed, allowed, group
 
 
 @kernel
-def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radiance, out_f, out_i):
+def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radiance, grouped, out_f, out_i):
     """Sends each queued ray (``mask``: the shadow rays' Embree mask) (its contribution already attenuated by its surface) on from the far
     side of the surface at ``pos`` (geometric normal ``ng`` facing the ray, offset ``scale``):
-    open, its contribution goes to ``radiance``, clamped to ``limit[r]`` (core.integrator.clamp);
+    open, its contribution goes to ``radiance``, clamped to ``limit[r]`` (core.integrator.clamp), and
+    to its light group's in ``grouped`` (empty: no light groups);
     opaque, or see-through past its allowed count, nothing; see-through within it, queued again in
     ``out``. Returns (rays traced, rows queued)."""
     rayhit = embree.new_rayhit()
@@ -96,9 +97,14 @@ def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radianc
             radiance[p, 0] += c0
             radiance[p, 1] += c1
             radiance[p, 2] += c2
+            g = qi[r, 5]
+            if len(grouped) and g >= 0:
+                grouped[p, g, 0] += c0
+                grouped[p, g, 1] += c1
+                grouped[p, g, 2] += c2
         elif what == SEE_THROUGH and qi[r, 3] + 1 < qi[r, 4]:
             enqueue(out_f, out_i, m, qf[r, 0], qf[r, 1], qf[r, 2], ox, oy, oz, dx, dy, dz, tmax, qf[r, 10], u, v,
-                    qf[r, 13] + along + t, qi[r, 0], prim, r, qi[r, 3] + 1, qi[r, 4])
+                    qf[r, 13] + along + t, qi[r, 0], prim, r, qi[r, 3] + 1, qi[r, 4], qi[r, 5])
             m += 1
     return len(qf), m
 
@@ -124,8 +130,9 @@ class TransparentShadows:
     def __init__(self, geometry, clear: np.ndarray, bind, count, clamp):
         self.geometry, self.clear, self.bind, self.count, self.clamp = geometry, clear, bind, count, clamp
 
-    def resolve(self, rays: ShadowRays, radiance: np.ndarray, timed: bool):
-        """Every queued ray taken through its surfaces until it is blocked or gets through."""
+    def resolve(self, rays: ShadowRays, radiance: np.ndarray, grouped: np.ndarray, timed: bool):
+        """Every queued ray taken through its surfaces until it is blocked or gets through (what
+        gets through added to ``radiance`` and its light group's in ``grouped``, empty: none)."""
         geo = self.geometry
         while len(rays):
             n = len(rays)
@@ -153,6 +160,7 @@ class TransparentShadows:
             traced, m = pass_through(geo.handle, geo.tables, self.clear, geo.shadow_mask, qf,
                                      np.ascontiguousarray(i[go]),
                                      surf.pos[go], surf.ng[go], surf.scale[go],
-                                     row_limits(self.clamp, rays.bounces[go, DEPTH] == 0), radiance, out_f, out_i)
+                                     row_limits(self.clamp, rays.bounces[go, DEPTH] == 0), radiance, grouped,
+                                     out_f, out_i)
             self.count("shadow", traced)
             rays = ShadowRays(out_f[:m], out_i[:m], rays.bounces[go][out_i[:m, 2]])

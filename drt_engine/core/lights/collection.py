@@ -109,6 +109,7 @@ class Lights:
         self.attributes = SurfaceAttributes(scene, geometry) if self.textured else None
         self._emitters(geometry, scene)
         self._excludes(scene, geometry)
+        self._groups(scene, geometry)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
@@ -183,6 +184,32 @@ class Lights:
         self.emissive_exclude = np.array([unlit(scene.instances[k]) for k in sources], np.int8)
         self.excluding = bool(self.light_exclude.any() or self.emissive_exclude.any())
 
+    def _groups(self, scene: SceneData, geometry) -> None:
+        """Each emitter's light group (an index into ``scene.light_groups``, -1: none): per light
+        (``light_group``), per instance (``instance_group``, its emissive triangles'), the world's."""
+        self.light_group = np.array([light.lightgroup for light in self.lights], np.int64)
+        self.instance_group = np.array([i.lightgroup for i in scene.instances], np.int64)
+        self.world_group = int(scene.world.lightgroup)
+        self.grouped = bool(scene.light_groups) and bool(
+            (self.light_group >= 0).any() or (self.instance_group >= 0).any() or self.world_group >= 0)
+        """Some emitter is in a light group."""
+
+    def group_of_triangles(self, prim: np.ndarray) -> np.ndarray:
+        """The light group of the emissive triangles ``prim`` (their objects')."""
+        if len(prim) == 0:
+            return np.zeros(0, np.int64)
+        return self.instance_group[self.geometry.source_of(prim)[:, 0]]
+
+    def _sample_groups(self, pick) -> np.ndarray:
+        """The light group of each strategy's sample whose light or triangle is ``pick`` (strategy by hit)."""
+        out = np.full(pick.shape, self.world_group, np.int64)  # the world's strategy is the last
+        slots = self.light_slots
+        if slots:
+            out[:slots] = self.light_group[pick[:slots]]
+        if len(self.emissive):
+            out[slots] = self.group_of_triangles(pick[slots])
+        return out
+
     @property
     def moving(self) -> bool:
         return bool(self.motions)
@@ -238,14 +265,15 @@ class Lights:
 
     # -- next-event estimation ----------------------------------------------------
     def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None,
-                   bounces: np.ndarray | None = None) -> LightSamples:
+                   bounces: np.ndarray | None = None, groups: bool = False) -> LightSamples:
         """Every strategy at shading points ``pos`` in one kernel call (lights.strategies);
         ``normal`` faces the incoming ray (the world is sampled about it); ``u`` (N, S, 2, 2): per
         strategy the point and the choice. With many lights, strategies below ``light_slots``
         each pick one light per point by estimated contribution and divide by the chance of that
         pick. Moving lights are sampled again in their own frames at ``time``; textured emission
         and the environment's radiance come from their shader programs, which see the points'
-        paths' ``bounces`` as light samples do (core.shading.lightpath)."""
+        paths' ``bounces`` as light samples do (core.shading.lightpath). With ``groups``, each
+        sample's light group (``LightSamples.group``)."""
         n, strategies = len(pos), self.strategies
         pos, normal, u = (np.ascontiguousarray(a, np.float64) for a in (pos, normal, u))
         out = LightSamples.empty(strategies, n)
@@ -278,6 +306,8 @@ class Lights:
                 out.restrict[w] = self.world_lobes
         if self.excluding:
             out.exclude = self._sample_excludes(pick)
+        if groups:
+            out.group = self._sample_groups(pick)
         return out
 
     def _sample_excludes(self, pick) -> np.ndarray:
@@ -359,14 +389,19 @@ class Lights:
                 pdf[k] = _pdf_batch(table, self.table, ids[k], slots, o, d, t[k], origins[k])
         return pdf
 
-    def suns_seen(self, origins, dirs, time=None):
-        """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs."""
+    def suns_seen(self, origins, dirs, time=None, group=None):
+        """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs (with
+        ``group``, of the suns in that light group alone)."""
         radiance = np.zeros((len(dirs), 3))
         pdf = np.zeros(len(dirs))
         slots = self.light_slots if self.selecting else 0
-        if len(self._fixed_suns):
-            _suns_batch(self.table, self.table, self._fixed_suns, slots, origins, dirs, radiance, pdf)
-        for i in self._moving_suns:
+        fixed, moving = self._fixed_suns, self._moving_suns
+        if group is not None:
+            fixed = fixed[self.light_group[fixed] == group]
+            moving = [i for i in moving if self.light_group[i] == group]
+        if len(fixed):
+            _suns_batch(self.table, self.table, fixed, slots, origins, dirs, radiance, pdf)
+        for i in moving:
             table, _, d, _ = self._frame(i, origins, dirs, time)
             _suns_batch(table, self.table, np.array([i], np.int64), slots, origins, d, radiance, pdf)
         return radiance, pdf

@@ -27,6 +27,7 @@ NO_SHADOW = 8
 """A bit of ``LightSamples.exclude`` beside bsdf.mixture's ``UNLIT_*``: the sample's light casts no
 shadow (Cycles' Cast Shadow off), its shadow ray is not traced."""
 _NOTHING_EXCLUDED = np.zeros((0, 0), np.int8)
+_NO_GROUPS = np.zeros((0, 0), np.int64)
 
 
 @dataclass
@@ -36,7 +37,8 @@ class LightSamples:
     distance to stop short of an emitter that is geometry, per strategy the BSDF parts it
     lights (core.integrator.direct's ``restrict``) and per sample what its light leaves out
     (``exclude``: bsdf.mixture's ``UNLIT_*`` bits and ``NO_SHADOW``, from the ray visibility of
-    the light or emissive object sampled; empty when no light leaves anything out)."""
+    the light or emissive object sampled; empty when no light leaves anything out) and each
+    sample's light group (``group``, core.integrator.lightgroups; empty without light groups)."""
 
     wi: np.ndarray
     dist: np.ndarray
@@ -45,6 +47,7 @@ class LightSamples:
     stop: np.ndarray
     restrict: np.ndarray
     exclude: np.ndarray = field(default_factory=lambda: _NOTHING_EXCLUDED)
+    group: np.ndarray = field(default_factory=lambda: _NO_GROUPS)
 
     @classmethod
     def empty(cls, strategies: int, n: int) -> "LightSamples":
@@ -63,7 +66,7 @@ class LightSamples:
     def take(self, rows) -> "LightSamples":
         return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
                             self.stop[:, rows], self.restrict, self.exclude[:, rows] if self.exclude.size else
-                            self.exclude)
+                            self.exclude, self.group[:, rows] if self.group.size else self.group)
 
     def arrays(self) -> tuple:
         """The fields, contiguous, in the order core.integrator.direct's kernel takes them."""
