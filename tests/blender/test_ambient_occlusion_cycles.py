@@ -44,9 +44,20 @@ def test_ambient_occlusion_matches_cycles(drt, tmp_path, monkeypatch, case):
 
 
 def test_ambient_occlusion_needs_no_warning(drt):
-    """The node is rendered: no material warning names it (Distance 0 unlinked would: Cycles' world
-    AO distance, which DRT does not read)."""
+    """The node is rendered: no material warning names it."""
     data = render_export(ns.ambient_occlusion_scene())
     assert not any("Ambient Occlusion" in w for w in data.warnings), data.warnings
-    data = render_export(ns.ambient_occlusion_scene(distance=0.0))
-    assert any("Ambient Occlusion" in w for w in data.warnings), data.warnings
+
+
+def test_distance_zero_is_the_worlds_ao_distance(drt, tmp_path):
+    """Distance 0 unlinked is Cycles' global radius, the world's AO distance: the image of Distance
+    0.25 when the world's is 0.25 (Cycles gives the very same image, seed for seed)."""
+    scene = ns.ambient_occlusion_scene(distance=0.0)
+    scene.world.light_settings.distance = 0.25
+    data = render_export(scene)
+    assert not any("Ambient Occlusion" in w for w in data.warnings), data.warnings
+    glob = rh.render(scene, "DRT", 16, 0, tmp_path, name="global").rgb
+    short = rh.render(ns.ambient_occlusion_scene(distance=0.25), "DRT", 16, 0, tmp_path, name="short").rgb
+    assert (glob == short).all()
+    far = rh.render(ns.ambient_occlusion_scene(distance=10.0), "DRT", 16, 0, tmp_path, name="far").rgb
+    assert abs(float(far.mean()) - float(short.mean())) > 0.02
