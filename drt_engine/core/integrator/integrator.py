@@ -166,7 +166,8 @@ class Integrator:
         held = np.array([i.holdout for i in scene.instances], bool)
         self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
             m.shader.holds_out for m in prepared.shading) else None
-        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
+        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0,
+                     "occlusion": 0}
         self._rays_lock = threading.Lock()
 
     def _count(self, kind, n):
@@ -348,7 +349,8 @@ class Integrator:
         if not self.occlusion:
             return None
         return OcclusionRays(self.geometry, sampler, samples.pixel[surf.path], samples.sample[surf.path], depth,
-                             surf.pos, surf.ng, surf.scale, surf.prim, surf.time if self.timed else None, surf.ns)
+                             surf.pos, surf.ng, surf.scale, surf.prim, surf.time if self.timed else None, surf.ns,
+                             lambda n: self._count("occlusion", n))
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput,
                        occlusion: OcclusionRays | None = None):

@@ -15,6 +15,7 @@ dimension of the path's sampler (core.sampling.dims.ao), so images stay determin
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -33,7 +34,7 @@ class OcclusionRays:
     """What AO rays from a batch of shading points need: the scene (``geometry``, core.geometry.accel),
     the path's ``sampler`` with each point's pixel, sample id and depth, the point, its geometric
     normal, offset scale, triangle and time, and ``normal`` the shading normal facing the ray
-    (Cycles' sd->N, the node's default Normal)."""
+    (Cycles' sd->N, the node's default Normal); ``count`` is told how many rays each call traces."""
 
     geometry: object
     sampler: object
@@ -46,11 +47,12 @@ class OcclusionRays:
     prim: np.ndarray
     time: np.ndarray | None
     normal: np.ndarray
+    count: Callable[[int], None] | None = None  # told how many rays each call traces
 
     def take(self, rows) -> "OcclusionRays":
         return OcclusionRays(self.geometry, self.sampler, self.pixel[rows], self.sample[rows], self.depth,
                              self.pos[rows], self.ng[rows], self.scale[rows], self.prim[rows],
-                             None if self.time is None else self.time[rows], self.normal[rows])
+                             None if self.time is None else self.time[rows], self.normal[rows], self.count)
 
     def unoccluded(self, normal, distance, samples: int, inside: bool, only_local: bool) -> np.ndarray:
         """(N,) AO: the share of the rays about ``normal`` (None: the shading normal) that reach
@@ -69,6 +71,8 @@ class OcclusionRays:
         rand = self.sampler.pairs(self.pixel, self.sample, dims)
         g = self.geometry
         handles, pivots = g.local_scenes if only_local else (np.zeros(0, np.int64), np.zeros((0, 3)))
+        if self.count is not None:
+            self.count(int(((distance > 0) & (length > 0)).sum()) * samples)
         out = np.empty(n)
         _unoccluded(g.handle, g.tables, g.shadow_mask, handles, pivots, only_local, _c(self.pos), _c(self.ng),
                     _c(self.scale), _c(self.prim), g.time_values(self.time), _c(normal), rand,
