@@ -158,7 +158,7 @@ def test_parts_merge_into_the_whole_render(tmp_path):
 
 def test_the_checks_fail_without_the_computation(monkeypatch):
     """With the integrator's AOV writes switched off, the closed forms above are not met."""
-    monkeypatch.setattr(Integrator, "_shader_aovs", lambda self, surf, hits, out: None)
+    monkeypatch.setattr(Integrator, "_shader_aovs", lambda self, *args: None)
     p = render(scene(), settings())[1].passes
     a, _, _ = columns(p["col"])
     assert not np.allclose(a, [*A_COLOR, 1.0], atol=1e-6)

@@ -1204,3 +1204,52 @@ def light_path_glass_scene(size=48):
     bpy.ops.mesh.primitive_cube_add(size=1.0, location=(1.1, -1.6, 1.0), scale=(2.2, 0.1, 2.2))
     bpy.context.active_object.data.materials.append(_path_material("Glass", glass))
     return scene
+
+
+AO_CASES = {
+    "default": {},
+    "short": {"distance": 0.25},
+    "inside": {"inside": True},
+    "only_local": {"only_local": True},
+}
+"""The Ambient Occlusion node's settings compared with Cycles: the defaults (Distance 1, 16
+samples), Distance 0.25, Inside, Only Local."""
+
+
+def _ao_material(distance=1.0, inside=False, only_local=False):
+    """An emission material of strength the Ambient Occlusion node's AO."""
+    material = new_material("AO")
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(emission.outputs["Emission"], tree.nodes["Material Output"].inputs["Surface"])
+    ao = tree.nodes.new("ShaderNodeAmbientOcclusion")
+    ao.inputs["Distance"].default_value = distance
+    ao.inside = inside
+    ao.only_local = only_local
+    tree.links.new(ao.outputs["AO"], emission.inputs["Strength"])
+    return material
+
+
+def ambient_occlusion_scene(**settings):
+    """A 1 m cube standing on a floor that fills the view and a smooth sphere of radius 0.6 beside it, all one emission
+    material whose Strength is the Ambient Occlusion node's AO with ``settings`` (AO_CASES), under
+    a black world: the image is the AO field. With Only Local the cube and the floor are one object."""
+    scene = ps._scene(64, 48)
+    ps.aim(scene.camera, (3.0, -5.0, 3.5))
+    scene.camera.data.lens = 35.0
+    ps.black_world(scene)
+    material = _ao_material(**settings)
+    floor = ps.add_primitive(bpy.ops.mesh.primitive_plane_add, material, "Floor", size=40.0)
+    cube = ps.add_primitive(bpy.ops.mesh.primitive_cube_add, material, "Cube", size=1.0, location=(-0.4, 0.3, 0.5))
+    if settings.get("only_local"):  # the cube and the floor one object
+        bpy.ops.object.select_all(action="DESELECT")
+        floor.select_set(True)
+        cube.select_set(True)
+        bpy.context.view_layer.objects.active = floor
+        bpy.ops.object.join()
+    ps.smooth_sphere("Sphere", 0.9, material)
+    sphere = scene.objects["Sphere"]
+    sphere.scale = (0.6, 0.6, 0.6)
+    sphere.location = (0.9, -0.2, 0.6)
+    return scene

@@ -652,6 +652,23 @@ class Compiler:
         i = self.op("layer_weight", [self._in(node, "Blend", "float")] + self._normal_in(node))
         return i, 0 if output.identifier == "Fresnel" else 1
 
+    def _node_ShaderNodeAmbientOcclusion(self, node, output):
+        """Color times AO and AO, the share of the node's rays that reach Distance (core.shading.occlusion;
+        1 in the world, where Cycles has no object to trace from). Distance 0 unlinked is Cycles'
+        global radius: the world's AO distance (measured: the same image as that Distance, Fast GI
+        on or off); without a world to read it from, named and traced as 0 (AO 1)."""
+        distance = self._in(node, "Distance", "float")
+        if not is_ref(distance) and distance == 0.0 and not self.world:
+            world = self.layer[0].world if self.layer is not None else None
+            if world is not None:
+                distance = float(world.light_settings.distance)
+            else:
+                self.issues.add(f"'{node.name}' (Ambient Occlusion's Distance 0 without a world: Cycles' "
+                                "global AO distance unknown, AO 1)")
+        args = [self._in(node, "Color", "color"), distance] + self._normal_in(node)
+        i = self.op("ao", args, samples=int(node.samples), inside=bool(node.inside), only_local=bool(node.only_local))
+        return i, 0 if output.identifier == "Color" else 1
+
     def _node_ShaderNodeBrightContrast(self, node, output):
         args = (self._in(node, "Color", "color"), self._in(node, "Bright", "float"),
                 self._in(node, "Contrast", "float"))

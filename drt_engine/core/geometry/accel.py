@@ -345,6 +345,14 @@ class Geometry:
         """The top-level Embree scene's handle for kernels (``blocked``); 0 when there is nothing to hit."""
         return 0 if self._top is None else self._top.handle
 
+    @property
+    def local_scenes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per mesh row, its own Embree scene's handle and the object-space pivot its vertices are
+        relative to: rays against one object alone (the Ambient Occlusion node's Only Local)."""
+        handles = np.array([ms.scene.handle for ms in self._mesh_list], np.int64)
+        pivots = np.array([ms.pivot for ms in self._mesh_list], np.float64).reshape(-1, 3)
+        return handles, pivots
+
     def ray_times(self, time) -> RayTimes:
         """The times as a RayTimes (None when nothing moves)."""
         if isinstance(time, RayTimes):

@@ -34,6 +34,7 @@ from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
+from ..shading.occlusion import OcclusionRays, traces
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
 from .bounces import binding, ended
@@ -137,6 +138,8 @@ class Integrator:
         self.ratio = frozenset(plan.ratio)
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
+        # the Ambient Occlusion node's rays, from the surfaces paths hit (core.shading.occlusion)
+        self.occlusion = any(traces(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
@@ -172,7 +175,8 @@ class Integrator:
         self.groups = light_groups(scene, self.lights, settings.passes)  # None: no group to fill
         self.group_passes = [name for name in settings.passes if name.startswith(LIGHTGROUP_PREFIX)
                              and name not in dict(settings.aovs)]
-        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0}
+        self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0,
+                     "occlusion": 0}
         self._rays_lock = threading.Lock()
 
     def _count(self, kind, n):
@@ -231,16 +235,19 @@ class Integrator:
                 order = np.argsort(mat, kind="stable")
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
-            self._emission_seen(surf, state, hits, out)
+            occlusion = self._occlusion(surf, samples, sampler, depth)
+            self._emission_seen(surf, state, hits, out, occlusion)
             if self.aovs is not None:
-                self._shader_aovs(surf, hits, out)
+                self._shader_aovs(surf, hits, out, occlusion)
             if self.limited:  # paths past a glossy or transmission limit end here, with what they saw
-                surf = surf.take(np.flatnonzero(~ended(surf.bounces, s)))
+                kept = np.flatnonzero(~ended(surf.bounces, s))
+                surf, occlusion = surf.take(kept), None if occlusion is None else occlusion.take(kept)
                 if len(surf) == 0:
                     break
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
-            bound = [(group, u.take(rows), shader) for rows, group, shader in self._bind_materials(surf, hits)]
+            bound = [(group, u.take(rows), shader)
+                     for rows, group, shader in self._bind_materials(surf, hits, occlusion=occlusion)]
             if self.holdouts is not None:
                 bound = self.holdouts.write(bound, out.alpha)
             lit = [(group, u_g) for group, u_g, shader in bound if shader.lobes] if self.lights.strategies else []
@@ -359,8 +366,19 @@ class Integrator:
                                straight=state.straight[rows], time=state.time[rows],
                                bounces=None if state.bounces is None else state.bounces[rows])
 
-    def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput):
-        """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles."""
+    def _occlusion(self, surf: SurfaceHits, samples: Samples, sampler, depth: int) -> OcclusionRays | None:
+        """The Ambient Occlusion node's rays from the hits ``surf`` of this depth (None when no
+        material has the node)."""
+        if not self.occlusion:
+            return None
+        return OcclusionRays(self.geometry, sampler, samples.pixel[surf.path], samples.sample[surf.path], depth,
+                             surf.pos, surf.ng, surf.scale, surf.prim, surf.time if self.timed else None, surf.ns,
+                             lambda n: self._count("occlusion", n))
+
+    def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput,
+                       occlusion: OcclusionRays | None = None):
+        """Emission seen on surfaces (two-sided), weighted against light sampling of emissive triangles;
+        ``occlusion``: the Ambient Occlusion node's rays from ``surf``."""
         glows = self.lights.glows
         glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
         if self.holdouts is not None and len(glowing):  # an object holdout the camera sees gives no light
@@ -370,7 +388,8 @@ class Integrator:
         prim = surf.prim[glowing]
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
-                                             self._ray_path(surf, hits, glowing))
+                                             self._ray_path(surf, hits, glowing),
+                                             None if occlusion is None else occlusion.take(glowing))
 
         def emissive_pdf(smooth):
             rows = hit[smooth]
@@ -416,15 +435,19 @@ class Integrator:
                 out.aov_reach[path] *= reach_scale(shader, group, rows)
             out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
 
-    def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput):
+    def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput, occlusion: OcclusionRays | None = None):
         """The materials' AOV Output nodes at the hits the camera sees directly or through
         transparency, before the data passes close their paths (core.integrator.aovs)."""
-        seen = surf.take(np.flatnonzero(surf.straight & ~out.indexed[surf.path]))
+        rows = np.flatnonzero(surf.straight & ~out.indexed[surf.path])
+        seen = surf.take(rows)
         if len(seen) == 0:
             return
+        occlusion = None if occlusion is None else occlusion.take(rows)
         for g in _material_slices(seen.mat):
             group = seen.take(g)
-            self.aovs.write(group, lambda: self._context(group, hits), out.aux, out.aov_reach[group.path])
+            rays = None if occlusion is None else occlusion.take(g)
+            self.aovs.write(group, lambda: self._context(group, hits, occlusion=rays), out.aux,
+                            out.aov_reach[group.path])
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
         """The diffuse and glossy colour passes of the camera's own hits."""
@@ -460,19 +483,21 @@ class Integrator:
             sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
         return StepSamples(light, path)
 
-    def _bind_materials(self, surf: SurfaceHits, hits, shadow: bool = False):
+    def _bind_materials(self, surf: SurfaceHits, hits, shadow: bool = False, occlusion: OcclusionRays | None = None):
         """(rows of ``surf``, those hits, shader) per material: a slice of the hits (sorted by
         material) for a constant material, index arrays of hits sharing one bound shader for a
         material with varying inputs (see core.shading); a program's normal replaces the shading
         normal and frame of its hits in the records it yields, an anisotropic material's tangent
-        the frame's tangent. ``shadow``: shadow rays reached the hits (Light Path's Is Shadow Ray)."""
+        the frame's tangent. ``shadow``: shadow rays reached the hits (Light Path's Is Shadow Ray);
+        ``occlusion``: the Ambient Occlusion node's rays from ``surf`` (None: AO 1, as Cycles' shadow rays)."""
         for g in _material_slices(surf.mat):
             group = surf.take(g)
             shading = self.prepared.shading[surf.mat[g.start]]
             if not shading.varying:
                 yield g, group, shading.shader
                 continue
-            groups, normal, tangent, smooth = shading.bind(self._context(group, hits, shadow))
+            rays = None if occlusion is None else occlusion.take(g)
+            groups, normal, tangent, smooth = shading.bind(self._context(group, hits, shadow, rays))
             facing_away = None  # the program's normals that wo lies below, where some do
             if normal is not None or tangent is not None:
                 ns, wo = group.ns, group.wo
@@ -492,14 +517,15 @@ class Integrator:
                     taken = _about(taken, facing_away[sub])
                 yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
 
-    def _context(self, group: SurfaceHits, hits, shadow: bool = False) -> SurfaceContext:
+    def _context(self, group: SurfaceHits, hits, shadow: bool = False,
+                 occlusion: OcclusionRays | None = None) -> SurfaceContext:
         """The hits ``group`` as shader programs read them (core.shading.surface); ``shadow``:
-        shadow rays reached them."""
+        shadow rays reached them; ``occlusion``: their Ambient Occlusion rays."""
         hu, hv = hits.u[group.row], hits.v[group.row]
         bary = np.stack([1.0 - hu - hv, hu, hv], axis=1)
         width = self.pixel_spread[0] + self.pixel_spread[1] * hits.t[group.row]
         return SurfaceContext(self.prepared.attributes, group.prim, bary, group.pos, group.ns, width, -group.wo,
-                              self._ray_path(group, hits, shadow=shadow))
+                              self._ray_path(group, hits, shadow=shadow), occlusion)
 
     @staticmethod
     def _ray_path(group: SurfaceHits, hits, rows=slice(None), shadow=False) -> RayPath | None:

@@ -16,9 +16,10 @@ import numpy as np
 
 from ..bsdf.shader import DIFFUSE_KINDS, see_through
 from ..geometry.motion import Motion, deforms, moves
+from ..shading.occlusion import traces
 from .ratio import delta_light, ratio_strategies
 
-RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent", "diffuse")
+RAY_KINDS = ("camera", "shadow", "reflection", "refraction", "transparent", "diffuse", "occlusion")
 
 
 @dataclass
@@ -76,7 +77,8 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
             "reflection": bounces and bool(kinds & {"reflect", "glass", "toon_glossy"}),
             "refraction": bounces and "glass" in kinds,
             "transparent": bounces and "transparent" in kinds,
-            "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS))}
+            "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS)),
+            "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion nodes
 
     strategies = []
     for light in lights.lights[:lights.light_slots] if not lights.selecting else []:

@@ -227,10 +227,11 @@ class Lights:
             best = np.maximum(best, self._emission_at(tris, weights, ng, corners))
         return best
 
-    def _emission_at(self, prim, bary, normal=None, corners=None, path=None):
+    def _emission_at(self, prim, bary, normal=None, corners=None, path=None, occlusion=None):
         """Emission of triangles ``prim`` at ``bary``, its texture seeing ``normal`` (the hits'
         shading normals), or the triangles' geometric normals at light-sampled points; ``path``
-        the rays there, for Light Path (core.shading.lightpath)."""
+        the rays there, for Light Path (core.shading.lightpath); ``occlusion`` the Ambient
+        Occlusion node's rays from hits (None: AO 1, as Cycles' light samples)."""
         g = self.geometry
         mats = g.material_of(prim)
         out = self.emission[mats]
@@ -241,16 +242,18 @@ class Lights:
                 pos = np.einsum("ni,nij->nj", bary[sel], p)
                 n = g.world_normals(prim[sel], p)[0] if normal is None else normal[sel]
                 ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n,
-                                     light_path=None if path is None else path.take(sel))
+                                     light_path=None if path is None else path.take(sel),
+                                     occlusion=None if occlusion is None else occlusion.take(sel))
                 out[sel] = self.shaders[m].emission_at(ctx)
         return out
 
-    def emission_seen(self, prim, u, v, normal=None, path=None):
+    def emission_seen(self, prim, u, v, normal=None, path=None, occlusion=None):
         """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``, the
-        rays that reached them ``path``)."""
+        rays that reached them ``path``, their Ambient Occlusion rays ``occlusion``)."""
         if not self.textured:
             return self.emission[self.geometry.material_of(prim)]
-        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal, path=path)
+        return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal, path=path,
+                                 occlusion=occlusion)
 
     def _frame(self, i, points, dirs, time):
         """(table, points, directions, rotation) in the frame where light i stands still."""

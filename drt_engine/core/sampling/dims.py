@@ -9,7 +9,9 @@ same when the scene changes. The layout:
   roulette's decision (drawn as one pair with the choice);
 - light strategies, per depth: a block of 4 (the point on the light (2D), the choice of a
   light or triangle) at a dimension hashed from the strategy's identity (a light's kind and
-  name, "emissive", "world", a selection slot) and the depth, above every path dimension.
+  name, "emissive", "world", a selection slot) and the depth, above every path dimension;
+- the Ambient Occlusion node, per depth: one 2D dimension per ray (up to 128), in a block of 256
+  above every light block.
 
 So adding a light leaves every other light's numbers, and the path's, as they were.
 Sobol pairs past the first four dimensions are independently scrambled padding (see
@@ -25,6 +27,8 @@ PATH_STRIDE = 4
 
 _LIGHT_BASE = 1 << 24  # above any path dimension (depth < 4 million)
 _LIGHT_BLOCKS = 1 << 22  # hashed blocks of 4 dimensions: room for lights x depths without collisions
+_AO_BASE = _LIGHT_BASE + 4 * _LIGHT_BLOCKS  # above every light block
+_AO_STRIDE = 256  # 2D dimensions for the node's 128 rays at most
 
 
 def lobe(depth: int) -> int:
@@ -36,6 +40,11 @@ def lobe_choice(depth: int) -> int:
     """1D: which lobe the path continues through; drawn as a pair whose second value (+3) is
     Russian roulette's decision (with diffuse bounces)."""
     return PATH + PATH_STRIDE * depth + 2
+
+
+def ao(depth: int, ray: int) -> int:
+    """2D: the direction of the Ambient Occlusion node's ray ``ray`` at a hit of this depth."""
+    return _AO_BASE + _AO_STRIDE * depth + 2 * ray
 
 
 def strategy_keys(lights) -> list[str]:

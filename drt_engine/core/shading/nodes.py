@@ -427,6 +427,10 @@ class Evaluator:
         if op == "affine":  # a fixed transform (3, 4) of points
             m = np.asarray(p["matrix"], float)
             return (x[0] @ m[:3, :3].T + m[:3, 3],)
+        if op == "ao":  # color, distance and, when linked, the normal: Color (Color * AO) and AO
+            ao = self.ctx.ambient_occlusion(x[2] if len(x) > 2 else None, x[1], p["samples"], p["inside"],
+                                            p["only_local"])
+            return x[0] * ao[:, None], ao
         if op == "backfacing":
             return (self.ctx.backfacing().astype(float),)
         if op == "light_path":
@@ -736,6 +740,9 @@ class DirectionContext:
 
     def backfacing(self):
         return np.zeros(self.n, bool)
+
+    def ambient_occlusion(self, normal, distance, samples, inside, only_local):
+        return np.ones(self.n)  # the world has no object: Cycles' svm_ao gives 1
 
     def object_matrix(self):
         return None  # the world has no object (Cycles' is_object is false there)

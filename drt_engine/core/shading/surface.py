@@ -40,10 +40,12 @@ EXACT_TABLES = Tables()
 
 class SurfaceContext:
     """Coordinates of a batch of hits for shader programs; ``shifted`` moves them on the surface.
-    ``light_path``: the rays that reached them (core.shading.lightpath.RayPath; None: light samples)."""
+    ``light_path``: the rays that reached them (core.shading.lightpath.RayPath; None: light samples);
+    ``occlusion``: the Ambient Occlusion node's rays from them (core.shading.occlusion; None where
+    Cycles does not trace them: light samples, shadow rays)."""
 
     def __init__(self, attrs: "SurfaceAttributes", prim, bary, pos, normal, width=None, direction=None,
-                 light_path=None):
+                 light_path=None, occlusion=None):
         self.attrs = attrs
         self.prim = prim
         self.bary = bary
@@ -55,19 +57,20 @@ class SurfaceContext:
         that lookups there filter no further)."""
         self.direction = direction
         self.light_path = light_path
+        self.occlusion = occlusion
         self.n = len(prim)
 
     def shifted(self, dp):
         db = self.attrs.bary_shift(self.prim, dp)
         out = SurfaceContext(self.attrs, self.prim, self.bary + db, self.pos + dp, self.normal, None,
-                             self.direction, self.light_path)
+                             self.direction, self.light_path, self.occlusion)
         out.pixel_width = self.pixel_width
         return out
 
     def turned(self, normal):
         """The same hits with ``normal`` as their shading normal (a displacement's bump)."""
         out = SurfaceContext(self.attrs, self.prim, self.bary, self.pos, normal, self.width, self.direction,
-                             self.light_path)
+                             self.light_path, self.occlusion)
         out.pixel_width = self.pixel_width
         return out
 
@@ -107,6 +110,12 @@ class SurfaceContext:
 
     def attribute(self, name):
         return self.attrs.corner(self.prim, self.bary, ("color", name))
+
+    def ambient_occlusion(self, normal, distance, samples, inside, only_local):
+        """(N,) the Ambient Occlusion node's AO (core.shading.occlusion); 1 where no rays are traced."""
+        if self.occlusion is None:
+            return np.ones(self.n)
+        return self.occlusion.unoccluded(normal, distance, samples, inside, only_local)
 
     def instance_attribute(self, key):
         """(N, 4) RGBA of an Object or Instancer attribute of each hit's object (0 where it has none)."""
