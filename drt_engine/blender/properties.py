@@ -120,6 +120,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         max_transparent_bounces=drt.max_transparent_bounces,
         sample_clamp_direct=drt.sample_clamp_direct,
         sample_clamp_indirect=drt.sample_clamp_indirect,
+        filter_glossy=drt.filter_glossy,
         threads=drt.threads,
         filter_type=drt.filter_type,
         filter_size=scene.render.filter_size,
@@ -236,6 +237,15 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         default=0.0,
         min=0.0,
         soft_max=100.0,
+    )
+    filter_glossy: FloatProperty(
+        name="Filter Glossy",
+        description="Blur glossy and glass surfaces seen after blurry bounces, as much as the least likely "
+        "bounce of the path allows (Cycles' Filter Glossy): less noise in caustics at the cost of accuracy; "
+        "0 turns it off (DRT's default; Cycles' is 1)",
+        default=0.0,
+        min=0.0,
+        max=10.0,
     )
     shadow_estimator: EnumProperty(
         name="Shadow Estimator",

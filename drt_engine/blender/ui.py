@@ -191,6 +191,15 @@ class DRT_PT_light_paths(DRTButtonsPanel, bpy.types.Panel):
         col.prop(drt, "shadow_estimator")
 
 
+class DRT_PT_light_paths_caustics(DRTButtonsPanel, bpy.types.Panel):
+    bl_label = "Caustics"
+    bl_parent_id = "DRT_PT_light_paths"
+
+    def draw(self, context):
+        layout = split(self.layout)
+        layout.column().prop(context.scene.drt, "filter_glossy")
+
+
 class DRT_PT_film(DRTButtonsPanel, bpy.types.Panel):
     bl_label = "Film"
 
@@ -385,6 +394,7 @@ classes = (
     DRT_PT_sampling_denoise,
     DRT_PT_sampling_range,
     DRT_PT_light_paths,
+    DRT_PT_light_paths_caustics,
     DRT_PT_film,
     DRT_PT_motion_blur,
     DRT_PT_motion_blur_curve,

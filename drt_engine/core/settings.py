@@ -111,6 +111,10 @@ class RenderSettings:
     # after (indirect) its path's first bounce kept within them (core.integrator.clamp); 0: off
     sample_clamp_direct: float = 0.0
     sample_clamp_indirect: float = 0.0
+    # Cycles' Filter Glossy: after a path's blurry bounces its GGX reflection and glass lobes are made
+    # at least as rough as the least likely bounce allows (core.bsdf.blur); 0: off (Cycles' default is
+    # 1, DRT's 0 keeps the image of paths that see highlights through rough bounces as it was)
+    filter_glossy: float = 0.0
     threads: int = 0
     filter_type: str = "BLACKMAN_HARRIS"
     filter_size: float = 1.5
@@ -160,7 +164,7 @@ class RenderSettings:
                      "min_transparent_bounces", "max_transparent_bounces"):
             if getattr(self, name) < 0:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 or more, not {getattr(self, name)}")
-        for name in ("sample_clamp_direct", "sample_clamp_indirect"):
+        for name in ("sample_clamp_direct", "sample_clamp_indirect", "filter_glossy"):
             if not getattr(self, name) >= 0:
                 raise SettingsError(f"{name.replace('_', ' ')} must be 0 (off) or more, not {getattr(self, name)}")
         if self.samples < 1:

@@ -135,6 +135,7 @@ def test_settings_from_scene(drt):
     d = scene.drt
     d.samples, d.seed, d.sampling_pattern, d.max_depth = 9, 7, "JITTERED", 3
     d.sample_clamp_direct, d.sample_clamp_indirect, d.threads, d.filter_type = 4.5, 1.5, 2, "GAUSSIAN"
+    d.filter_glossy = 0.5
     d.use_adaptive_sampling, d.adaptive_threshold, d.adaptive_min_samples = True, 0.05, 16
     d.adaptive_mode = "CONTRAST"
     d.time_limit, d.target_error = 12.0, 0.02
@@ -147,7 +148,7 @@ def test_settings_from_scene(drt):
     settings = properties.settings_from_scene(scene, view_layer)
     assert settings == RenderSettings(
         samples=9, seed=7, sampling_pattern="JITTERED", max_depth=3, sample_clamp_direct=4.5,
-        sample_clamp_indirect=1.5, threads=2,
+        sample_clamp_indirect=1.5, filter_glossy=0.5, threads=2,
         filter_type="GAUSSIAN", filter_size=2.25,
         passes=("Combined", "Depth", "Env", "Noise", "Mist", "IndexOB", "IndexMA"), pass_alpha_threshold=0.25,
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,

@@ -10,7 +10,8 @@ from ..base.constants import TINY
 from ..base.jit import kernel
 from . import microfacet as mf
 from . import thin_film as tf
-from .layout import H_TINT_R, H_TINT_T, P_ALPHA, P_ETA, P_FILM, P_FILM_IOR, P_REFRACT_ONLY
+from .blur import alpha as blurred_alpha
+from .layout import H_TINT_R, H_TINT_T, P_ETA, P_FILM, P_FILM_IOR, P_REFRACT_ONLY
 from .reflection import masking, reflected
 
 
@@ -18,7 +19,7 @@ from .reflection import masking, reflected
 def glass_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz, refl, trans, eta):
     """Rough dielectric (Walter et al. 2007), radiance form, following pbrt-v4:
     (f |cos| RGB, density of sampling wi through this lobe)."""
-    alpha = lp[l, P_ALPHA]
+    alpha = blurred_alpha(lp, hp, r, l)
     etap = eta if trans else 1.0
     mx, my, mz = wix * etap + wox, wiy * etap + woy, wiz * etap + woz
     if mz < 0.0:
@@ -80,21 +81,21 @@ def lobe_eta(lp, l, inside):
 def glass_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     """Sample the lobe alone, reflection or refraction by the Fresnel factor at the sampled
     normal: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
-    hx, hy, hz, c, rx, ry, rz = reflected(lp, l, wox, woy, woz, u0, u1)
+    hx, hy, hz, c, rx, ry, rz = reflected(lp, hp, r, l, wox, woy, woz, u0, u1)
     if lp[l, P_FILM] > tf.CUTOFF:
         r0, r1, r2, p = film_reflectance(lp, hp, r, l, c, eta)
         if u_choice < p:
-            g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz) / p
+            g = masking(lp, lt, hp, r, l, j, t, wox, woy, woz, rx, ry, rz) / p
             return rx, ry, rz, r0 * g, r1 * g, r2 * g, rz > 0.0
         tx, ty, tz, ok = mf.refract(wox, woy, woz, hx, hy, hz, eta)
-        g = masking(lp, lt, l, j, t, wox, woy, woz, tx, ty, tz) / (eta ** 2 * max(1.0 - p, TINY))
+        g = masking(lp, lt, hp, r, l, j, t, wox, woy, woz, tx, ty, tz) / (eta ** 2 * max(1.0 - p, TINY))
         return (tx, ty, tz, (1.0 - r0) * hp[r, l, H_TINT_T] * g, (1.0 - r1) * hp[r, l, H_TINT_T + 1] * g,
                 (1.0 - r2) * hp[r, l, H_TINT_T + 2] * g, ok and tz < 0.0)
     fr = mf.fresnel_dielectric1(c, eta)
     p_reflect = 0.0 if lp[l, P_REFRACT_ONLY] != 0.0 else fr
     if u_choice < p_reflect:  # the Fresnel factor cancels against the choice probability
-        g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz)
+        g = masking(lp, lt, hp, r, l, j, t, wox, woy, woz, rx, ry, rz)
         return rx, ry, rz, hp[r, l, H_TINT_R] * g, hp[r, l, H_TINT_R + 1] * g, hp[r, l, H_TINT_R + 2] * g, rz > 0.0
     tx, ty, tz, ok = mf.refract(wox, woy, woz, hx, hy, hz, eta)
-    g = masking(lp, lt, l, j, t, wox, woy, woz, tx, ty, tz) / eta ** 2  # radiance scales by 1/eta² crossing
+    g = masking(lp, lt, hp, r, l, j, t, wox, woy, woz, tx, ty, tz) / eta ** 2  # radiance scales by 1/eta² crossing
     return tx, ty, tz, hp[r, l, H_TINT_T] * g, hp[r, l, H_TINT_T + 1] * g, hp[r, l, H_TINT_T + 2] * g, ok and tz < 0.0

@@ -69,4 +69,5 @@ H_TINT_T = 9  # (3) glass transmission tint
 H_F0 = 12  # (3) Fresnel colour
 H_NORMAL = 15  # (3) P_OWN_NORMAL: the lobe's normal in the local shading frame
 H_PLACE = 18  # (2) P_OWN_NORMAL, P_UNDER_OWN: ``tables.locate`` of wo's cosine to that normal (j, t)
-H = 20
+H_BLUR = 20  # Filter Glossy's least alpha for a reflect or glass lobe at this hit (core.bsdf.blur); 0: none
+H = 21

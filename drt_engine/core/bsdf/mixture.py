@@ -19,10 +19,11 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
+from . import blur
 from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_DELTA, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
+from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
                      SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
@@ -102,7 +103,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     lit = lit_part * shade
     lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else shade_diffuse
     for l in range(lp.shape[0]):
-        if lp[l, P_DELTA] != 0.0:
+        if blur.delta(lp, hp, r, l):
             continue
         kind = int(lp[l, P_KIND])
         if diffuse_kind(kind):
@@ -231,7 +232,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     ms = ms_factor(lp, lt, hp, r, j, t, l)
     p = max(p_choice, TINY)
     w0, w1, w2 = w0 * s0 * ms / p, w1 * s1 * ms / p, w2 * s2 * ms / p
-    delta = lp[l, P_DELTA] != 0.0
+    delta = blur.delta(lp, hp, r, l)
     valid = ok and p_choice > 0.0
     pdf = 0.0
     # a reflection about a lobe's own normal may leave below the shading normal, on wo's side still

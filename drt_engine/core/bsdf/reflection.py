@@ -11,10 +11,11 @@ from __future__ import annotations
 from ..base import vectors as vec
 from ..base.constants import TINY
 from ..base.jit import kernel
+from . import blur
 from . import microfacet as mf
 from . import thin_film as tf
-from .layout import (F_DIELECTRIC, F_F82, F_F82_FILM, F_FILM, GLASS, H_F0, H_NORMAL, P_ALPHA, P_ALPHA_T, P_ALPHA_X,
-                     P_ALPHA_Y, P_ANISO, P_DELTA, P_ETA_F, P_F82, P_FILM, P_FILM_IOR, P_FRESNEL, P_KIND, T_WHITE)
+from .layout import (F_DIELECTRIC, F_F82, F_F82_FILM, F_FILM, GLASS, H_F0, H_NORMAL, P_ANISO, P_ETA_F, P_F82, P_FILM,
+                     P_FILM_IOR, P_FRESNEL, P_KIND, T_WHITE)
 from .tables import at, place
 
 
@@ -45,11 +46,11 @@ def fresnel(lp, hp, r, l, c):
 @kernel(inline="always")
 def reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
     """GGX reflection: (f |cos| RGB, density of sampling wi through this lobe)."""
-    alpha = lp[l, P_ALPHA]
+    alpha = blur.alpha(lp, hp, r, l)
     hx, hy, hz = vec.unit(wox + wix, woy + wiy, woz + wiz)
     cos_oh = min(max(wox * hx + woy * hy + woz * hz, 0.0), 1.0)
     if lp[l, P_ANISO] != 0.0:
-        ax, ay = lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y]
+        ax, ay = blur.alphas_xy(lp, hp, r, l)
         d = mf.ggx_d_aniso(hx, hy, hz, ax, ay)
         lambda_o = mf.ggx_lambda_aniso(wox, woy, woz, ax, ay)
         g2 = 1.0 / (1.0 + lambda_o + mf.ggx_lambda_aniso(wix, wiy, wiz, ax, ay))
@@ -64,7 +65,7 @@ def reflect_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
 
 
 @kernel(inline="always")
-def masking(lp, lt, l, j, t, wox, woy, woz, wix, wiy, wiz):
+def masking(lp, lt, hp, r, l, j, t, wox, woy, woz, wix, wiy, wiz):
     """Sampling weight G2/G1 of visible-normal sampling toward wi.
 
     A delta lobe's reflection takes the white albedo of GGX at its own alpha instead
@@ -72,29 +73,31 @@ def masking(lp, lt, l, j, t, wox, woy, woz, wix, wiy, wiz):
     mirror direction near grazing); its refraction is masked at the refracted spread
     alpha_t (none at IOR 1).
     """
-    alpha = lp[l, P_ALPHA]
-    if lp[l, P_DELTA] == 0.0:
+    alpha = blur.alpha(lp, hp, r, l)
+    if not blur.delta(lp, hp, r, l):
         if lp[l, P_ANISO] != 0.0:
-            ax, ay = lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y]
+            ax, ay = blur.alphas_xy(lp, hp, r, l)
             lambda_o = mf.ggx_lambda_aniso(wox, woy, woz, ax, ay)
             return (1.0 + lambda_o) / (1.0 + lambda_o + mf.ggx_lambda_aniso(wix, wiy, wiz, ax, ay))
         return mf.ggx_g2(woz, abs(wiz), alpha) / mf.ggx_g1(woz, alpha)
     if wiz > 0.0:
         return at(lt, l, T_WHITE, j, t)
-    a_t = lp[l, P_ALPHA_T] if int(lp[l, P_KIND]) == GLASS else alpha
+    a_t = blur.alpha_t(lp, hp, r, l) if int(lp[l, P_KIND]) == GLASS else alpha
     return mf.ggx_g2(woz, abs(wiz), a_t) / mf.ggx_g1(woz, a_t)
 
 
 @kernel(inline="always")
-def reflected(lp, l, wox, woy, woz, u0, u1):
+def reflected(lp, hp, r, l, wox, woy, woz, u0, u1):
     """(microfacet normal h, cos(wo, h), wo mirrored about h): h is the shading normal for a delta
     lobe, else sampled among the normals visible from wo."""
-    if lp[l, P_DELTA] != 0.0:
+    if blur.delta(lp, hp, r, l):
         hx, hy, hz = 0.0, 0.0, 1.0
     elif lp[l, P_ANISO] != 0.0:
-        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA_X], lp[l, P_ALPHA_Y], u0, u1)
+        ax, ay = blur.alphas_xy(lp, hp, r, l)
+        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, ax, ay, u0, u1)
     else:
-        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, lp[l, P_ALPHA], lp[l, P_ALPHA], u0, u1)
+        a = blur.alpha(lp, hp, r, l)
+        hx, hy, hz = mf.sample_visible_normal(wox, woy, woz, a, a, u0, u1)
     c = wox * hx + woy * hy + woz * hz
     rx, ry, rz = 2.0 * c * hx - wox, 2.0 * c * hy - woy, 2.0 * c * hz - woz
     return hx, hy, hz, c, rx, ry, rz
@@ -103,9 +106,9 @@ def reflected(lp, l, wox, woy, woz, u0, u1):
 @kernel(inline="always")
 def reflect_sample(lp, lt, hp, r, j, t, l, wox, woy, woz, u0, u1):
     """Sample the lobe alone: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
-    _, _, _, c, rx, ry, rz = reflected(lp, l, wox, woy, woz, u0, u1)
+    _, _, _, c, rx, ry, rz = reflected(lp, hp, r, l, wox, woy, woz, u0, u1)
     f0, f1, f2 = fresnel(lp, hp, r, l, min(max(c, 0.0), 1.0))
-    g = masking(lp, lt, l, j, t, wox, woy, woz, rx, ry, rz)
+    g = masking(lp, lt, hp, r, l, j, t, wox, woy, woz, rx, ry, rz)
     return rx, ry, rz, f0 * g, f1 * g, f2 * g, rz > 0.0
 
 

@@ -673,6 +673,23 @@ class MaterialShader:
         turned.hp = hp
         return turned
 
+    @property
+    def blurs(self) -> bool:
+        """It has lobes Filter Glossy blurs: GGX reflection and glass (core.bsdf.blur)."""
+        return any(lobe.kind in ("reflect", "glass") for lobe in self.lobes)
+
+    def blurred(self, roughness: np.ndarray) -> "MaterialShader":
+        """The shader bound to n hits (itself bound to them or constant) whose reflect and glass lobes
+        take at least alpha ``roughness`` (n,) at each (Filter Glossy, core.bsdf.blur)."""
+        n = len(roughness)
+        hp = self.hp.copy() if self.bound else np.repeat(self.hp, n, axis=0)
+        for l, lobe in enumerate(self.lobes):
+            if lobe.kind in ("reflect", "glass"):
+                hp[:, l, layout.H_BLUR] = roughness
+        blurred = copy.copy(self)
+        blurred.hp, blurred.bound = hp, True
+        return blurred
+
     def take(self, rows) -> "MaterialShader":
         """The shader of the hits ``rows`` of its binding (itself when it is not bound)."""
         if not self.bound:

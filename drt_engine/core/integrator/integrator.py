@@ -23,6 +23,7 @@ import numpy as np
 
 from ..base import vectors as vec
 from ..base.vectors import Frame
+from ..bsdf.blur import blur_roughness
 from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
 from ..film.denoising import Features
@@ -150,6 +151,9 @@ class Integrator:
         self.diffuse = settings.diffuse_bounces if plan.rays.get("diffuse") else 0
         self.clamp = clamp_limits(settings)  # Clamp Direct and Indirect (core.integrator.clamp)
         self.clamping = bool(np.isfinite(self.clamp).any())
+        # Filter Glossy (core.bsdf.blur): paths carry their least bounce density only when it is on and
+        # some material has lobes it blurs
+        self.filter_glossy = settings.filter_glossy if any(sh.blurs for sh in prepared.shaders) else 0.0
         # transparent shadows when some material lets shadow rays through (the plan lists them)
         self.shadows = None
         if plan.see_through:
@@ -246,7 +250,7 @@ class Integrator:
                     break
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
                            depth < s.max_depth)
-            bound = [(group, u.take(rows), shader)
+            bound = [(group, u.take(rows), self._blurred(shader, group, state))
                      for rows, group, shader in self._bind_materials(surf, hits, occlusion=occlusion)]
             if self.holdouts is not None:
                 bound = self.holdouts.write(bound, out.alpha)
@@ -299,7 +303,8 @@ class Integrator:
                           throughput=np.ones((n, 3)), prev_pdf=np.full(n, np.inf), prev_normal=np.zeros((n, 3)),
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
                           bounces=camera_bounces(n) if self.carried else None,
-                          mis_origin=cam.origins if self.shadows is not None else None)
+                          mis_origin=cam.origins if self.shadows is not None else None,
+                          min_pdf=np.full(n, np.inf) if self.filter_glossy > 0 else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray | None:
@@ -534,6 +539,14 @@ class Integrator:
             return None
         return RayPath(group.straight[rows], group.bounces[rows], hits.t[group.row[rows]], shadow=shadow)
 
+    def _blurred(self, shader, group: SurfaceHits, state: PathState):
+        """The shader of hits ``group`` with its glossy lobes blurred as Filter Glossy asks after their
+        paths' bounces (core.bsdf.blur); itself where nothing is blurred."""
+        if state.min_pdf is None or not shader.blurs:
+            return shader
+        roughness = blur_roughness(state.min_pdf[group.row], self.filter_glossy)
+        return shader.blurred(roughness) if roughness.any() else shader
+
     # -- next-event estimation ----------------------------------------------------------
     def _sample_lights(self, lit) -> LightSamples:
         """Every light strategy sampled at the hits of one depth step that have lobes (``lit``:
@@ -617,10 +630,15 @@ class Integrator:
             prev_normal = np.where(kept, state.prev_normal[rows], prev_normal)
             prev_shading = np.where(kept, state.prev_shading[rows], prev_shading)
             mis_origin = np.where(kept, state.mis_origin[rows], origin)
+        min_pdf = None
+        if state.min_pdf is not None:  # Cycles' min_ray_pdf: the least density of non-transparent bounces
+            before = state.min_pdf[hits.row[sel]]
+            min_pdf = np.where(passthrough, before, np.minimum(before, prev_pdf))
         return PathState(path=hits.path[sel], origins=origin, dirs=wi[sel], tmax=np.full(len(sel), np.inf),
                          throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
-                         bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin)
+                         bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin,
+                         min_pdf=min_pdf)
 
 
 def _material_slices(mat):

@@ -61,7 +61,9 @@ class PathState(Rows):
     shader program reads Light Path; ``mis_origin`` (with transparent shadows) where the
     direction that ``prev_pdf`` is of was sampled: a transparent pass-through keeps the previous
     bounce's pdf, normals and origin, as Cycles keeps its MIS state through transparent bounces,
-    since light sampling from there reaches through the transparent surface too."""
+    since light sampling from there reaches through the transparent surface too; ``min_pdf`` (with
+    Filter Glossy) the least density of the path's non-transparent bounces so far (inf: none or
+    only delta ones; core.bsdf.blur)."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -75,6 +77,7 @@ class PathState(Rows):
     time: np.ndarray  # shutter time of each ray (zeros when nothing moves)
     bounces: np.ndarray | None = None
     mis_origin: np.ndarray | None = None
+    min_pdf: np.ndarray | None = None
 
     def mis_ray(self, rows, t):
         """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs
