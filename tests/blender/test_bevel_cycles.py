@@ -5,7 +5,11 @@ samples (the defaults but for the radius) and Radius 0.2 with 16.
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the node ignored (the Diffuse's Normal
-unlinked: the flat faces' normals) must fail that limit by far."""
+unlinked: the flat faces' normals) must fail that limit by far. Measured (64x48 px, 64 spp):
+Radius 0.1 0.0051 against a limit of 0.0078 (Cycles' seeds 0.0039), Radius 0.2 0.0025 against
+0.0081; the node ignored 0.066 and 0.133. With each disk sample on a dimension of its own instead
+of Cycles' consecutive (stratified) sample ids, Radius 0.1 was 0.0145: the normalised sum is not
+linear in its samples."""
 from __future__ import annotations
 
 import pytest
