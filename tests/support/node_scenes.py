@@ -1258,12 +1258,15 @@ def ambient_occlusion_scene(**settings):
 BEVEL_CASES = {
     "default": {},
     "wide": {"radius": 0.2, "samples": 16},
+    "bumped": {"bumped": True},
 }
-"""The Bevel node's settings compared with Cycles: Radius 0.1 with 8 samples, and 0.2 with 16."""
+"""The Bevel node's settings compared with Cycles: Radius 0.1 with 8 samples, 0.2 with 16, and
+the node's Normal linked (a Bump of a Noise Texture, whose turn the node keeps)."""
 
 
-def _bevel_material(radius=0.1, samples=8):
-    """A white Diffuse BSDF whose Normal is the Bevel node's."""
+def _bevel_material(radius=0.1, samples=8, bumped=False):
+    """A white Diffuse BSDF whose Normal is the Bevel node's (its own Normal a noise bump's when
+    ``bumped``)."""
     material = new_material("Bevel")
     tree = material.node_tree
     tree.nodes.remove(tree.nodes["Principled BSDF"])
@@ -1274,6 +1277,13 @@ def _bevel_material(radius=0.1, samples=8):
     bevel.inputs["Radius"].default_value = radius
     bevel.samples = samples
     tree.links.new(bevel.outputs["Normal"], diffuse.inputs["Normal"])
+    if bumped:
+        noise = tree.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 4.0
+        bump = tree.nodes.new("ShaderNodeBump")
+        bump.inputs["Distance"].default_value = 0.2
+        tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        tree.links.new(bump.outputs["Normal"], bevel.inputs["Normal"])
     return material
 
 
