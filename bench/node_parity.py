@@ -3,7 +3,7 @@
 Renders the scenes tests/blender/test_node_parity.py holds DRT to (the grid of node cases, the
 spheres of the nodes that see the view, the closures' squares, and the scenes compared whole:
 Pointiness, attributes, Object Info, Light Path, Light Falloff, Wireframe, displacement, the
-mirror-ball environment, each sky model this Blender offers and the Ambient Occlusion node's cases) with DRT (seed 0) and Cycles (seeds
+mirror-ball environment, each sky model this Blender offers, the Ambient Occlusion and Bevel nodes' cases) with DRT (seed 0) and Cycles (seeds
 0 and 1), writes docs/node_parity.json, and replaces the page's block between the markers below
 with each case's worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
 A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
@@ -48,6 +48,8 @@ def _whole_scenes() -> dict:
     for name, settings in ns.AO_CASES.items():
         scenes[f"Ambient Occlusion {name}"] = (lambda settings=settings: ns.ambient_occlusion_scene(**settings),
                                                 (0, 0))
+    for name, settings in ns.BEVEL_CASES.items():
+        scenes[f"Bevel {name}"] = (lambda settings=settings: ns.bevel_scene(**settings), (0, 0))
     for name, props in sky_scenes.CASES.items():
         if sky_scenes.offered(props["sky_type"]):
             scenes[f"Sky Texture {name}"] = (lambda props=props: sky_scenes.sky_scene(props), (0, 0))

@@ -55,17 +55,17 @@ def test_every_case_exports_without_a_warning(drt):
 
 
 def test_a_node_left_out_keeps_its_one_warning(drt):
-    """Bevel still has no handler: the socket it feeds keeps its value, with one warning naming it."""
+    """Point Info still has no handler: the socket it feeds keeps its value, with one warning naming it."""
     scene = ns.grid_scene(ns.CASES[:1])
-    mat = new_material("Bevel")  # Bevel -> Fresnel's IOR -> Principled roughness
+    mat = new_material("Point Info")  # Point Info -> Fresnel's IOR -> Principled roughness
     tree = mat.node_tree
-    bevel = tree.nodes.new("ShaderNodeBevel")
+    info = tree.nodes.new("ShaderNodePointInfo")
     fresnel = tree.nodes.new("ShaderNodeFresnel")
-    tree.links.new(bevel.outputs["Normal"], fresnel.inputs["IOR"])
+    tree.links.new(info.outputs["Radius"], fresnel.inputs["IOR"])
     tree.links.new(fresnel.outputs[0], tree.nodes["Principled BSDF"].inputs["Roughness"])
     scene.objects[ns.CASES[0].name].data.materials[0] = mat
     warnings = _cannot(render_export(scene))
-    assert len(warnings) == 1 and "Bevel" in warnings[0] and "Fresnel" not in warnings[0], warnings
+    assert len(warnings) == 1 and "Point Info" in warnings[0] and "Fresnel" not in warnings[0], warnings
 
 
 @pytest.mark.parametrize("index", range(len(ns.CASES)), ids=[c.name for c in ns.CASES])

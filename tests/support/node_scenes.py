@@ -1253,3 +1253,55 @@ def ambient_occlusion_scene(**settings):
     sphere.scale = (0.6, 0.6, 0.6)
     sphere.location = (0.9, -0.2, 0.6)
     return scene
+
+
+BEVEL_CASES = {
+    "default": {},
+    "wide": {"radius": 0.2, "samples": 16},
+    "bumped": {"bumped": True},
+}
+"""The Bevel node's settings compared with Cycles: Radius 0.1 with 8 samples, 0.2 with 16, and
+the node's Normal linked (a Bump of a Noise Texture, whose turn the node keeps)."""
+
+
+def _bevel_material(radius=0.1, samples=8, bumped=False):
+    """A white Diffuse BSDF whose Normal is the Bevel node's (its own Normal a noise bump's when
+    ``bumped``)."""
+    material = new_material("Bevel")
+    tree = material.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    tree.links.new(diffuse.outputs["BSDF"], tree.nodes["Material Output"].inputs["Surface"])
+    bevel = tree.nodes.new("ShaderNodeBevel")
+    bevel.inputs["Radius"].default_value = radius
+    bevel.samples = samples
+    tree.links.new(bevel.outputs["Normal"], diffuse.inputs["Normal"])
+    if bumped:
+        noise = tree.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 4.0
+        bump = tree.nodes.new("ShaderNodeBump")
+        bump.inputs["Distance"].default_value = 0.2
+        tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
+        tree.links.new(bump.outputs["Normal"], bevel.inputs["Normal"])
+    return material
+
+
+def bevel_scene(**settings):
+    """A 1 m cube turned about z and a flat-shaded cylinder (24 sides, radius 0.5, 1 m high), sharp
+    edged, of one Diffuse material whose Normal is the Bevel node's with ``settings`` (BEVEL_CASES),
+    lit by a sun at an angle under a black world: the edges the node rounds catch the light."""
+    scene = ps._scene(64, 48)
+    ps.aim(scene.camera, (2.6, -3.6, 2.6))
+    scene.camera.data.lens = 50.0
+    ps.black_world(scene)
+    material = _bevel_material(**settings)
+    ps.add_primitive(bpy.ops.mesh.primitive_cube_add, material, "Cube", size=1.0, location=(-0.55, 0.35, 0.0),
+                     rotation=(0.0, 0.0, 0.5))
+    ps.add_primitive(bpy.ops.mesh.primitive_cylinder_add, material, "Cylinder", vertices=24, radius=0.5,
+                     depth=1.0, location=(0.65, -0.45, 0.0))
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    ps.aim(sun, (-1.0, -3.0, 2.0))
+    scene.collection.objects.link(sun)
+    return scene

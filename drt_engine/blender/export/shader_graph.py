@@ -669,6 +669,12 @@ class Compiler:
         i = self.op("ao", args, samples=int(node.samples), inside=bool(node.inside), only_local=bool(node.only_local))
         return i, 0 if output.identifier == "Color" else 1
 
+    def _node_ShaderNodeBevel(self, node, output):
+        """Normal: the normals of the hit's own object within Radius, averaged as Cycles' svm_bevel
+        (core.shading.bevel; the shading normal in the world, where Cycles has no object)."""
+        return self.op("bevel", [self._in(node, "Radius", "float")] + self._normal_in(node),
+                       samples=int(node.samples)), 0
+
     def _node_ShaderNodeBrightContrast(self, node, output):
         args = (self._in(node, "Color", "color"), self._in(node, "Bright", "float"),
                 self._in(node, "Contrast", "float"))

@@ -348,7 +348,8 @@ class Geometry:
     @property
     def local_scenes(self) -> tuple[np.ndarray, np.ndarray]:
         """Per mesh row, its own Embree scene's handle and the object-space pivot its vertices are
-        relative to: rays against one object alone (the Ambient Occlusion node's Only Local)."""
+        relative to: rays against one object alone (the Ambient Occlusion node's Only Local, the Bevel
+        node; ``object_ray`` carries a world ray there)."""
         handles = np.array([ms.scene.handle for ms in self._mesh_list], np.int64)
         pivots = np.array([ms.pivot for ms in self._mesh_list], np.float64).reshape(-1, 3)
         return handles, pivots
@@ -445,6 +446,21 @@ def instance_frame(geo, i, time, frame):
                 frame[1, r, c] = inverse[i, r, c]
     else:
         _moving_frame(geo[10], geo[11], geo[12], geo[9][i, 0], count, time, frame)
+
+
+@kernel(inline="always")
+def object_ray(frame, pivots, row, ox, oy, oz, dx, dy, dz):
+    """A world ray carried into the object whose world-to-object transform is ``frame[1]``, in its
+    mesh's own Embree scene (vertices relative to ``pivots[row]``, see ``Geometry.local_scenes``):
+    origin and direction there, distances along it the same as in the world."""
+    m = frame[1]
+    px = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3] - pivots[row, 0]
+    py = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3] - pivots[row, 1]
+    pz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3] - pivots[row, 2]
+    ex = m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz
+    ey = m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz
+    ez = m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz
+    return px, py, pz, ex, ey, ez
 
 
 @kernel

@@ -35,6 +35,7 @@ from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
+from ..shading.bevel import bevels
 from ..shading.occlusion import OcclusionRays, traces
 from ..shading.surface import SurfaceContext
 from .aovs import ShaderAOVs, reach_scale
@@ -139,7 +140,7 @@ class Integrator:
         self.ratio = frozenset(plan.ratio)
         self.light_path = reads_light_path(scene.world.program) or any(
             reads_light_path(m.material.program) for m in prepared.shading)
-        # the Ambient Occlusion node's rays, from the surfaces paths hit (core.shading.occlusion)
+        # the Ambient Occlusion and Bevel nodes' rays, from the surfaces paths hit (core.shading.occlusion)
         self.occlusion = any(traces(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
@@ -154,6 +155,8 @@ class Integrator:
         # Filter Glossy (core.bsdf.blur): paths carry their least bounce density only when it is on and
         # some material has lobes it blurs
         self.filter_glossy = settings.filter_glossy if any(sh.blurs for sh in prepared.shaders) else 0.0
+        # the Bevel node (core.shading.bevel) also reads that density: Cycles bevels no blurry path
+        self.min_pdf = self.filter_glossy > 0 or any(bevels(m.material.program) for m in prepared.shading)
         # transparent shadows when some material lets shadow rays through (the plan lists them)
         self.shadows = None
         if plan.see_through:
@@ -239,7 +242,7 @@ class Integrator:
                 order = np.argsort(mat, kind="stable")
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
-            occlusion = self._occlusion(surf, samples, sampler, depth)
+            occlusion = self._occlusion(surf, state, samples, sampler, depth)
             self._emission_seen(surf, state, hits, out, occlusion)
             if self.aovs is not None:
                 self._shader_aovs(surf, hits, out, occlusion)
@@ -304,7 +307,7 @@ class Integrator:
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
                           bounces=camera_bounces(n) if self.carried else None,
                           mis_origin=cam.origins if self.shadows is not None else None,
-                          min_pdf=np.full(n, np.inf) if self.filter_glossy > 0 else None)
+                          min_pdf=np.full(n, np.inf) if self.min_pdf else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray | None:
@@ -371,14 +374,16 @@ class Integrator:
                                straight=state.straight[rows], time=state.time[rows],
                                bounces=None if state.bounces is None else state.bounces[rows])
 
-    def _occlusion(self, surf: SurfaceHits, samples: Samples, sampler, depth: int) -> OcclusionRays | None:
-        """The Ambient Occlusion node's rays from the hits ``surf`` of this depth (None when no
-        material has the node)."""
+    def _occlusion(self, surf: SurfaceHits, state: PathState, samples: Samples, sampler,
+                   depth: int) -> OcclusionRays | None:
+        """The Ambient Occlusion and Bevel nodes' rays from the hits ``surf`` of this depth (None when
+        no material has either node)."""
         if not self.occlusion:
             return None
         return OcclusionRays(self.geometry, sampler, samples.pixel[surf.path], samples.sample[surf.path], depth,
                              surf.pos, surf.ng, surf.scale, surf.prim, surf.time if self.timed else None, surf.ns,
-                             lambda n: self._count("occlusion", n))
+                             lambda n: self._count("occlusion", n),
+                             None if state.min_pdf is None else state.min_pdf[surf.row])
 
     def _emission_seen(self, surf: SurfaceHits, state: PathState, hits, out: WaveOutput,
                        occlusion: OcclusionRays | None = None):

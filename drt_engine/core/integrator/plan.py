@@ -78,7 +78,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
             "refraction": bounces and "glass" in kinds,
             "transparent": bounces and "transparent" in kinds,
             "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS)),
-            "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion nodes
+            "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion and Bevel nodes
 
     strategies = []
     for light in lights.lights[:lights.light_slots] if not lights.selecting else []:

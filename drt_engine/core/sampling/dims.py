@@ -11,7 +11,10 @@ same when the scene changes. The layout:
   light or triangle) at a dimension hashed from the strategy's identity (a light's kind and
   name, "emissive", "world", a selection slot) and the depth, above every path dimension;
 - the Ambient Occlusion node, per depth: one 2D dimension per ray (up to 128), in a block of 256
-  above every light block.
+  above every light block;
+- the Bevel node, per depth: one 2D dimension above every Ambient Occlusion block (depths below
+  65536), its disk samples drawn at consecutive sample ids (Cycles' branched samples, so a hit's
+  disk samples are stratified together).
 
 So adding a light leaves every other light's numbers, and the path's, as they were.
 Sobol pairs past the first four dimensions are independently scrambled padding (see
@@ -29,6 +32,7 @@ _LIGHT_BASE = 1 << 24  # above any path dimension (depth < 4 million)
 _LIGHT_BLOCKS = 1 << 22  # hashed blocks of 4 dimensions: room for lights x depths without collisions
 _AO_BASE = _LIGHT_BASE + 4 * _LIGHT_BLOCKS  # above every light block
 _AO_STRIDE = 256  # 2D dimensions for the node's 128 rays at most
+_BEVEL_BASE = _AO_BASE + _AO_STRIDE * (1 << 16)  # above the AO blocks of every depth below 65536
 
 
 def lobe(depth: int) -> int:
@@ -45,6 +49,12 @@ def lobe_choice(depth: int) -> int:
 def ao(depth: int, ray: int) -> int:
     """2D: the direction of the Ambient Occlusion node's ray ``ray`` at a hit of this depth."""
     return _AO_BASE + _AO_STRIDE * depth + 2 * ray
+
+
+def bevel(depth: int) -> int:
+    """2D: the axis and point on the disk of the Bevel node's samples at a hit of this depth; sample k
+    of S draws at sample id ``S * id + k`` (Cycles' path_branched_rng_2D)."""
+    return _BEVEL_BASE + 2 * depth
 
 
 def strategy_keys(lights) -> list[str]:

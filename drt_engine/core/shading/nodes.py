@@ -431,6 +431,13 @@ class Evaluator:
             ao = self.ctx.ambient_occlusion(x[2] if len(x) > 2 else None, x[1], p["samples"], p["inside"],
                                             p["only_local"])
             return x[0] * ao[:, None], ao
+        if op == "bevel":  # radius and, when linked, a normal: Cycles' svm_node_bevel keeps that normal's turn
+            normal = self.ctx.bevel(x[0], p["samples"])
+            if len(x) > 1:
+                turned = x[1] + (normal - self.ctx.normal)
+                length = np.linalg.norm(turned, axis=1, keepdims=True)
+                normal = turned / np.where(length > 0, length, 1.0)
+            return (normal,)
         if op == "backfacing":
             return (self.ctx.backfacing().astype(float),)
         if op == "light_path":
@@ -743,6 +750,9 @@ class DirectionContext:
 
     def ambient_occlusion(self, normal, distance, samples, inside, only_local):
         return np.ones(self.n)  # the world has no object: Cycles' svm_ao gives 1
+
+    def bevel(self, radius, samples):
+        return np.array(self.normal, float)  # the world has no object: Cycles' svm_bevel gives sd->N
 
     def object_matrix(self):
         return None  # the world has no object (Cycles' is_object is false there)

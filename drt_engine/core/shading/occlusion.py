@@ -22,8 +22,9 @@ import numpy as np
 from ..base.jit import kernel
 from ..base.warps import concentric_disk
 from ..geometry import embree
-from ..geometry.accel import blocked, instance_frame, instance_of, spawn_point
+from ..geometry.accel import blocked, instance_frame, instance_of, object_ray, spawn_point
 from ..sampling import dims as D
+from .bevel import bevel_normals
 
 MAX_SAMPLES = 128
 """Blender's limit on the node's Samples (core.sampling.dims reserves that many pairs per depth)."""
@@ -31,9 +32,10 @@ MAX_SAMPLES = 128
 
 @dataclass
 class OcclusionRays:
-    """What AO rays from a batch of shading points need: the scene (``geometry``, core.geometry.accel),
+    """What the rays a shader traces from a batch of its points (the Ambient Occlusion node's here, the
+    Bevel node's in core.shading.bevel) need: the scene (``geometry``, core.geometry.accel),
     the path's ``sampler`` with each point's pixel, sample id and depth, the point, its geometric
-    normal, offset scale, triangle and time, and ``normal`` the shading normal facing the ray
+    normal facing the ray, offset scale, triangle and time, and ``normal`` the shading normal facing the ray
     (Cycles' sd->N, the node's default Normal); ``count`` is told how many rays each call traces."""
 
     geometry: object
@@ -48,11 +50,17 @@ class OcclusionRays:
     time: np.ndarray | None
     normal: np.ndarray
     count: Callable[[int], None] | None = None  # told how many rays each call traces
+    min_pdf: np.ndarray | None = None  # the paths' least bounce density (Cycles' min_ray_pdf; None: not kept)
 
     def take(self, rows) -> "OcclusionRays":
         return OcclusionRays(self.geometry, self.sampler, self.pixel[rows], self.sample[rows], self.depth,
                              self.pos[rows], self.ng[rows], self.scale[rows], self.prim[rows],
-                             None if self.time is None else self.time[rows], self.normal[rows], self.count)
+                             None if self.time is None else self.time[rows], self.normal[rows], self.count,
+                             None if self.min_pdf is None else self.min_pdf[rows])
+
+    def bevel(self, radius, samples: int) -> np.ndarray:
+        """(N, 3) the Bevel node's normal for ``radius`` (core.shading.bevel)."""
+        return bevel_normals(self, radius, samples)
 
     def unoccluded(self, normal, distance, samples: int, inside: bool, only_local: bool) -> np.ndarray:
         """(N,) AO: the share of the rays about ``normal`` (None: the shading normal) that reach
@@ -81,8 +89,9 @@ class OcclusionRays:
 
 
 def traces(program) -> bool:
-    """Whether a shader program has an Ambient Occlusion node (its hits then need ``OcclusionRays``)."""
-    return program is not None and any(node.op == "ao" for node in program.nodes)
+    """Whether a shader program has an Ambient Occlusion or a Bevel node (its hits then need
+    ``OcclusionRays``)."""
+    return program is not None and any(node.op in ("ao", "bevel") for node in program.nodes)
 
 
 def _c(a):
@@ -134,13 +143,6 @@ def _unoccluded(scene, geo, mask, handles, pivots, local, pos, ng, scale, prim, 
 @kernel(inline="always")
 def _blocked_in_object(handle, pivots, row, frame, rayhit, ox, oy, oz, dx, dy, dz, tmax, time):
     """Whether the object whose world-to-object transform is ``frame[1]`` lies on the world ray
-    before tmax: the ray carried into its mesh's scene (vertices relative to ``pivots[row]``), where
-    distances along it stay the same."""
-    m = frame[1]
-    px = m[0, 0] * ox + m[0, 1] * oy + m[0, 2] * oz + m[0, 3] - pivots[row, 0]
-    py = m[1, 0] * ox + m[1, 1] * oy + m[1, 2] * oz + m[1, 3] - pivots[row, 1]
-    pz = m[2, 0] * ox + m[2, 1] * oy + m[2, 2] * oz + m[2, 3] - pivots[row, 2]
-    ex = m[0, 0] * dx + m[0, 1] * dy + m[0, 2] * dz
-    ey = m[1, 0] * dx + m[1, 1] * dy + m[1, 2] * dz
-    ez = m[2, 0] * dx + m[2, 1] * dy + m[2, 2] * dz
+    before tmax (the ray carried into its mesh's scene)."""
+    px, py, pz, ex, ey, ez = object_ray(frame, pivots, row, ox, oy, oz, dx, dy, dz)
     return embree.occluded1(handle, rayhit, px, py, pz, ex, ey, ez, 0.0, min(tmax, 3.0e38), time, -1)

@@ -117,6 +117,12 @@ class SurfaceContext:
             return np.ones(self.n)
         return self.occlusion.unoccluded(normal, distance, samples, inside, only_local)
 
+    def bevel(self, radius, samples):
+        """(N, 3) the Bevel node's normal (core.shading.bevel); the shading normal where no rays are traced."""
+        if self.occlusion is None:
+            return np.array(self.normal, float)
+        return self.occlusion.bevel(radius, samples)
+
     def instance_attribute(self, key):
         """(N, 4) RGBA of an Object or Instancer attribute of each hit's object (0 where it has none)."""
         return self.attrs.instance_attribute(self.prim, key)
