@@ -48,7 +48,9 @@ def clamped(c0, c1, c2, limit):
 
 
 def clamp_rows(e: np.ndarray, limit: np.ndarray) -> np.ndarray:
-    """``clamped`` over rows of contributions (N, 3)."""
+    """``clamped`` over rows of contributions (N, 3) and ``row_limits``' limits (``UNCLAMPED``: as they are)."""
+    if len(limit) == 0:
+        return e
     total = np.abs(e).sum(axis=1)
     over = total > limit
     if not over.any():

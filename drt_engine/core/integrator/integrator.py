@@ -310,10 +310,10 @@ class Integrator:
                           min_pdf=np.full(n, np.inf) if self.min_pdf else None)
         return state, cam
 
-    def _limits(self, straight: np.ndarray) -> np.ndarray | None:
+    def _limits(self, straight: np.ndarray) -> np.ndarray:
         """The clamp limit of each contribution of paths ``straight`` or not (direct: before their
-        first bounce), None when nothing is clamped."""
-        return row_limits(self.clamp, straight) if self.clamping else None
+        first bounce; core.integrator.clamp.row_limits, ``UNCLAMPED`` when nothing is clamped)."""
+        return row_limits(self.clamp, straight)
 
     def _group(self, group) -> np.ndarray | None:
         """The wave's light group columns of the emitters in the scene light groups ``group()``

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
-from .clamp import clamp_rows
+from .clamp import UNCLAMPED, clamp_rows
 
 
 @kernel(inline="always")
@@ -30,13 +30,13 @@ def power_heuristic(a, b):
     return out
 
 
-def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf, limit=None, group=None):
+def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf, limit=UNCLAMPED, group=None):
     """Emission a BSDF-sampled ray found, any emitter: weighted by the power heuristic against
     light sampling where both could have produced the direction (``light_pdf(rows)``, the
     light-sampling density of those rows' directions; None if light sampling never picks this
     emitter; camera rays and delta lobes, prev_pdf = inf, take it whole). Adds it to the wave's
     radiance and denoising features (``out``, the wave's WaveOutput) and returns throughput x
-    weighted emission, each row clamped to its ``limit`` (core.integrator.clamp; None: no clamping),
+    weighted emission, each row clamped to its ``limit`` (core.integrator.clamp.row_limits),
     also added to each row's light group column ``group`` of ``out.grouped`` (-1: none;
     core.integrator.lightgroups)."""
     weight = np.ones(len(path))
@@ -44,8 +44,7 @@ def add_emitted(out, path, throughput, emitted, prev_pdf, light_pdf, limit=None,
     if len(smooth) and light_pdf is not None:
         weight[smooth] = power_heuristic(prev_pdf[smooth], light_pdf(smooth))
     e = throughput * emitted * weight[:, None]
-    if limit is not None:
-        e = clamp_rows(e, limit)
+    e = clamp_rows(e, limit)
     out.radiance[path] += e
     if group is not None and out.grouped is not None:
         rows = np.flatnonzero(group >= 0)
