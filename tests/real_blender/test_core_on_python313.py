@@ -21,7 +21,7 @@ def test_core_tests_pass_on_python313_numpy22_with_warnings_as_errors(installed,
     shutil.copy(REPO / "tests" / "conftest.py", copy / "tests")
     done = env.run("env", f"PYTHONPATH={SITE_PACKAGES}", "sh", "-c",
                    f"cd {env.inside(copy)} && python3 -c 'import sys, numpy; print(sys.version.split()[0], numpy.__version__)'"
-                   " && python3 -m pytest tests/core -q -p no:cacheprovider -W error", timeout=900)
+                   " && python3 -m pytest tests/core -q -p no:cacheprovider -W error", timeout=1800)
     versions = done.stdout.splitlines()[0].split()
     summary = re.findall(r"^=*\s*(\d+ passed.*?)\s*=*$", done.stdout, re.MULTILINE)
     measured["core_on_python313"] = {"python": versions[0], "numpy": versions[1], "summary": summary}
