@@ -92,7 +92,7 @@ def kernel(fn=None, **options):
 
     def compile_(f):
         dispatcher = numba.njit(**opts)(f)
-        if opts["cache"]:
+        if opts["cache"] and not numba.config.DISABLE_JIT:  # NUMBA_DISABLE_JIT: the plain function
             dispatcher._cache = _SharedFolderCache(dispatcher.py_func)
         return dispatcher
 
