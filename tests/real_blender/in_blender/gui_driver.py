@@ -29,6 +29,9 @@ from mathutils import Quaternion
 OUT = Path(sys.argv[sys.argv.index("--") + 1])
 RENDER_TIMEOUT = 120.0
 """Seconds the F12 render and each viewport render may take at most."""
+FIRST_PREVIEW_TIMEOUT = 600.0
+"""Seconds the slot icons may take: the first preview compiles the kernels the preview scene needs
+and the Cornell box (compiled before the session) does not (139 s seen on 2 loaded cores)."""
 F12_SIZE = 256
 VIEWPORT_SAMPLES = 4
 """Viewport samples while the GUI session waits for viewport renders to finish."""
@@ -280,7 +283,8 @@ def steps():
     for slot in material_object.material_slots:
         slot.material.preview_ensure().reload()
     props.tag_redraw()
-    yield from wait_for_previews(lambda size: size[0] <= 32, icons_before + len(material_object.material_slots))
+    yield from wait_for_previews(lambda size: size[0] <= 32, icons_before + len(material_object.material_slots),
+                                 FIRST_PREVIEW_TIMEOUT)
     state["material_icons"] = {}
     for slot in material_object.material_slots:
         preview = slot.material.preview
@@ -385,10 +389,10 @@ def measure_viewport(window, view3d, scene):
     yield 1.0
 
 
-def wait_for_previews(fits, count: int):
-    """Yield until ``count`` preview renders whose size ``fits`` are logged (or the timeout)."""
+def wait_for_previews(fits, count: int, timeout: float = RENDER_TIMEOUT):
+    """Yield until ``count`` preview renders whose size ``fits`` are logged (or ``timeout``)."""
     since = time.monotonic()
-    while time.monotonic() - since < RENDER_TIMEOUT:
+    while time.monotonic() - since < timeout:
         if sum(1 for r in state["renders"] if r["preview"] and fits(r["size"])) >= count:
             return
         yield 0.5
