@@ -14,6 +14,7 @@ of Cycles' consecutive (stratified) sample ids, Radius 0.1 was 0.0145: the norma
 linear in its samples."""
 from __future__ import annotations
 
+import bpy
 import pytest
 
 from tests.support import node_scenes as ns
@@ -27,6 +28,9 @@ CASES = ns.BEVEL_CASES
 
 @pytest.mark.parametrize("case", CASES)
 def test_bevel_matches_cycles(drt, tmp_path, case):
+    if CASES[case].get("bumped") and bpy.app.version < (5, 0, 0):
+        pytest.skip("Blender 4.2's Bump node has no Filter Width and bumps otherwise (as in "
+                    "test_bump_shadowing_cycles): this case measured 0.028 against a limit of 0.0071 under 4.2")
     scene = ns.bevel_scene(**CASES[case])
     cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, case)
     tree = scene.objects["Cube"].active_material.node_tree
