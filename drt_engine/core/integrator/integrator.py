@@ -26,6 +26,7 @@ from ..base.vectors import Frame
 from ..bsdf.blur import blur_roughness
 from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
+from ..bsdf.specular_normal import valid_specular_reflection
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
@@ -370,7 +371,8 @@ class Integrator:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
         facing the ray (core.integrator.hits)."""
         return surface_records(self.geometry, hits.prim, hits.u, hits.v, ray_times, rows, state.dirs,
-                               path=state.path[rows], mat=mat, throughput=state.throughput[rows],
+                               self.prepared.keeps_normal, path=state.path[rows], mat=mat,
+                               throughput=state.throughput[rows],
                                straight=state.straight[rows], time=state.time[rows],
                                bounces=None if state.bounces is None else state.bounces[rows])
 
@@ -523,7 +525,7 @@ class Integrator:
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo), smooth=smooth)
             for sub, shader in groups:
                 taken = group.take(sub)
-                if facing_away is not None and shader.lambertian and not shader.sampled:
+                if facing_away is not None and shader.keeps_normal:
                     taken = _about(taken, facing_away[sub])
                 yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
 
@@ -699,27 +701,3 @@ def _coat_turned(shader, hits: SurfaceHits):
     nc = valid_specular_reflection(ng, hits.wo, nc)
     nc = np.where((vec.dot(hits.wo, nc) <= 1e-6)[:, None], n, nc)
     return shader.turn_coat(hits.frame.to_local(nc), hits.wo_l)
-
-
-def valid_specular_reflection(ng, wo, n):
-    """Cycles' ensure_valid_specular_reflection (kernel/closure/bsdf_util.h) over rows: where wo
-    mirrored about the shading normal ``n`` leaves below min(0.9 cos(wo, ng), 0.01) of the
-    geometric normal ``ng`` (facing wo), ``n`` turned toward ``ng`` in their plane just enough
-    that the mirror image leaves at that threshold."""
-    r = 2.0 * vec.dot(n, wo)[:, None] * n - wo
-    iz = vec.dot(wo, ng)
-    threshold = np.minimum(0.9 * iz, 0.01)
-    bad = vec.dot(ng, r) < threshold
-    if not np.any(bad):
-        return n
-    x = n - vec.dot(n, ng)[:, None] * ng
-    length = vec.norm(x)
-    x = np.where((length > 1e-20)[:, None], x / np.maximum(length, 1e-20)[:, None], n)
-    ix = vec.dot(wo, x)
-    a = ix * ix + iz * iz
-    b = 2.0 * (a + iz * threshold)
-    c = (threshold + iz) ** 2
-    root = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
-    nz2 = 0.25 * np.where(ix < 0, b + root, b - root) / np.maximum(a, 1e-30)
-    raised = np.sqrt(np.maximum(1.0 - nz2, 0.0))[:, None] * x + np.sqrt(np.maximum(nz2, 0.0))[:, None] * ng
-    return np.where(bad[:, None], raised, n)
