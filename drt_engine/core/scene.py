@@ -250,10 +250,15 @@ class Instance:
     an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
     lightgroup: int = -1
     """The light group its emission counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    motion_pass: np.ndarray | None = None
+    """For the Vector pass: object-to-world (2, 4, 4) at the previous and the next frame (None: it
+    stands still there, or the pass is off)."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+        if self.motion_pass is not None:
+            self.motion_pass = np.asarray(self.motion_pass, dtype=np.float64).reshape(2, 4, 4)
 
     @property
     def matrix(self) -> np.ndarray:
@@ -422,9 +427,14 @@ class Camera:
     rolling_shutter: float | None = None
     """Rolling shutter (rows read from the top down over the shutter): Cycles' rolling shutter
     duration, None when off."""
+    motion_pass: np.ndarray | None = None
+    """For the Vector pass: camera-to-world (2, 4, 4) at the previous and the next frame (None: it
+    stands still there, or the pass is off)."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+        if self.motion_pass is not None:
+            self.motion_pass = np.asarray(self.motion_pass, dtype=np.float64).reshape(2, 4, 4)
         w, h = (int(v) for v in self.resolution)
         if w < 1 or h < 1:
             raise ValueError(f"camera resolution must be positive, got {w}x{h}")
