@@ -37,8 +37,8 @@ def export_scene(
     """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
 
     With ``frame_set`` (the render engine's) and motion blur on, motion over the
-    shutter is sampled too; with the Vector pass on instead, the previous and next frames. ``meshes`` (the viewport's) keeps meshes between exports: one
-    found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
+    shutter is sampled too; with the Vector pass on instead, the previous and next frames.
+    ``meshes`` (the viewport's) keeps meshes between exports: one found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
     and ``RenderCancelled`` when ``cancel()`` returns True.
     """
     scene = depsgraph.scene
