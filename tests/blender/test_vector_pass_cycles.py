@@ -134,3 +134,42 @@ def test_cycles_pass_is_zero_under_motion_blur(drt, tmp_path):
     vector = rh.render(vector_scene(motion_blur=True), "CYCLES", 4, 0, tmp_path, passes=("Vector",),
                        name="blur").passes["Vector"]
     assert np.all(vector == 0.0)
+
+
+def deforming_scene():
+    """A still camera over a grid whose shape key shears and bends it, its value 0, 0.3 and 1 at
+    frames 1 to 3: only the vertices move (the pass would be 0 without them)."""
+    scene = ps._scene(WIDTH, HEIGHT)
+    ps.aim(scene.camera, (0.0, -6.0, 4.0))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=12, size=5.0)
+    grid = bpy.context.active_object
+    grid.data.materials.append(new_material("Grid"))
+    grid.shape_key_add(name="Basis")
+    key = grid.shape_key_add(name="Shear")
+    for point in key.data:
+        x, y, _ = point.co
+        point.co = (x + 0.4 * y, y, 0.3 * x * x)
+    for frame, value in ((1, 0.0), (2, 0.3), (3, 1.0)):
+        key.value = value
+        key.keyframe_insert("value", frame=frame)
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    scene.collection.objects.link(sun)
+    scene.frame_set(2)
+    return scene
+
+
+def test_deforming_mesh_matches_cycles(drt, tmp_path):
+    scene = deforming_scene()
+    scene.view_layers[0].use_pass_vector = True
+    data = _export(scene)
+    assert sum(mesh.motion_pass_vertices is not None for mesh in data.meshes) == 1
+    assert all(inst.motion_pass is None for inst in data.instances) and data.camera.motion_pass is None
+    drt_v, c0, c1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, passes=("Vector",), name="deform")
+                     .passes["Vector"] for engine, seed in ps.RUNS]
+    figures, pixels = ps.parity(drt_v, c0, c1), per_pixel(drt_v, c0, c1)
+    still = ps.parity(np.zeros_like(drt_v), c0, c1)
+    print(f"Vector deforming: blocks {figures}; per pixel {pixels}; without the vertices' motion {still}")
+    assert figures["ok"], ps.message("Vector deforming", figures)
+    assert pixels["ok"], pixels
+    assert not still["ok"] and still["worst"] > 5 * still["limit"]

@@ -8,7 +8,7 @@ import pytest
 from drt_engine.core.film import parts
 from drt_engine.core.geometry.motion_vectors import MotionVectors
 from drt_engine.core.render import merge
-from drt_engine.core.scene import Camera, Instance
+from drt_engine.core.scene import Camera, Instance, Mesh
 from tests.core.test_mist_index import RES, render
 from tests.core.test_mist_index import scene as quads
 from tests.core.test_mist_index import settings as mist_settings
@@ -53,6 +53,20 @@ def test_a_moving_camera_sees_the_opposite_motion():
 def test_nothing_moves_gives_exactly_zero():
     points = np.random.default_rng(1).normal(size=(64, 3)) - [0, 0, 5]
     assert np.all(MotionVectors(perspective(), [Instance(0, np.eye(4))]).vectors(points, np.zeros(64, int)) == 0)
+
+
+def test_a_deforming_mesh_carries_its_points_with_its_vertices():
+    """A point at barycentric (0.2, 0.3, 0.5) of a triangle whose corners move differently lands at
+    the same place among the moved corners (the object moved too: its transform there applies)."""
+    tri = np.array([[-1.0, -1.0, -DEPTH], [1.0, -1.0, -DEPTH], [0.0, 1.0, -DEPTH]])
+    shift = np.array([[[0.1, 0, 0], [0.3, 0.2, 0], [0, 0, 0]], [[-0.4, 0, 0], [0, 0.5, 0], [0.2, 0, 0]]])
+    mesh = Mesh("tri", tri, [[0, 1, 2]], [0], motion_pass_vertices=tri + shift)
+    weights = np.array([0.2, 0.3, 0.5])
+    point = (weights @ tri)[None]
+    v = MotionVectors(perspective(), [moving(0.25, 0.0)], [mesh]).vectors(point, np.array([0]), np.array([0]))[0]
+    pre, post = weights @ shift[0] + [0.25, 0, 0], weights @ shift[1]
+    scale = 16.0 / DEPTH
+    assert np.allclose(v, [pre[0] * scale, pre[1] * scale, -post[0] * scale, -post[1] * scale], rtol=1e-9)
 
 
 def test_orthographic_scale():

@@ -205,9 +205,10 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
 def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], None], instance_keys: list,
                     camera_name: str) -> None:
     """For the Vector pass, each instance's and the camera's transforms at the previous and the next
-    frame (Cycles' motion for passes: frame -1 and +1 when motion blur is off; with it on Cycles' pass
-    is 0, and so is DRT's without them). Meshes whose vertices move between frames get their object's
-    motion only: named in the render's warning."""
+    frame, and the vertices there of meshes that deform (Cycles' motion for passes: frame -1 and +1
+    when motion blur is off; with it on Cycles' pass is 0, and so is DRT's without them). As for
+    motion blur, a mesh's vertices are read when one object uses it, its Deformation switch is on and
+    its vertex count stays (Cycles keeps no vertex motion otherwise)."""
     scene = depsgraph.scene
     if not depsgraph.view_layer.use_pass_vector or scene.render.use_motion_blur:
         return
@@ -216,7 +217,7 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
     matrices = np.zeros((len(instance_keys), 2, 4, 4))
     seen = np.zeros((len(instance_keys), 2), bool)
     camera = np.repeat(scene_data.camera.matrix[None], 2, 0)
-    deforming: set[str] = set()
+    vertices: dict[int, list] = {}  # mesh -> its vertices at the previous and the next frame
     frame, subframe = scene.frame_current, scene.frame_subframe
     try:
         for k, step in enumerate((-1, 1)):
@@ -227,11 +228,11 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
                     continue
                 matrices[i, k] = np.array(instance.matrix_world, dtype=np.float64)
                 seen[i, k] = True
-                mesh = scene_data.meshes[scene_data.instances[i].mesh]
-                if users[scene_data.instances[i].mesh] == 1 and deforms_in_motion(instance.object.original):
+                mesh_index = scene_data.instances[i].mesh
+                if users[mesh_index] == 1 and deforms_in_motion(instance.object.original):
                     v = _vertices(instance.object)
-                    if v is not None and len(v) == len(mesh.vertices) and not np.allclose(v, mesh.vertices):
-                        deforming.add(instance.object.original.name)
+                    if v is not None and len(v) == len(scene_data.meshes[mesh_index].vertices):
+                        vertices.setdefault(mesh_index, [None, None])[k] = v
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:
                 camera[k] = without_scale(cam.matrix_world)
@@ -242,8 +243,8 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
             inst.motion_pass = matrices[i]
     if not np.allclose(camera, scene_data.camera.matrix[None]):
         scene_data.camera.motion_pass = camera
-    if deforming:
-        names = sorted(deforming)
-        shown = ", ".join(f"'{name}'" for name in names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
-        scene_data.warnings.append(f"Vector pass: the deformation of {shown} between frames is not written "
-                                   "(only the objects' and the camera's motion)")
+    for mesh_index, (pre, post) in vertices.items():
+        mesh = scene_data.meshes[mesh_index]
+        if pre is not None and post is not None and not (np.allclose(pre, mesh.vertices)
+                                                         and np.allclose(post, mesh.vertices)):
+            mesh.motion_pass_vertices = np.stack([pre, post])

@@ -147,7 +147,8 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
-        self.motion_vectors = MotionVectors(scene.camera, scene.instances) if "Vector" in settings.passes else None
+        self.motion_vectors = MotionVectors(scene.camera, scene.instances, scene.meshes) \
+            if "Vector" in settings.passes else None
         aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
@@ -452,8 +453,8 @@ class Integrator:
             out.indexed[path] = closed
             if self.motion_vectors is not None and closed.any():
                 rows, path = rows[closed], path[closed]
-                out.aux["Vector"][path, :4] = self.motion_vectors.vectors(
-                    group.pos[rows], self.geometry.source_of(group.prim[rows])[:, 0])
+                source = self.geometry.source_of(group.prim[rows])
+                out.aux["Vector"][path, :4] = self.motion_vectors.vectors(group.pos[rows], source[:, 0], source[:, 1])
                 out.aux["Vector"][path, 4] = 1.0
 
     def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput, occlusion: OcclusionRays | None = None):
