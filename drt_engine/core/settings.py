@@ -27,6 +27,7 @@ PASSES = (
     "Mist",  # Cycles' mist: 0 near, 1 far and for the background, by the world's mist settings
     "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
     "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
+    "Vector",  # Cycles' motion vectors in pixels: to the previous frame's position, from the next's (core.film.vector)
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -44,12 +45,17 @@ PASS_CHANNELS = {
     "Mist": "Z",
     "IndexOB": "X",
     "IndexMA": "X",
+    "Vector": "XYZW",
     "Noisy Image": "RGBA",
 }
 FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
 """Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
 mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
 writes these at sample 0 only, core.film.film)."""
+WEIGHTED_PASSES = ("Vector",)
+"""Passes whose sums carry one more channel, the count of samples that wrote them, and read as the
+sum over it (Cycles' motion weight: a pixel's vector is the mean of its samples that hit a surface,
+the background's samples count for nothing)."""
 AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 """Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
 writes: 1 per sample whose camera path wrote the AOV)."""

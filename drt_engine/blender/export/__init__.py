@@ -19,7 +19,7 @@ from .geometry import GeometryExporter, MeshCache
 from .left_out import LeftOut
 from .lights import export_light
 from .materials import MaterialTable
-from .motion import add_motion, instance_key
+from .motion import add_motion, add_motion_pass, instance_key
 from .shader_graph import ImageTable
 from .world import export_world
 
@@ -37,8 +37,8 @@ def export_scene(
     """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
 
     With ``frame_set`` (the render engine's) and motion blur on, motion over the
-    shutter is sampled too. ``meshes`` (the viewport's) keeps meshes between exports: one
-    found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
+    shutter is sampled too; with the Vector pass on instead, the previous and next frames.
+    ``meshes`` (the viewport's) keeps meshes between exports: one found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
     and ``RenderCancelled`` when ``cancel()`` returns True.
     """
     scene = depsgraph.scene
@@ -91,5 +91,6 @@ def export_scene(
     )
     if frame_set is not None:
         add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)
+        add_motion_pass(scene_data, depsgraph, frame_set, geometry.keys, camera_object.name)
     return scene_data
 

@@ -30,6 +30,7 @@ from ..bsdf.specular_normal import valid_specular_reflection
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
+from ..geometry.motion_vectors import MotionVectors
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
 from ..lights.strategies import LightSamples
@@ -147,6 +148,8 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
+        self.motion_vectors = MotionVectors(scene.camera, scene.instances, scene.meshes) \
+            if "Vector" in settings.passes else None
         aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
@@ -201,6 +204,8 @@ class Integrator:
         aux = {name: np.zeros((n, len(ch))) for name, ch in _AUX if name in s.passes}
         aux.update((name, np.zeros((n, len(AOV_CHANNELS[kind])))) for name, kind in s.aovs)
         aux.update((name, np.zeros((n, 3))) for name in self.group_passes)
+        if self.motion_vectors is not None:
+            aux["Vector"] = np.zeros((n, 5))  # the vector and its weight (core.film.film WEIGHTED_PASSES)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if self.groups is not None:
@@ -209,7 +214,7 @@ class Integrator:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
             out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
-        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None:
+        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None or self.motion_vectors is not None:
             out.indexed = np.zeros(n, bool)
         if self.aovs is not None:
             out.aov_reach = np.ones(n)
@@ -427,7 +432,8 @@ class Integrator:
         """Mist and the index passes at the hits the camera sees directly or through transparency,
         as Cycles' film_write_data_passes: each hit takes (1 - mist) of Mist, weighted by the path's
         throughput times the hit's opacity; an index is the last such hit's until one is at least
-        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film)."""
+        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film);
+        that hit alone writes the Vector pass, with weight 1 (core.geometry.motion_vectors)."""
         rows = np.flatnonzero(group.straight)
         if len(rows) == 0:
             return
@@ -445,7 +451,13 @@ class Integrator:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
             if out.aov_reach is not None:
                 out.aov_reach[path] *= reach_scale(shader, group, rows)
-            out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
+            closed = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
+            out.indexed[path] = closed
+            if self.motion_vectors is not None and closed.any():
+                rows, path = rows[closed], path[closed]
+                source = self.geometry.source_of(group.prim[rows])
+                out.aux["Vector"][path, :4] = self.motion_vectors.vectors(group.pos[rows], source[:, 0], source[:, 1])
+                out.aux["Vector"][path, 4] = 1.0
 
     def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput, occlusion: OcclusionRays | None = None):
         """The materials' AOV Output nodes at the hits the camera sees directly or through
