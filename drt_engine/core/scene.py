@@ -220,6 +220,10 @@ class Mesh:
                            for k, v in self.attributes.items()}
 
 
+LIGHT_SETS_ALL = (1 << 64) - 1
+"""An emitter's light-set membership when it lights every object (no light linking)."""
+
+
 @dataclass
 class Instance:
     """One placement of a mesh: ``mesh`` indexes ``SceneData.meshes``.
@@ -250,6 +254,10 @@ class Instance:
     an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
     lightgroup: int = -1
     """The light group its emission counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    receiver_light_set: int = 0
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking (core.lights.linking): the receiver set the object is in (0: the default) and,
+    for its emission, the sets it lights."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
@@ -310,6 +318,8 @@ class Light:
     name: str = ""
     lightgroup: int = -1
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:
@@ -361,6 +371,8 @@ class World:
     linear 1, inverse quadratic 0.5). The defaults are Cycles' film's, what it uses without a world."""
     lightgroup: int = -1
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
 
     @property
     def visible_lighting(self) -> bool:

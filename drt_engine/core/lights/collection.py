@@ -27,12 +27,13 @@ from ..base.jit import kernel
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..errors import SceneError
 from ..geometry.motion import Motion
-from ..scene import Light, SceneData
+from ..scene import LIGHT_SETS_ALL, Light, SceneData
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
+from .linking import lights as links
 from .strategies import MAP_WORLD, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch
@@ -110,6 +111,7 @@ class Lights:
         self._emitters(geometry, scene)
         self._excludes(scene, geometry)
         self._groups(scene, geometry)
+        self._links(scene)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
@@ -194,6 +196,31 @@ class Lights:
             (self.light_group >= 0).any() or (self.instance_group >= 0).any() or self.world_group >= 0)
         """Some emitter is in a light group."""
 
+    def _links(self, scene: SceneData) -> None:
+        """Light linking (lights.linking): per light and per instance the receiver sets it lights,
+        per instance its own set; ``linking`` only when some emitter leaves some set out."""
+        self.light_membership = np.array([light.light_set_membership for light in self.lights], np.uint64)
+        self.instance_membership = np.array([i.light_set_membership for i in scene.instances], np.uint64)
+        self.instance_receiver = np.array([i.receiver_light_set for i in scene.instances], np.int64)
+        every = np.uint64(LIGHT_SETS_ALL)
+        self.linking = bool((self.light_membership != every).any() or (self.instance_membership != every).any())
+
+    def receivers(self, prim: np.ndarray) -> np.ndarray:
+        """The receiver light sets of the objects of triangles ``prim``."""
+        if len(prim) == 0:
+            return np.zeros(0, np.int64)
+        return self.instance_receiver[self.geometry.source_of(prim)[:, 0]]
+
+    def light_links(self, light_id: np.ndarray, receiver: np.ndarray) -> np.ndarray:
+        """Whether lights ``light_id`` light objects of receiver sets ``receiver``."""
+        return links(self.light_membership[light_id], receiver)
+
+    def triangle_links(self, prim: np.ndarray, receiver: np.ndarray) -> np.ndarray:
+        """Whether emissive triangles ``prim`` light objects of receiver sets ``receiver``."""
+        if len(prim) == 0:
+            return np.zeros(0, bool)
+        return links(self.instance_membership[self.geometry.source_of(prim)[:, 0]], receiver)
+
     def group_of_triangles(self, prim: np.ndarray) -> np.ndarray:
         """The light group of the emissive triangles ``prim`` (their objects')."""
         if len(prim) == 0:
@@ -268,7 +295,8 @@ class Lights:
 
     # -- next-event estimation ----------------------------------------------------
     def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None,
-                   bounces: np.ndarray | None = None, groups: bool = False) -> LightSamples:
+                   bounces: np.ndarray | None = None, groups: bool = False,
+                   receivers: np.ndarray | None = None) -> LightSamples:
         """Every strategy at shading points ``pos`` in one kernel call (lights.strategies);
         ``normal`` faces the incoming ray (the world is sampled about it); ``u`` (N, S, 2, 2): per
         strategy the point and the choice. With many lights, strategies below ``light_slots``
@@ -276,7 +304,10 @@ class Lights:
         pick. Moving lights are sampled again in their own frames at ``time``; textured emission
         and the environment's radiance come from their shader programs, which see the points'
         paths' ``bounces`` as light samples do (core.shading.lightpath). With ``groups``, each
-        sample's light group (``LightSamples.group``)."""
+        sample's light group (``LightSamples.group``). With ``receivers`` (the points' objects'
+        receiver light sets, under light linking), samples of emitters that do not light a point
+        are zero, as Cycles' light_link_object_match rejects them (every strategy keeps its
+        density: each light is one, so nothing is renormalised)."""
         n, strategies = len(pos), self.strategies
         pos, normal, u = (np.ascontiguousarray(a, np.float64) for a in (pos, normal, u))
         out = LightSamples.empty(strategies, n)
@@ -307,11 +338,21 @@ class Lights:
                 out.value[w, k] = self.environment.radiance(out.wi[w, k], path) / out.pdf[w, k, None]
             if self.world_lobes is not None:
                 out.restrict[w] = self.world_lobes
+        if receivers is not None and self.linking:
+            self._unlinked(out, pick, receivers)
         if self.excluding:
             out.exclude = self._sample_excludes(pick)
         if groups:
             out.group = self._sample_groups(pick)
         return out
+
+    def _unlinked(self, out: LightSamples, pick, receivers) -> None:
+        """Zero the samples of lights and emissive triangles that do not light their points."""
+        slots = self.light_slots
+        if slots:
+            out.value[:slots][~links(self.light_membership[pick[:slots]], receivers[None])] = 0.0
+        if len(self.emissive):
+            out.value[slots][~self.triangle_links(pick[slots], receivers)] = 0.0
 
     def _sample_excludes(self, pick) -> np.ndarray:
         """``LightSamples.exclude`` of samples whose lights or triangles are ``pick`` (strategy by hit)."""
@@ -392,16 +433,30 @@ class Lights:
                 pdf[k] = _pdf_batch(table, self.table, ids[k], slots, o, d, t[k], origins[k])
         return pdf
 
-    def suns_seen(self, origins, dirs, time=None, group=None):
+    def suns_seen(self, origins, dirs, time=None, group=None, receiver=None):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs (with
-        ``group``, of the suns in that light group alone)."""
-        radiance = np.zeros((len(dirs), 3))
-        pdf = np.zeros(len(dirs))
-        slots = self.light_slots if self.selecting else 0
+        ``group``, of the suns in that light group alone; with ``receiver``, the receiver light
+        sets of the objects the rays left, of the suns that light them, light linking)."""
         fixed, moving = self._fixed_suns, self._moving_suns
         if group is not None:
             fixed = fixed[self.light_group[fixed] == group]
             moving = [i for i in moving if self.light_group[i] == group]
+        if receiver is None or not self.linking:
+            return self._suns_seen(origins, dirs, time, fixed, moving)
+        radiance, pdf = np.zeros((len(dirs), 3)), np.zeros(len(dirs))
+        for i in list(fixed) + moving:  # each sun at the rays whose objects it lights
+            rows = np.flatnonzero(links(self.light_membership[np.full(len(dirs), i)], receiver))
+            one = np.array([i], np.int64) if i in fixed else np.zeros(0, np.int64)
+            r, p = self._suns_seen(origins[rows], dirs[rows], None if time is None else time[rows], one,
+                                   [i] if i in moving else [])
+            radiance[rows] += r
+            pdf[rows] += p
+        return radiance, pdf
+
+    def _suns_seen(self, origins, dirs, time, fixed, moving):
+        radiance = np.zeros((len(dirs), 3))
+        pdf = np.zeros(len(dirs))
+        slots = self.light_slots if self.selecting else 0
         if len(fixed):
             _suns_batch(self.table, self.table, fixed, slots, origins, dirs, radiance, pdf)
         for i in moving:
