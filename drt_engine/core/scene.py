@@ -371,8 +371,6 @@ class World:
     linear 1, inverse quadratic 0.5). The defaults are Cycles' film's, what it uses without a world."""
     lightgroup: int = -1
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
-    light_set_membership: int = LIGHT_SETS_ALL
-    """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
 
     @property
     def visible_lighting(self) -> bool:
