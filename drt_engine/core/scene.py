@@ -258,6 +258,10 @@ class Instance:
     light_set_membership: int = LIGHT_SETS_ALL
     """Light linking (core.lights.linking): the receiver set the object is in (0: the default) and,
     for its emission, the sets it lights."""
+    blocker_shadow_set: int = 0
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking, alike: the blocker set the object is in and, for its emission, the blocker
+    sets that cast its shadows."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
@@ -320,6 +324,8 @@ class Light:
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
     light_set_membership: int = LIGHT_SETS_ALL
     """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking: the objects' blocker sets that cast its shadows."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:

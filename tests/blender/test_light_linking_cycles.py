@@ -3,11 +3,13 @@
 worst plus 0.002): a ground and two cubes under a red and a blue area light and an emissive quad;
 the red light's receiver collection excludes one cube (it lights everything else), the blue light's
 includes the ground and that cube alone (the other cube is not lit by it), the quad's excludes the
-ground. The same render with the receiver collections removed (linking ignored) is far off."""
+ground; and a ground under two quads lit by an area light whose blocker collection excludes one
+quad (it casts none of that light's shadows; the other does) and by a spot light whose shadows
+every object casts. The same renders with the collections removed (linking ignored) are far off."""
 from __future__ import annotations
 
 import bpy
-import numpy as np
+import pytest
 
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
@@ -34,13 +36,17 @@ def _add(name, mat, primitive, location, size, rotation=(0.0, 0.0, 0.0)):
                             location=location, rotation=rotation)
 
 
-def _receivers(emitter, links):
-    """``emitter``'s receiver collection of (object, link state) entries."""
-    collection = bpy.data.collections.new(f"{emitter.name} receivers")
+def _collection(emitter, links, kind="receiver"):
+    """``emitter``'s receiver (or blocker) collection of (object, link state) entries."""
+    collection = bpy.data.collections.new(f"{emitter.name} {kind}s")
     for k, (obj, state) in enumerate(links):
         collection.objects.link(obj)
         collection.collection_objects[k].light_linking.link_state = state
-    emitter.light_linking.receiver_collection = collection
+    setattr(emitter.light_linking, f"{kind}_collection", collection)
+
+
+def _receivers(emitter, links):
+    _collection(emitter, links)
 
 
 def linking_scene():
@@ -58,17 +64,30 @@ def linking_scene():
     return scene
 
 
-def test_light_linking_matches_cycles(drt, tmp_path):
-    scene = linking_scene()
-    image, cycles0, cycles1 = (rh.render(scene, engine, SAMPLES, seed, tmp_path, name="linking").rgb
+def shadow_scene():
+    scene = ps.dark_scene(SIZE, (0.0, -6.0, 5.0), 40.0, False)
+    _add("Ground", _diffuse("Ground", (0.8, 0.8, 0.8)), "plane", (0, 0, 0), 5.0)
+    free = _add("Free", _diffuse("Blue", (0.2, 0.3, 0.8)), "plane", (-0.8, 0.2, 1.0), 1.2, (0.2, 0.0, 0.0))
+    _add("Casting", _diffuse("Green", (0.2, 0.7, 0.3)), "plane", (1.0, 0.8, 0.8), 1.2, (0.0, 0.3, 0.0))
+    area = add_light(scene, "AREA", location=(0.3, -0.5, 3.5), energy=200.0, size=1.0)
+    add_light(scene, "SPOT", location=(-1.0, 0.5, 3.5), energy=150.0, spot_size=1.2, shadow_soft_size=0.2)
+    _collection(area, [(free, "EXCLUDE")], "blocker")
+    return scene
+
+
+@pytest.mark.parametrize("build", [linking_scene, shadow_scene], ids=lambda b: b.__name__)
+def test_light_linking_matches_cycles(drt, tmp_path, build):
+    scene = build()
+    name = build.__name__
+    image, cycles0, cycles1 = (rh.render(scene, engine, SAMPLES, seed, tmp_path, name=name).rgb
                                for engine, seed in ps.RUNS)
     figures = ps.parity(image, cycles0, cycles1)
-    print("light linking", figures)
-    assert figures["ok"], ps.message("light linking", figures)
-    for obj in bpy.data.objects:  # linking ignored: every emitter lights every object
+    print(name, figures)
+    assert figures["ok"], ps.message(name, figures)
+    for obj in bpy.data.objects:  # linking ignored: every emitter lights every object, every object casts shadows
         if obj.light_linking is not None:
-            obj.light_linking.receiver_collection = None
-    ignored = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="unlinked").rgb
+            obj.light_linking.receiver_collection = obj.light_linking.blocker_collection = None
+    ignored = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name=f"{name}-unlinked").rgb
     off = ps.parity(ignored, cycles0, cycles1)
-    print("linking ignored", off)
+    print(name, "linking ignored", off)
     assert off["worst"] > 5 * figures["limit"], off

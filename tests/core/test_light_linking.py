@@ -101,3 +101,35 @@ def test_each_emitter_linked_apart():
     floor = _floor_mask(render(scene(out, out, floor_set=1)))
     assert abs(linked[floor].mean() - glow_only[floor].mean()) < 0.05 * glow_only[floor].mean()
     assert plain[floor].mean() > 2 * linked[floor].mean()
+
+
+def shadow_scene(light_membership=LIGHT_SETS_ALL, occluder_set=0, occluder_shadow=True) -> SceneData:
+    """A floor under a square occluder (blocker set ``occluder_set``) and an area light, black world."""
+    white = Material("white", [Closure("DIFFUSE", color=(0.8, 0.8, 0.8)),
+                               Closure("GLOSSY", color=(0.8, 0.8, 0.8), roughness=0.3, weight=(0.3,) * 3)])
+    meshes = [plane(6.0), plane(1.2, 0.8)]
+    instances = [Instance(0, np.eye(4), name="floor"),
+                 Instance(1, np.eye(4), name="occluder", blocker_shadow_set=occluder_set,
+                          visible_shadow=occluder_shadow)]
+    light = Light("AREA", translation(1.0, 0.0, 2.0), radiance=np.array([3.0, 3.0, 3.0]), size_x=0.6, size_y=0.6,
+                  shadow_set_membership=light_membership)
+    return SceneData(top_camera(3.0, 1.0, 24), meshes, instances, [white], [light], World(radiance=np.zeros(3)))
+
+
+def test_a_blocker_the_light_leaves_out_casts_no_shadow():
+    """The light's shadows cast by set 0 alone, the occluder in set 1: the image is (up to noise) the
+    one with the occluder hidden from shadow rays, and far from the one with its shadow; the camera
+    still sees the occluder, and reflections (max depth 2) of it, alike."""
+    settings = {"samples": 64, "max_depth": 2}
+    linked = render(shadow_scene(1, occluder_set=1), **settings)
+    hidden = render(shadow_scene(occluder_shadow=False), **settings)
+    shadowed = render(shadow_scene(), **settings)
+    assert abs(linked.mean() - hidden.mean()) < 0.02 * hidden.mean()
+    assert np.abs(linked - hidden).mean() < 0.2 * np.abs(shadowed - hidden).mean()
+    assert np.abs(shadowed - hidden).mean() > 0.02 * hidden.mean()  # the shadow shows (4% of the mean)
+
+
+def test_shadow_masks():
+    from drt_engine.core.geometry.visibility import SHADOW, shadow_ray_mask
+    assert shadow_ray_mask(LIGHT_SETS_ALL) & SHADOW and shadow_ray_mask(1 << 1) == 1 << 5
+    assert shadow_ray_mask(LIGHT_SETS_ALL & ~1) & SHADOW == 0

@@ -328,6 +328,9 @@ class Integrator:
         if len(rays) and rays.receiver is not None:  # light linking: camera rays see every light
             keep = np.flatnonzero(rays.straight | self.lights.light_links(light_id, rays.receiver))
             rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
+        if len(rays) and self.lights.shadow_linking:  # light sampling's alone (strategies.NO_MIS)
+            keep = np.flatnonzero(rays.straight | ~self.lights.shadow_linked(light_id=light_id))
+            rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
         if len(rays) == 0:
             return
 
@@ -400,6 +403,8 @@ class Integrator:
         if state.receiver is not None and len(glowing):  # light linking: camera rays see every emitter
             seen = self.lights.triangle_links(surf.prim[glowing], state.receiver[surf.row[glowing]])
             glowing = glowing[surf.straight[glowing] | seen]
+        if self.lights.shadow_linking and len(glowing):  # light sampling's alone (strategies.NO_MIS)
+            glowing = glowing[surf.straight[glowing] | ~self.lights.shadow_linked(prim=surf.prim[glowing])]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]

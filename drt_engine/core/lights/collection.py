@@ -27,6 +27,7 @@ from ..base.jit import kernel
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..errors import SceneError
 from ..geometry.motion import Motion
+from ..geometry.visibility import shadow_ray_mask
 from ..scene import LIGHT_SETS_ALL, Light, SceneData
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
@@ -34,7 +35,7 @@ from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .linking import lights as links
-from .strategies import MAP_WORLD, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
+from .strategies import MAP_WORLD, NO_MIS, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch
 from .world import lights_shown_batch, pdf_world_batch, world_shown_batch
@@ -180,10 +181,14 @@ class Lights:
             return ((0 if item.visible_diffuse else UNLIT_DIFFUSE) | (0 if item.visible_glossy else UNLIT_REFLECTION)
                     | (0 if item.visible_transmission else UNLIT_TRANSMISSION))
 
-        self.light_exclude = np.array([unlit(light) | (0 if light.cast_shadow else NO_SHADOW) for light in self.lights],
-                                      np.int8)
+        def alone(item):  # shadow linking: light sampling's alone (strategies.NO_MIS)
+            return NO_MIS if item.shadow_set_membership != LIGHT_SETS_ALL else 0
+
+        self.light_exclude = np.array([unlit(light) | (0 if light.cast_shadow else NO_SHADOW) | alone(light)
+                                       for light in self.lights], np.int8)
         sources = geometry.source_of(self.emissive)[:, 0] if len(self.emissive) else np.zeros(0, np.int64)
-        self.emissive_exclude = np.array([unlit(scene.instances[k]) for k in sources], np.int8)
+        self.emissive_exclude = np.array([unlit(scene.instances[k]) | alone(scene.instances[k]) for k in sources],
+                                         np.int8)
         self.excluding = bool(self.light_exclude.any() or self.emissive_exclude.any())
 
     def _groups(self, scene: SceneData, geometry) -> None:
@@ -204,6 +209,16 @@ class Lights:
         self.instance_receiver = np.array([i.receiver_light_set for i in scene.instances], np.int64)
         every = np.uint64(LIGHT_SETS_ALL)
         self.linking = bool((self.light_membership != every).any() or (self.instance_membership != every).any())
+        self.shadow_linking = bool(self.geometry.shadow_linking)
+        """Some emitter's shadows are cast by some objects alone: its shadow rays carry their own mask."""
+        self.light_shadow_mask = np.array([shadow_ray_mask(light.shadow_set_membership) for light in self.lights],
+                                          np.int32)
+        self.instance_shadow_mask = np.array([shadow_ray_mask(i.shadow_set_membership) for i in scene.instances],
+                                             np.int32)
+        self.light_shadow_linked = np.array([light.shadow_set_membership != LIGHT_SETS_ALL for light in self.lights],
+                                            bool)
+        self.instance_shadow_linked = np.array([i.shadow_set_membership != LIGHT_SETS_ALL for i in scene.instances],
+                                               bool)
 
     def receivers(self, prim: np.ndarray) -> np.ndarray:
         """The receiver light sets of the objects of triangles ``prim``."""
@@ -340,11 +355,32 @@ class Lights:
                 out.restrict[w] = self.world_lobes
         if receivers is not None and self.linking:
             self._unlinked(out, pick, receivers)
+        if self.shadow_linking:
+            out.mask = self._sample_masks(pick)
         if self.excluding:
             out.exclude = self._sample_excludes(pick)
         if groups:
             out.group = self._sample_groups(pick)
         return out
+
+    def _sample_masks(self, pick) -> np.ndarray:
+        """Each sample's shadow-ray mask (shadow linking), strategy by hit; the world's the scene's."""
+        out = np.full(pick.shape, self.geometry.shadow_mask, np.int32)
+        slots = self.light_slots
+        if slots:
+            out[:slots] = self.light_shadow_mask[pick[:slots]]
+        if len(self.emissive):
+            out[slots] = self.instance_shadow_mask[self.geometry.source_of(pick[slots])[:, 0]]
+        return out
+
+    def shadow_linked(self, light_id=None, prim=None) -> np.ndarray:
+        """Whether lights ``light_id`` (or the emissive triangles ``prim``) have shadow linking: rays
+        that find them do not count them (strategies.NO_MIS)."""
+        if light_id is not None:
+            return self.light_shadow_linked[light_id]
+        if len(prim) == 0:
+            return np.zeros(0, bool)
+        return self.instance_shadow_linked[self.geometry.source_of(prim)[:, 0]]
 
     def _unlinked(self, out: LightSamples, pick, receivers) -> None:
         """Zero the samples of lights and emissive triangles that do not light their points."""
@@ -436,8 +472,12 @@ class Lights:
     def suns_seen(self, origins, dirs, time=None, group=None, receiver=None):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs (with
         ``group``, of the suns in that light group alone; with ``receiver``, the receiver light
-        sets of the objects the rays left, of the suns that light them, light linking)."""
+        sets of the objects the rays left, of the suns that light them, light linking). Suns with
+        shadow linking are light sampling's alone (strategies.NO_MIS) and not seen here."""
         fixed, moving = self._fixed_suns, self._moving_suns
+        if self.shadow_linking:
+            fixed = fixed[~self.light_shadow_linked[fixed]]
+            moving = [i for i in moving if not self.light_shadow_linked[i]]
         if group is not None:
             fixed = fixed[self.light_group[fixed] == group]
             moving = [i for i in moving if self.light_group[i] == group]

@@ -20,10 +20,13 @@ MAX_COLLECTIONS = 64
 """Receiver collections Blender tells apart; emitters of further ones light everything."""
 
 
-def light_sets(collections: list[dict[str, bool] | None]) -> tuple[dict[str, int], list[int]]:
-    """(receiver set per object named in some collection, membership per emitter) for emitters'
-    receiver collections as {object name: included} (None: the emitter has none). Emitters that
-    share a collection share it here too (pass the same dict)."""
+def light_sets(collections: list[dict[str, bool] | None], max_set: int = MAX_SET
+               ) -> tuple[dict[str, int], list[int]]:
+    """(set per object named in some collection, membership per emitter) for emitters' receiver
+    (or blocker) collections as {object name: included} (None: the emitter has none), sets
+    numbered up to ``max_set``. Emitters that share a collection share it here too (pass the same
+    dict). Shadow linking's blocker sets are made alike: an emitter's shadows are cast by the
+    objects of the sets of its shadow membership."""
     ids: dict[int, int] = {}  # id() of a collection -> its bit
     for links in collections:
         if links is not None and id(links) not in ids and len(ids) < MAX_COLLECTIONS:
@@ -44,7 +47,7 @@ def light_sets(collections: list[dict[str, bool] | None]) -> tuple[dict[str, int
     for name in include:
         key = (include[name], exclude[name])
         if key not in set_of:
-            if len(set_of) + 1 > MAX_SET:
+            if len(set_of) + 1 > max_set:
                 continue
             set_of[key] = len(set_of) + 1
         s = set_of[key]
