@@ -5,7 +5,9 @@ the red light's receiver collection excludes one cube (it lights everything else
 includes the ground and that cube alone (the other cube is not lit by it), the quad's excludes the
 ground; and a ground under two quads lit by an area light whose blocker collection excludes one
 quad (it casts none of that light's shadows; the other does) and by a spot light whose shadows
-every object casts. The same renders with the collections removed (linking ignored) are far off."""
+every object casts. The same renders with the collections removed (linking ignored) are far off.
+Measured (48 x 48, 128 samples, Blender 5.0): worst block / limit (Cycles' seeds) 0.0250 / 0.0351
+(0.0221) receivers, 0.0114 / 0.0233 (0.0142) blockers; linking ignored 1.78 and 0.755."""
 from __future__ import annotations
 
 import bpy

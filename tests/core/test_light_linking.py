@@ -55,7 +55,8 @@ def scene(light_membership=LIGHT_SETS_ALL, glow_membership=LIGHT_SETS_ALL, floor
     white = Material("white", [Closure("DIFFUSE", color=(0.8, 0.8, 0.8))])
     glow = Material("glow", [Closure("EMISSION", emission=(2.0, 1.0, 0.5))])
     meshes = [plane(6.0), uv_sphere(0.4, (0.3, 0.0, 0.4), 24, 12), uv_sphere(0.25, (-0.6, 0.4, 0.3), 16, 8, material=1)]
-    instances = [Instance(0, np.eye(4), name="floor", receiver_light_set=floor_set), Instance(1, np.eye(4), name="ball"),
+    instances = [Instance(0, np.eye(4), name="floor", receiver_light_set=floor_set),
+                 Instance(1, np.eye(4), name="ball"),
                  Instance(2, np.eye(4), name="glow", light_set_membership=glow_membership)]
     light = Light("AREA", translation(0.0, 0.0, 2.0), radiance=np.array([3.0, 3.0, 3.0]), size_x=0.8, size_y=0.8,
                   light_set_membership=light_membership)

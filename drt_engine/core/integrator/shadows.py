@@ -75,7 +75,8 @@ def enqueue(qf, qi, m, c0, c1, c2, ox, oy, oz, dx, dy, dz, tmax, time, u, v, len
 
 @kernel
 def pass_through(scene, geo, clear, qf, qi, pos, ng, scale, limit, radiance, grouped, out_f, out_i):
-    """Sends each queued ray (with its own Embree mask) (its contribution already attenuated by its surface) on from the far
+    """Sends each queued ray (its contribution already attenuated by its surface, its own Embree
+    mask in its int row) on from the far
     side of the surface at ``pos`` (geometric normal ``ng`` facing the ray, offset ``scale``):
     open, its contribution goes to ``radiance``, clamped to ``limit[r]`` (core.integrator.clamp), and
     to its light group's in ``grouped`` (empty: no light groups);

@@ -35,7 +35,8 @@ from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .linking import lights as links
-from .strategies import MAP_WORLD, NO_MIS, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
+from .strategies import (MAP_WORLD, NO_MIS, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples,
+                         sample_strategies)
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch
 from .world import lights_shown_batch, pdf_world_batch, world_shown_batch
