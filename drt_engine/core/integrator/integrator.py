@@ -328,8 +328,10 @@ class Integrator:
         if len(rays) and rays.receiver is not None:  # light linking: camera rays see every light
             keep = np.flatnonzero(rays.straight | self.lights.light_links(light_id, rays.receiver))
             rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
-        if len(rays) and self.lights.shadow_linking:  # light sampling's alone (strategies.NO_MIS)
-            keep = np.flatnonzero(rays.straight | ~self.lights.shadow_linked(light_id=light_id))
+        if len(rays) and self.lights.shadow_linking:  # light sampling's alone (strategies.NO_MIS), but after a
+            # delta lobe, which light sampling does not light
+            keep = np.flatnonzero(rays.straight | np.isinf(rays.prev_pdf)
+                                  | ~self.lights.shadow_linked(light_id=light_id))
             rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
         if len(rays) == 0:
             return
@@ -404,7 +406,8 @@ class Integrator:
             seen = self.lights.triangle_links(surf.prim[glowing], state.receiver[surf.row[glowing]])
             glowing = glowing[surf.straight[glowing] | seen]
         if self.lights.shadow_linking and len(glowing):  # light sampling's alone (strategies.NO_MIS)
-            glowing = glowing[surf.straight[glowing] | ~self.lights.shadow_linked(prim=surf.prim[glowing])]
+            glowing = glowing[surf.straight[glowing] | np.isinf(state.prev_pdf[surf.row[glowing]])
+                              | ~self.lights.shadow_linked(prim=surf.prim[glowing])]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]
