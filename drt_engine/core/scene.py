@@ -226,6 +226,10 @@ class Mesh:
                            for k, v in self.attributes.items()}
 
 
+LIGHT_SETS_ALL = (1 << 64) - 1
+"""An emitter's light-set membership when it lights every object (no light linking)."""
+
+
 @dataclass
 class Instance:
     """One placement of a mesh: ``mesh`` indexes ``SceneData.meshes``.
@@ -259,6 +263,14 @@ class Instance:
     motion_pass: np.ndarray | None = None
     """For the Vector pass: object-to-world (2, 4, 4) at the previous and the next frame (None: it
     stands still there, or the pass is off)."""
+    receiver_light_set: int = 0
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking (core.lights.linking): the receiver set the object is in (0: the default) and,
+    for its emission, the sets it lights."""
+    blocker_shadow_set: int = 0
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking, alike: the blocker set the object is in and, for its emission, the blocker
+    sets that cast its shadows."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
@@ -321,6 +333,10 @@ class Light:
     name: str = ""
     lightgroup: int = -1
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking: the objects' blocker sets that cast its shadows."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:

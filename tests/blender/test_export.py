@@ -932,8 +932,8 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
 
 
 def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Shadow catcher and light linking change Cycles' image; until DRT reads them, a scene using
-    them says so (objects named, a long list cut short). Light groups are read: not named."""
+    """Shadow catcher changes Cycles' image; until DRT reads it, a scene using it says so (objects
+    named, a long list cut short). Light groups and light linking are read: not named."""
     scene = empty_scene()
     cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
     for cube in cubes[:5]:
@@ -942,14 +942,35 @@ def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
     cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
     data = render_export(scene)
     (warning,) = data.warnings
-    for expected in ("shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)", "light or shadow linking ('Cube3')"):
-        assert expected in warning, warning
+    assert "shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)" in warning, warning
     assert "Cube5" not in warning and "visibility" not in warning and "holdout" not in warning
-    assert "light group" not in warning
+    assert "light group" not in warning and "linking" not in warning
     for cube in cubes[:5]:
         cube.is_shadow_catcher = False
     cubes[3].light_linking.receiver_collection = None
     assert not render_export(scene).warnings
+
+
+def test_light_and_shadow_linking_are_exported():
+    """A receiver collection excluding one cube and a blocker collection including another: the
+    excluded cube gets its own receiver set, which the emitter's membership leaves out; the
+    included cube its own blocker set, the emitter's shadow membership that set alone."""
+    scene = empty_scene()
+    cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(3)]
+    receivers, blockers = bpy.data.collections.new("Receivers"), bpy.data.collections.new("Blockers")
+    receivers.objects.link(cubes[1])
+    receivers.collection_objects[0].light_linking.link_state = "EXCLUDE"
+    blockers.objects.link(cubes[2])
+    cubes[0].light_linking.receiver_collection = receivers
+    cubes[0].light_linking.blocker_collection = blockers
+    data = render_export(scene)
+    by_name = {i.name: i for i in data.instances}
+    emitter, excluded, blocker = by_name["Cube0"], by_name["Cube1"], by_name["Cube2"]
+    assert excluded.receiver_light_set == 1 and by_name["Cube2"].receiver_light_set == 0
+    assert emitter.light_set_membership == (1 << 64) - 1 - 2
+    assert blocker.blocker_shadow_set == 1 and excluded.blocker_shadow_set == 0
+    assert emitter.shadow_set_membership == 2
+    assert excluded.light_set_membership == (1 << 64) - 1 and not data.warnings
 
 
 def test_light_groups_are_exported():

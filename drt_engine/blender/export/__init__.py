@@ -17,6 +17,7 @@ from ..properties import lightgroup_of, view_layer_lightgroups
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
 from .left_out import LeftOut
+from .linking import LightLinks
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, add_motion_pass, instance_key
@@ -56,6 +57,7 @@ def export_scene(
     lights = []
     light_keys = []
     left_out = LeftOut(depsgraph.mode == "RENDER")
+    links = LightLinks()
     for count, instance in enumerate(depsgraph.object_instances):
         if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
             raise RenderCancelled("Render cancelled during scene export")
@@ -63,6 +65,7 @@ def export_scene(
             continue
         obj = instance.object
         rendered = left_out.look_at(obj, instance.is_instance)
+        links.look_at(obj)
         matrix = np.array(instance.matrix_world, dtype=np.float64)
         if obj.type == "LIGHT":
             light = export_light(obj, matrix, warnings)
@@ -74,6 +77,7 @@ def export_scene(
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
     geometry.finish()
+    links.apply(lights, geometry.instances)
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
     warnings.extend(left_out.warnings())
     scene_data = SceneData(

@@ -4,7 +4,7 @@ scene relying on them is never rendered differently without a word.
 
 Each object is looked at once (its instances share its settings). Objects' and lights' ray
 visibility, lights' Cast Shadow, objects' Holdout and the world's ray visibility are read (export.geometry,
-export.lights, export.world) and so are not listed here.
+export.lights, export.world) and so are light and shadow linking (export.linking): they are not listed here.
 """
 from __future__ import annotations
 
@@ -46,9 +46,6 @@ class LeftOut:
         for attribute, rendered, what in OBJECT_SETTINGS:
             if obj.type != "LIGHT" and getattr(obj, attribute, rendered) != rendered:
                 self._add(what, name)
-        linking = getattr(obj, "light_linking", None)  # Blender 4.0+
-        if linking is not None and (linking.receiver_collection is not None or linking.blocker_collection is not None):
-            self._add("light or shadow linking", name)
 
     def _shows_hair(self, obj) -> bool:
         """Whether the object shows hair particles as strands (Cycles renders them as curves)."""

@@ -313,7 +313,8 @@ class Integrator:
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
                           bounces=camera_bounces(n) if self.carried else None,
                           mis_origin=cam.origins if self.shadows is not None else None,
-                          min_pdf=np.full(n, np.inf) if self.min_pdf else None)
+                          min_pdf=np.full(n, np.inf) if self.min_pdf else None,
+                          receiver=np.zeros(n, np.int64) if self.lights.linking else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray:
@@ -330,6 +331,14 @@ class Integrator:
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
         """Lights hit directly: always by reflected and refracted rays, by the camera if asked; the
         rays go on to what is behind, which alone decides the pixel's alpha."""
+        if len(rays) and rays.receiver is not None:  # light linking: camera rays see every light
+            keep = np.flatnonzero(rays.straight | self.lights.light_links(light_id, rays.receiver))
+            rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
+        if len(rays) and self.lights.shadow_linking:  # light sampling's alone (strategies.NO_MIS), but after a
+            # delta lobe, which light sampling does not light
+            keep = np.flatnonzero(rays.straight | np.isinf(rays.prev_pdf)
+                                  | ~self.lights.shadow_linked(light_id=light_id))
+            rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
         if len(rays) == 0:
             return
 
@@ -367,7 +376,7 @@ class Integrator:
         if len(bounced):
             # with light groups, each group's suns apart (a sun's light goes to its group)
             for group in [None] if self.groups is None else np.unique(lights.light_group):
-                sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group)
+                sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group, bounced.receiver)
                 add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
                             lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
                             None if group is None else self._group(lambda: np.full(len(bounced), group)))
@@ -400,6 +409,12 @@ class Integrator:
         glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
         if self.holdouts is not None and len(glowing):  # an object holdout the camera sees gives no light
             glowing = glowing[~self.holdouts.whole(surf.take(glowing))]
+        if state.receiver is not None and len(glowing):  # light linking: camera rays see every emitter
+            seen = self.lights.triangle_links(surf.prim[glowing], state.receiver[surf.row[glowing]])
+            glowing = glowing[surf.straight[glowing] | seen]
+        if self.lights.shadow_linking and len(glowing):  # light sampling's alone (strategies.NO_MIS)
+            glowing = glowing[surf.straight[glowing] | np.isinf(state.prev_pdf[surf.row[glowing]])
+                              | ~self.lights.shadow_linked(prim=surf.prim[glowing])]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]
@@ -579,7 +594,9 @@ class Integrator:
                                      joined([u.light for _, u in lit]),
                                      joined([h.time for h in hits]) if self.timed else None,
                                      joined([h.bounces for h in hits]) if self.light_path else None,
-                                     groups=self.groups is not None)
+                                     groups=self.groups is not None,
+                                     receivers=self.lights.receivers(joined([h.prim for h in hits]))
+                                     if self.lights.linking else None)
         if self.groups is not None:
             out.group = self.groups.column(out.group)
         return out
@@ -649,6 +666,9 @@ class Integrator:
             prev_normal = np.where(kept, state.prev_normal[rows], prev_normal)
             prev_shading = np.where(kept, state.prev_shading[rows], prev_shading)
             mis_origin = np.where(kept, state.mis_origin[rows], origin)
+        receiver = None
+        if state.receiver is not None:  # light linking: the object bounced off, kept through pass-throughs
+            receiver = np.where(passthrough, state.receiver[hits.row[sel]], self.lights.receivers(hits.prim[sel]))
         min_pdf = None
         if state.min_pdf is not None:  # Cycles' min_ray_pdf: the least density of non-transparent bounces
             before = state.min_pdf[hits.row[sel]]
@@ -657,7 +677,7 @@ class Integrator:
                          throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin,
-                         min_pdf=min_pdf)
+                         min_pdf=min_pdf, receiver=receiver)
 
 
 def _material_slices(mat):
