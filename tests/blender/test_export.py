@@ -973,6 +973,19 @@ def test_light_and_shadow_linking_are_exported():
     assert excluded.light_set_membership == (1 << 64) - 1 and not data.warnings
 
 
+def test_more_blocker_sets_than_drt_tells_apart_are_named():
+    """Each of 28 emitters' blocker collection includes a cube of its own: 28 blocker sets, past the
+    26 DRT's shadow masks tell apart (the 27th and 28th cubes cast every shadow): one warning."""
+    scene = empty_scene()
+    for i in range(28):
+        emitter = add_object(scene, f"Emitter{i}", cube_mesh(f"Emitter{i}"))
+        blockers = bpy.data.collections.new(f"Blockers{i}")
+        blockers.objects.link(add_object(scene, f"Blocker{i}", cube_mesh(f"Blocker{i}")))
+        emitter.light_linking.blocker_collection = blockers
+    warnings = [w for w in render_export(scene).warnings if "shadow linking" in w]
+    assert len(warnings) == 1 and "28 sets" in warnings[0], warnings
+
+
 def test_light_groups_are_exported():
     """The view layer's light groups, and each object's, light's and the world's group as an index
     among them (-1: none, or a name the view layer has no group of, as Cycles)."""

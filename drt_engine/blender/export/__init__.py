@@ -77,7 +77,7 @@ def export_scene(
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
     geometry.finish()
-    links.apply(lights, geometry.instances)
+    links.apply(lights, geometry.instances, warnings)
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
     warnings.extend(left_out.warnings())
     scene_data = SceneData(

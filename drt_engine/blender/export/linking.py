@@ -43,10 +43,11 @@ class LightLinks:
         if linking is not None and linking.blocker_collection is not None:
             self._blockers[obj.name] = linking.blocker_collection
 
-    def apply(self, lights, instances) -> None:
+    def apply(self, lights, instances, warnings: list[str]) -> None:
         """Sets each light's and instance's memberships and each instance's receiver and blocker
         sets (nothing without such collections: the defaults light everything, every object
-        casting every shadow). DRT tells core.geometry.visibility.BLOCKER_SETS blocker sets apart."""
+        casting every shadow). DRT tells core.geometry.visibility.BLOCKER_SETS blocker sets apart,
+        Blender MAX_SET: a scene that needs more is named in ``warnings``."""
         if self._receivers:
             receiver, member = _sets(self._receivers, MAX_SET)
             for emitter in (*lights, *instances):
@@ -55,6 +56,11 @@ class LightLinks:
                 instance.receiver_light_set = receiver.get(instance.name, 0)
         if self._blockers:
             blocker, member = _sets(self._blockers, BLOCKER_SETS)
+            needed = max(_sets(self._blockers, MAX_SET)[0].values(), default=0)
+            if needed > BLOCKER_SETS:
+                warnings.append(f"shadow linking: the blocker collections make {needed} sets of objects, DRT tells "
+                                f"{BLOCKER_SETS} apart (Cycles {MAX_SET}): objects of the others cast every "
+                                "emitter's shadows")
             for emitter in (*lights, *instances):
                 emitter.shadow_set_membership = member.get(emitter.name, LIGHT_SETS_ALL)
             for instance in instances:
