@@ -9,6 +9,8 @@ export.lights, export.world) and so are light and shadow linking (export.linking
 """
 from __future__ import annotations
 
+import bpy
+
 TYPES = {"CURVES": "hair curves", "POINTCLOUD": "point cloud", "VOLUME": "volume"}
 """Object types Cycles renders and DRT does not (text, curves and surfaces reach the export as
 meshes; empties, armatures, grease pencil and the like render in neither)."""
@@ -93,6 +95,8 @@ class LeftOut:
 def passes_left_out(view_layer) -> list[str]:
     """One line naming the view layer's enabled passes DRT does not write (none: no line)."""
     names = [name for toggle, name in PASSES if getattr(view_layer, toggle, False)]
-    if not names:
-        return []
-    return ["passes DRT does not write yet (not in the render result): " + ", ".join(names)]
+    out = ["passes DRT does not write yet (not in the render result): " + ", ".join(names)] if names else []
+    if getattr(view_layer, "use_pass_vector", False) and bpy.app.version >= (5, 1, 0):
+        out.append("the Vector pass is written as Cycles 4.2 to 5.0 write it: this Blender's Cycles differs at "
+                   "object edges (not matched yet)")
+    return out
