@@ -112,6 +112,13 @@ def _vertices(obj) -> np.ndarray | None:
     return co.reshape(-1, 3).astype(np.float64)
 
 
+def _kept_vertices(obj, mesh) -> np.ndarray | None:
+    """The evaluated object's vertices where they are as many as the exported ``mesh``'s (Cycles
+    keeps no vertex motion for a mesh whose topology changes), else None."""
+    v = _vertices(obj)
+    return v if v is not None and len(v) == len(mesh.vertices) else None
+
+
 def _steps_of(depsgraph, wanted: dict, light_index: dict, camera_name: str):
     """Each wanted instance's, light's and the camera's motion steps (``motion_steps``, at least
     ``long_shutter_steps``) and whether each instance's mesh may deform (its Deformation switch),
@@ -179,8 +186,8 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
                 seen[i, k] = True
                 mesh_index = scene_data.instances[i].mesh
                 if users[mesh_index] == 1 and deform[i] and inst_steps[i]:
-                    v = _vertices(instance.object)
-                    if v is not None and len(v) == len(scene_data.meshes[mesh_index].vertices):
+                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
+                    if v is not None:
                         vertices.setdefault(mesh_index, (i, [None] * steps))[1][k] = v
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:
@@ -230,8 +237,8 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
                 seen[i, k] = True
                 mesh_index = scene_data.instances[i].mesh
                 if users[mesh_index] == 1 and deforms_in_motion(instance.object.original):
-                    v = _vertices(instance.object)
-                    if v is not None and len(v) == len(scene_data.meshes[mesh_index].vertices):
+                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
+                    if v is not None:
                         vertices.setdefault(mesh_index, [None, None])[k] = v
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:

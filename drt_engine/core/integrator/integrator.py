@@ -30,9 +30,9 @@ from ..bsdf.specular_normal import valid_specular_reflection
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
-from ..geometry.motion_vectors import MotionVectors
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
+from ..geometry.motion_vectors import MotionVectors
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
