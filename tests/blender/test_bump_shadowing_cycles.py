@@ -13,6 +13,7 @@ as Cycles'); correction off 0.0010 against 0.0035, read as on 0.078."""
 from __future__ import annotations
 
 import bpy
+import numpy as np
 import pytest
 
 from drt_engine.core.integrator import integrator
@@ -106,14 +107,14 @@ def bumped_sphere():
 def test_bumped_normal_facing_away_from_the_camera(drt, tmp_path, monkeypatch):
     """Cycles shades a diffuse closure about its bumped normal even where the camera sees it from
     behind (the sphere's rim); DRT raised such normals (as it must for glossy lobes) and lit the rim
-    brighter. Measured (96x64, 128 spp, 5.0): 0.0025 against a limit of 0.0060; raised 0.096; the
+    brighter. Measured (96x64, 128 spp, 5.0): 0.0025 against a limit of 0.0060; raised 0.12; the
     geometric normal in its place (DRT before) 0.145."""
     scene = bumped_sphere()
     drt_image, cycles0, cycles1 = [rh.render(scene, e, SAMPLES, s, tmp_path, name="rim") for e, s in ps.RUNS]
     figures = ps.parity(drt_image.rgb, cycles0.rgb, cycles1.rgb)
     print("bumped rim", figures)
     assert figures["ok"], ps.message("bumped rim", figures)
-    monkeypatch.setattr(integrator, "_about", lambda hits, normal: hits)
+    monkeypatch.setattr(integrator, "_diffuse_normal", lambda frame, n, kept: np.tile([0.0, 0.0, 1.0], (len(n), 1)))
     raised = ps.parity(rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="raised").rgb, cycles0.rgb, cycles1.rgb)
     print("raised", raised)
     assert not raised["ok"], f"DRT passes with the raised normal too: {raised}"

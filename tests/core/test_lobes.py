@@ -106,18 +106,23 @@ GI_MATERIALS = {
 }
 
 
-NO_BUMP = (0.0, 0.0, 1.0, 0)
-BUMPED = (-np.sin(0.5), 0.0, np.cos(0.5), bump_shadowing.GGX)  # a smooth normal 0.5 rad off, Cycles 5's term
+FRAME_NORMAL = (0.0, 0.0, 1.0)  # the diffuse lobes' normal where it is the frame's
+NO_BUMP = (0.0, 0.0, 1.0, 0, *FRAME_NORMAL)
+BUMPED = (-np.sin(0.5), 0.0, np.cos(0.5), bump_shadowing.GGX, *FRAME_NORMAL)  # smooth normal 0.5 rad off, Cycles 5's
+# a silhouette's rim: the diffuse lobes' normal 1 rad off the frame's, wo (below) below it (core.bsdf.diffuse_normal)
+RIM = (0.0, 0.0, 1.0, 0, -np.sin(1.0), 0.0, np.cos(1.0))
+BUMPED_RIM = (-np.sin(0.5), 0.0, np.cos(0.5), bump_shadowing.GGX, -np.sin(1.0), 0.0, np.cos(1.0))
 
 
-@pytest.mark.parametrize("bump", [NO_BUMP, BUMPED], ids=["smooth", "bumped"])
+@pytest.mark.parametrize("bump", [NO_BUMP, BUMPED, RIM, BUMPED_RIM], ids=["smooth", "bumped", "rim", "bumped rim"])
 @pytest.mark.parametrize("name", list(GI_MATERIALS))
 def test_sampling_with_diffuse_lobes_integrates_the_whole_bsdf(name, bump):
     """With diffuse bounces (the mixture's diffuse bits), a ray continues through any lobe, the
     diffuse ones cosine-weighted, weighted by the whole mixture's f / pdf: its mean weight is
     the BSDF's albedo, the integral of f |cos| over the sphere that uniform directions give.
     A pdf that is not the sampler's density (a lobe's share or its cosine left out) fails; with a
-    bump, sampling weighs by the same bump shadowing as evaluation."""
+    bump, sampling weighs by the same bump shadowing as evaluation; at a rim the diffuse lobes are
+    sampled and evaluated about their own normal alike."""
     shader = MaterialShader(Material("m", GI_MATERIALS[name]))
     bits = layout.SAMPLE_DIFFUSE | layout.SAMPLE_TRANSLUCENT
     args = (shader.lp, shader.lt, shader.hp, 0, shader.mu)

@@ -69,7 +69,7 @@ def test_samples_follow_the_density(rough, cos_o):
     wi = np.zeros((n, 3))
     for i in range(n):
         s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo, *u[i], False, sel, 0,
-                                 layout.SAMPLE_DIFFUSE, 0.0, 0.0, 1.0, 0)
+                                 layout.SAMPLE_DIFFUSE, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         wi[i] = s[0:3]
         if s[8]:
             f, _, _, p = _eval(shader, wo, wi[i])

@@ -55,7 +55,7 @@ def _sample(shader, kind, wo):
     for i in range(n):
         mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, bits)
         s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *u[i], False, sel, 0, bits,
-                                 0.0, 0.0, 1.0, 0)
+                                 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         out[0][i], out[1][i], out[2][i], out[3][i] = s[0:3], s[3:6], s[6], s[8]
         assert not s[7] and s[10] == (kind == "DIFFUSE_TOON")  # neither is a delta; the diffuse one is diffuse
     return out

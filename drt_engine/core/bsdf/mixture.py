@@ -22,6 +22,7 @@ from ..base.jit import kernel
 from . import blur
 from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
+from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
 from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
                      SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
@@ -81,15 +82,18 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 
 @kernel(inline="always")
 def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit,
-               sx, sy, sz, model):
+               sx, sy, sz, model, dx, dy, dz):
     """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
 
-    ``above``: wi is on wo's side of the geometric surface; ``inside``: wo arrived from the
+    ``above``: wi is on wo's side of the surface (light sampling: of Cycles' sd->N, which the diffuse
+    lobes have, core.bsdf.diffuse_normal; where that is not the frame's, the diffuse lobes' side is
+    their cosine's and ``above`` the others'); ``inside``: wo arrived from the
     back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo, for the ``diffuse``
     lobes a path may continue through (``slot``). ``unlit`` (``UNLIT_*`` bits): parts a light
     does not reach (the world's ray visibility): their BSDF is left out, their density kept, so
     that the rays the lobes send weigh against this light sample as they would. (sx, sy, sz, model):
-    the smooth normal before a bump and its model of shadowing (``bump_shadowing``). Returns (the part
+    the smooth normal before a bump and its model of shadowing (``bump_shadowing``); (dx, dy, dz)
+    the diffuse lobes' normal (core.bsdf.diffuse_normal). Returns (the part
     no ray continues through RGB: the diffuse lobes (Lambert, Oren-Nayar, translucent) left out
     of the choice, the part rays continue through RGB, density of continuing toward wi through
     the lobes of the choice).
@@ -99,6 +103,12 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     refl = above and wiz > 0.0
     trans = (not above) and wiz < 0.0
     shade_diffuse, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
+    cd = dx * wix + dy * wiy + dz * wiz  # wi's cosine to the diffuse lobes' normal
+    own = tilted(dx, dy)
+    if own and model != 0:  # the diffuse lobes' shadowing about their own normal
+        ax, ay, az = into(dx, dy, dz, sx, sy, sz)
+        bx, by, bz = into(dx, dy, dz, wix, wiy, wiz)
+        shade_diffuse, _ = bump_shadowing(ax, ay, az, model, bx, by, bz)
     lit_part = 0.0 if unlit & (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION) else 1.0
     lit = lit_part * shade
     lit_diffuse = 0.0 if unlit & UNLIT_DIFFUSE else shade_diffuse
@@ -107,21 +117,26 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             continue
         kind = int(lp[l, P_KIND])
         if diffuse_kind(kind):
-            p = abs(wiz) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone and sheen's
+            p = abs(cd) / np.pi  # cosine-weighted (cosine_sample), but for the toon lobe's cone and sheen's
             if kind == TRANSLUCENT:
-                if not trans:
+                if not (cd < 0.0 if own else not above and cd < 0.0):
                     continue
-                d0, d1, d2 = translucent_eval(lp, lt, hp, r, j, t, l, wiz)
-            elif not refl:
+                d0, d1, d2 = translucent_eval(lp, lt, hp, r, j, t, l, cd)
+            elif not (cd > 0.0 if own else above and cd > 0.0):
                 continue
             elif kind == DIFFUSE:
-                d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
+                d0, d1, d2 = diffuse_eval(lp, lt, hp, r, j, t, l, cd)
             elif kind == TOON_DIFFUSE:
-                d0, d1, d2, p = toon_diffuse_eval(lp, lt, hp, r, j, t, l, wiz)
-            elif kind == SHEEN:
-                d0, d1, d2, p = sheen_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
-            else:
-                d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, wox, woy, woz, wix, wiy, wiz)
+                d0, d1, d2, p = toon_diffuse_eval(lp, lt, hp, r, j, t, l, cd)
+            else:  # sheen and Oren-Nayar see wo and wi about their normal
+                ox, oy, oz, ix, iy, iz = wox, woy, woz, wix, wiy, wiz
+                if own:
+                    ox, oy, oz = into(dx, dy, dz, wox, woy, woz)
+                    ix, iy, iz = into(dx, dy, dz, wix, wiy, wiz)
+                if kind == SHEEN:
+                    d0, d1, d2, p = sheen_eval(lp, lt, hp, r, j, t, l, ox, oy, oz, ix, iy, iz)
+                else:
+                    d0, d1, d2 = oren_nayar_eval(lp, lt, hp, r, j, t, l, ox, oy, oz, ix, iy, iz)
             d0, d1, d2 = d0 * lit_diffuse, d1 * lit_diffuse, d2 * lit_diffuse
             k = slot(lp, l, diffuse)
             if k >= 0:  # a lobe paths continue through: weighed against sampling it, as the others
@@ -180,10 +195,11 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
 
 @kernel(inline="always")
 def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si, diffuse,
-                 sx, sy, sz, model):
+                 sx, sy, sz, model, dx, dy, dz):
     """Continue through one lobe chosen by ``sel[si]`` (``selection`` at wo with the same
-    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through;
-    (sx, sy, sz, model) the smooth normal as ``eval_lobes`` takes it.
+    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through
+    (about the diffuse lobes' normal (dx, dy, dz)); (sx, sy, sz, model) the smooth normal as
+    ``eval_lobes`` takes it.
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
     the transparent lobe was taken, diffuse: a diffuse lobe was, crosses: wi leaves through the
@@ -214,15 +230,20 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
             l += 1
     kind = int(lp[l, P_KIND])
     if kind == TOON_DIFFUSE:  # its weight is the mixture's, below, as the other diffuse lobes'
-        wix, wiy, wiz = toon_cone_sample(lp, l, 0.0, 0.0, 1.0, u0, u1)
+        wix, wiy, wiz = toon_cone_sample(lp, l, dx, dy, dz, u0, u1)
         w0 = w1 = w2 = 1.0
         ok = True
     elif kind == SHEEN:
-        wix, wiy, wiz = sheen_sample(lp, l, wox, woy, woz, u0, u1)
-        w0 = w1 = w2 = 1.0
+        ox, oy, oz = into(dx, dy, dz, wox, woy, woz) if tilted(dx, dy) else (wox, woy, woz)
+        wix, wiy, wiz = sheen_sample(lp, l, ox, oy, oz, u0, u1)
         ok = wiz > 0.0
+        if tilted(dx, dy):
+            wix, wiy, wiz = out_of(dx, dy, dz, wix, wiy, wiz)
+        w0 = w1 = w2 = 1.0
     elif diffuse_kind(kind):
         wix, wiy, wiz, _ = cosine_sample(u0, u1, -1.0 if kind == TRANSLUCENT else 1.0)
+        if tilted(dx, dy):
+            wix, wiy, wiz = out_of(dx, dy, dz, wix, wiy, wiz)
         w0 = w1 = w2 = 1.0
         ok = True
     else:
@@ -235,11 +256,18 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     delta = blur.delta(lp, hp, r, l)
     valid = ok and p_choice > 0.0
     pdf = 0.0
-    # a reflection about a lobe's own normal may leave below the shading normal, on wo's side still
-    crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
+    # a reflection about a lobe's own normal may leave below the shading normal, on wo's side still,
+    # and a diffuse one about the diffuse lobes' normal
+    if diffuse_kind(kind):
+        crosses = kind == TRANSLUCENT if tilted(dx, dy) else wiz < 0.0
+    else:
+        crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
+    above = not crosses
+    if tilted(dx, dy) and diffuse_kind(kind):  # the side the other lobes are weighed on: the frame's
+        above = wiz > 0.0
     if valid and not delta:
-        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, not crosses, inside,
-                                              sel, si, diffuse, 0, sx, sy, sz, model)
+        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
+                                              sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:

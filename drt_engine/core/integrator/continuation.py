@@ -18,9 +18,9 @@ from .bounces import diffuse_bits
 
 
 @kernel
-def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside, u_select, u2, throughput, pos, ng, scale,
-                   bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf, passthrough,
-                   transmit, next_bounces, diffuse):
+def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, inside, u_select, u2, throughput, pos, ng,
+                   scale, bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf,
+                   passthrough, transmit, next_bounces, diffuse):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
     world direction ``wi``, the path's new throughput ``weight``, the density that sampled the
     direction (``prev_pdf``, inf for a delta lobe), whether the transparent lobe was taken, whether
@@ -42,7 +42,7 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside,
         selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
-                         inside[j], sel, 0, bits, sx, sy, sz, model)
+                         inside[j], sel, 0, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
         t0, t1, t2 = throughput[j, 0] * s[3], throughput[j, 1] * s[4], throughput[j, 2] * s[5]
         peak = np.maximum(np.maximum(t0, t1), t2)
         go[j] = False

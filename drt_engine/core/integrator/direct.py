@@ -74,7 +74,7 @@ def unlit_parts(restrict, k):
 
 
 @kernel
-def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path,
+def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo_l, inside, scale, throughput, path,
                  limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
                  exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, f_diff, visibility, cuts,
                  clear, allowed, qf, qi):
@@ -83,7 +83,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
 
     Shader: the packed lobes (lp, lt, hp, per-hit rows prow, mu; bsdf.layout). Hits: world
     position, geometric normal (facing the ray), shading frame (N, 3, 3: tangent, bitangent,
-    normal rows), the smooth normal a bump replaced (empty: none, bsdf.bump_shadowing), wo in that frame, inside, offset scale, throughput, path, the paths' depths and
+    normal rows), the smooth normal a bump replaced (empty: none, bsdf.bump_shadowing), the diffuse
+    lobes' normal in that frame (bsdf.diffuse_normal), wo in that frame, inside, offset scale,
+    throughput, path, the paths' depths and
     the diffuse bounces (the diffuse lobes paths continue through are weighed against sampling
     them, integrator.bounces; the others are light-sampled alone), whether any ray ``continues``
     from these hits (at the last depth none does: light sampling alone finds all their light,
@@ -139,10 +141,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
             lx = wx * frame[j, 0, 0] + wy * frame[j, 0, 1] + wz * frame[j, 0, 2]
             ly = wx * frame[j, 1, 0] + wy * frame[j, 1, 1] + wz * frame[j, 1, 2]
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
-            above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
+            cd = lx * dn[j, 0] + ly * dn[j, 1] + lz * dn[j, 2]
+            above = cd > 0  # the shading hemisphere decides, as in Cycles (of sd->N), not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
                            inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS)),
-                           sx, sy, sz, model)
+                           sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
@@ -153,8 +156,8 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
             if not _positive(c0, c1, c2):
                 continue
-            ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, lz, hx, hy,
-                                       hz, scale[j])
+            ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, cd,
+                                       hx, hy, hz, scale[j])
             tmax = math.inf
             if not math.isinf(dist[k, j]):
                 # aimed at the sampled point from where the ray starts: the offset and the lift

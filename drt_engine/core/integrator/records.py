@@ -95,7 +95,10 @@ class PathState(Rows):
 @dataclass
 class SurfaceHits(Rows):
     """Rays that hit a surface, in shading order: the frame faces the incoming ray
-    (``inside``: it came from the back), ``wo_l`` is the outgoing direction in that frame,
+    (``inside``: it came from the back), about the normal of the lobes but the diffuse ones,
+    ``ns`` the shading normal facing it as the diffuse lobes have it (Cycles' sd->N: where wo lies
+    below it, the frame's is raised from it, core.integrator.hits), ``dn`` that normal in the frame
+    ((0, 0, 1) where they are one), ``wo_l`` is the outgoing direction in that frame,
     ``scale`` the offset that clears the surface, ``row`` the hit's row in its depth's
     intersection results, ``normal`` the mesh's shading normal as interpolated (the Normal pass),
     ``bounces`` the path state's, ``smooth`` the shading normal a bump or normal map replaced
@@ -107,7 +110,9 @@ class SurfaceHits(Rows):
     mat: np.ndarray
     pos: np.ndarray
     ng: np.ndarray
-    frame: Frame  # about the shading normal
+    frame: Frame
+    ns: np.ndarray
+    dn: np.ndarray
     wo: np.ndarray
     wo_l: np.ndarray
     inside: np.ndarray
@@ -118,11 +123,6 @@ class SurfaceHits(Rows):
     normal: np.ndarray
     bounces: np.ndarray | None = None
     smooth: np.ndarray | None = None
-
-    @property
-    def ns(self) -> np.ndarray:
-        """The shading normal, facing the incoming ray: the frame's normal."""
-        return self.frame.n
 
 
 @dataclass
