@@ -38,7 +38,7 @@ class Merger:
             self.first = part
             self.film = Film(part.width, part.height, tuple(part.header["passes"]),
                              ratio=parts_mod.RATIO in part.header["channels"], halved=tuple(part.header["halved"]),
-                             aovs=part.settings().aovs)
+                             aovs=part.settings().aovs, cryptomatte_levels=part.settings().cryptomatte_levels)
         else:
             parts_mod.check_same(self.first, part, "the first part", name)
         if part.sample_range not in self.ranges:

@@ -85,7 +85,8 @@ class Renderer:
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
-                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs)
+                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs,
+                         cryptomatte_levels=settings.cryptomatte_levels)
 
     @property
     def rays(self) -> dict:
