@@ -15,7 +15,10 @@ import numpy as np
 
 from ..core.base import jit
 from ..core.errors import DRTError, RenderCancelled
+from ..core.film import cryptomatte
+from ..core.film.cryptomatte import SceneIds
 from ..core.render import report
+from ..core.settings import CRYPTOMATTE_PASSES
 from .hooks import render_hooks
 from .oidn import UNAVAILABLE, oidn_library
 from .part_files import keep_part
@@ -94,6 +97,19 @@ def stamp_report(engine, view_layer: str, outcome) -> None:
         result.stamp_data_add_field(f"drt.{view_layer}.{name}", value)
 
 
+def stamp_cryptomatte(engine, view_layer: str, scene_data, settings) -> None:
+    """Each Cryptomatte pass's name, hash, conversion and manifest as the render's metadata, as Cycles
+    stamps them (``cryptomatte/<7 hex digits>/...``): the compositor's Cryptomatte node reads them."""
+    kinds = [name for name in CRYPTOMATTE_PASSES if name in settings.passes]
+    result = engine.get_result() if kinds else None
+    if result is None or not hasattr(result, "stamp_data_add_field"):
+        return
+    ids = SceneIds(scene_data)
+    for kind in kinds:
+        for key, value in cryptomatte.metadata(f"{view_layer}.{kind}", ids.manifest_names(kind)).items():
+            result.stamp_data_add_field(key, value)
+
+
 def render(engine, depsgraph) -> None:
     """The engine's ``render``: errors end as one report, a bug's details go to the console."""
     try:
@@ -154,6 +170,7 @@ def _render(engine, depsgraph):
         engine.end_result(result)
     if not engine.is_preview:
         stamp_report(engine, view_layer.name, outcome)
+        stamp_cryptomatte(engine, view_layer.name, scene_data, settings)
     _warn(engine, [w for w in getattr(outcome, "warnings", ()) if w not in scene_data.warnings])
     if not outcome.cancelled:
         engine.update_progress(1.0)
