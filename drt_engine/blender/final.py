@@ -16,9 +16,7 @@ import numpy as np
 from ..core.base import jit
 from ..core.errors import DRTError, RenderCancelled
 from ..core.film import cryptomatte
-from ..core.film.cryptomatte import SceneIds
 from ..core.render import report
-from ..core.settings import CRYPTOMATTE_PASSES
 from .hooks import render_hooks
 from .oidn import UNAVAILABLE, oidn_library
 from .part_files import keep_part
@@ -100,14 +98,12 @@ def stamp_report(engine, view_layer: str, outcome) -> None:
 def stamp_cryptomatte(engine, view_layer: str, scene_data, settings) -> None:
     """Each Cryptomatte pass's name, hash, conversion and manifest as the render's metadata, as Cycles
     stamps them (``cryptomatte/<7 hex digits>/...``): the compositor's Cryptomatte node reads them."""
-    kinds = [name for name in CRYPTOMATTE_PASSES if name in settings.passes]
-    result = engine.get_result() if kinds else None
+    fields = cryptomatte.scene_metadata(view_layer, scene_data, settings.passes)
+    result = engine.get_result() if fields else None
     if result is None or not hasattr(result, "stamp_data_add_field"):
         return
-    ids = SceneIds(scene_data)
-    for kind in kinds:
-        for key, value in cryptomatte.metadata(f"{view_layer}.{kind}", ids.manifest_names(kind)).items():
-            result.stamp_data_add_field(key, value)
+    for key, value in fields.items():
+        result.stamp_data_add_field(key, value)
 
 
 def render(engine, depsgraph) -> None:

@@ -72,6 +72,11 @@ def cryptomatte_passes(name: str, levels: int) -> tuple[str, ...]:
     return tuple(f"{name}{i:02d}" for i in range((min(16, levels) + 1) // 2))
 
 
+def pass_of(image: str) -> str:
+    """The pass an image of the film belongs to: a Cryptomatte rank pass's own pass, else the image's name."""
+    return image[:-2] if image[:-2] in CRYPTOMATTE_PASSES and image[-2:].isdigit() else image
+
+
 AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 """Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
 writes: 1 per sample whose camera path wrote the AOV)."""
@@ -92,7 +97,7 @@ def pass_channels(name: str, aovs=()) -> str:
     AOVs ``aovs`` ((name, type) pairs, ``RenderSettings.aovs``)."""
     if name in PASS_CHANNELS:
         return PASS_CHANNELS[name]
-    if name[:-2] in CRYPTOMATTE_PASSES and name[-2:].isdigit():
+    if pass_of(name) in CRYPTOMATTE_PASSES:
         return CRYPTOMATTE_CHANNELS
     aov = dict(aovs).get(name)
     if aov is None and name.startswith(LIGHTGROUP_PREFIX):

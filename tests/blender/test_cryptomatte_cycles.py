@@ -207,3 +207,41 @@ def test_the_compositors_cryptomatte_node_picks_the_same_mattes(drt, tmp_path):
         assert 0.02 < c0[..., i].mean() < 0.5 and (c0[..., i] == 1.0).any()
     # the cube's asset holds the sphere too, its material matte does not
     assert drt_m[..., 2].sum() > drt_m[..., 1].sum() + 0.5 * drt_m[..., 0].sum()
+
+
+def test_farm_parts_merge_into_the_single_render(drt, tmp_path):
+    """Two sample ranges rendered as parts in Blender (scene.drt.sample_offset / count) and merged by the
+    CLI's ``merge``: the rank passes equal the single render's bit for bit, and the merged EXR carries
+    the same Cryptomatte metadata."""
+    import subprocess
+    import sys
+
+    scene = crypto_scene()
+    scene.drt.threads = 1
+    single, single_meta = render(scene, "DRT", 0, tmp_path)
+    scene.render.engine = "DRT"
+    rh.configure_drt(scene, SAMPLES, 0)
+    settings = scene.render.image_settings
+    settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.render.filepath, scene.render.use_file_extension = str(tmp_path / "frame_####"), True
+    pieces = []
+    for start, count in ((0, 5), (5, SAMPLES - 5)):
+        scene.drt.sample_offset, scene.drt.sample_count = start, count
+        assert bpy.ops.render.render(write_still=True, scene=scene.name) == {"FINISHED"}
+        pieces.append(tmp_path / f"frame_{scene.frame_current:04d}.samples-{start}-{start + count}.exr")
+        assert pieces[-1].is_file(), sorted(p.name for p in tmp_path.iterdir())
+    out = tmp_path / "merged.exr"
+    root = Path(__file__).resolve().parents[2]
+    result = subprocess.run([sys.executable, "-m", "drt_engine", "merge", *map(str, pieces), "-o", str(out)],
+                            cwd=root, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    channels = rh.read_channels(out)
+    layer = scene.view_layers[0].name
+    for kind in KINDS:
+        merged = np.stack([channels[f"{layer}.{kind}{i:02d}.{c}"] for i in range(3) for c in "rgba"], axis=-1)
+        assert np.array_equal(merged, single[kind]), kind
+    image = oiio.ImageInput.open(str(out))
+    meta = {a.name: a.value for a in image.spec().extra_attribs if a.name.startswith("cryptomatte/")}
+    image.close()
+    assert meta == single_meta

@@ -136,8 +136,8 @@ def test_parts_merge_into_the_whole_render(tmp_path):
     pieces = [rendered_part(data, settings(start=a, end=b, **s))[0] for a, b in ((3, 8), (0, 3))]
     for i, piece in enumerate(pieces):
         parts.write(tmp_path / f"{i}.exr", piece)
-    film = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).film
-    images = film.images()
+    merger = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"])
+    film, images = merger.film, merger.images()
     for name in ("CryptoObject00", "CryptoObject01", "CryptoObject02", "CryptoMaterial00", "CryptoAsset00"):
         assert np.array_equal(images[name], whole.passes[name]), name
     # the parts' slots added as plain sums would add their ids too: the merge is not that

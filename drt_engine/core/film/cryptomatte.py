@@ -78,6 +78,19 @@ def metadata(layer_pass: str, names) -> dict:
             prefix + "conversion": "uint32_to_float32", prefix + "manifest": manifest(names)}
 
 
+def scene_metadata(view_layer: str, scene, passes) -> dict:
+    """Every stamp field of the Cryptomatte passes among ``passes`` of ``scene`` (a SceneData) rendered
+    as view layer ``view_layer``: the render result's, and the header of a farm's merged EXR."""
+    from ..settings import CRYPTOMATTE_PASSES
+
+    kinds = [name for name in CRYPTOMATTE_PASSES if name in passes]
+    if not kinds:
+        return {}
+    ids = SceneIds(scene)
+    return {key: value for kind in kinds
+            for key, value in metadata(f"{view_layer}.{kind}", ids.manifest_names(kind)).items()}
+
+
 def slot_count(levels: int) -> int:
     """Slots per pixel for ``levels`` (the view layer's depth): two per pass, passes rounded up, at most 16
     levels, as Cycles."""
