@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
+from ..scene import DEFAULT_MATERIAL
+from ..settings import CRYPTOMATTE_PASSES
 
 EMPTY = 0.0
 """An empty slot's id (Cycles' ID_NONE): no name hashes to it, the exponent is never 0."""
@@ -81,8 +83,6 @@ def metadata(layer_pass: str, names) -> dict:
 def scene_metadata(view_layer: str, scene, passes) -> dict:
     """Every stamp field of the Cryptomatte passes among ``passes`` of ``scene`` (a SceneData) rendered
     as view layer ``view_layer``: the render result's, and the header of a farm's merged EXR."""
-    from ..settings import CRYPTOMATTE_PASSES
-
     kinds = [name for name in CRYPTOMATTE_PASSES if name in passes]
     if not kinds:
         return {}
@@ -148,8 +148,6 @@ class SceneIds:
     its name (``CryptoMaterial``; the default surface Cycles' ``default_surface``)."""
 
     def __init__(self, scene):
-        from ..scene import DEFAULT_MATERIAL
-
         materials = [DEFAULT_SHADERS[0] if i == 0 and m.name == DEFAULT_MATERIAL.name else m.name
                      for i, m in enumerate(scene.materials)]
         self.names = {"CryptoObject": [inst.name for inst in scene.instances],
