@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.base import jit
 from ..core.errors import DRTError, RenderCancelled
+from ..core.film import cryptomatte
 from ..core.render import report
 from .hooks import render_hooks
 from .oidn import UNAVAILABLE, oidn_library
@@ -94,6 +95,17 @@ def stamp_report(engine, view_layer: str, outcome) -> None:
         result.stamp_data_add_field(f"drt.{view_layer}.{name}", value)
 
 
+def stamp_cryptomatte(engine, view_layer: str, scene_data, settings) -> None:
+    """Each Cryptomatte pass's name, hash, conversion and manifest as the render's metadata, as Cycles
+    stamps them (``cryptomatte/<7 hex digits>/...``): the compositor's Cryptomatte node reads them."""
+    fields = cryptomatte.scene_metadata(view_layer, scene_data, settings.passes)
+    result = engine.get_result() if fields else None
+    if result is None or not hasattr(result, "stamp_data_add_field"):
+        return
+    for key, value in fields.items():
+        result.stamp_data_add_field(key, value)
+
+
 def render(engine, depsgraph) -> None:
     """The engine's ``render``: errors end as one report, a bug's details go to the console."""
     try:
@@ -154,6 +166,7 @@ def _render(engine, depsgraph):
         engine.end_result(result)
     if not engine.is_preview:
         stamp_report(engine, view_layer.name, outcome)
+        stamp_cryptomatte(engine, view_layer.name, scene_data, settings)
     _warn(engine, [w for w in getattr(outcome, "warnings", ()) if w not in scene_data.warnings])
     if not outcome.cancelled:
         engine.update_progress(1.0)

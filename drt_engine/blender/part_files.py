@@ -13,7 +13,7 @@ import os
 import bpy
 
 from ..core.errors import DRTError
-from ..core.film import parts
+from ..core.film import cryptomatte, parts
 from .hooks import render_hooks
 
 
@@ -23,7 +23,8 @@ def keep_part(scene, view_layer, scene_data, film, settings, summary: dict) -> N
     if not (settings.partial or collect):
         return
     header = {"blend": bpy.data.filepath, "frame": scene.frame_current, "view_layer": view_layer.name,
-              "fingerprint": parts.fingerprint(scene_data), "report": summary}
+              "fingerprint": parts.fingerprint(scene_data), "report": summary,
+              "metadata": cryptomatte.scene_metadata(view_layer.name, scene_data, settings.passes)}
     part = parts.from_film(film, settings, header)
     if collect:
         render_hooks.last_parts[view_layer.name] = part

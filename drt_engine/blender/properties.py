@@ -13,7 +13,15 @@ from bpy.props import (
     PointerProperty,
 )
 
-from ..core.settings import NOISY_IMAGE, PASSES, RenderSettings, lightgroup_pass, pass_channels
+from ..core.settings import (
+    CRYPTOMATTE_PASSES,
+    NOISY_IMAGE,
+    PASSES,
+    RenderSettings,
+    cryptomatte_passes,
+    lightgroup_pass,
+    pass_channels,
+)
 from .oidn import oidn_library
 
 BLENDER_PASS_TOGGLES = {
@@ -28,6 +36,9 @@ BLENDER_PASS_TOGGLES = {
     "IndexOB": "use_pass_object_index",
     "IndexMA": "use_pass_material_index",
     "Vector": "use_pass_vector",
+    "CryptoObject": "use_pass_cryptomatte_object",
+    "CryptoMaterial": "use_pass_cryptomatte_material",
+    "CryptoAsset": "use_pass_cryptomatte_asset",
 }
 """Passes Blender has its own view-layer toggle for (the compositor knows them by these names)."""
 
@@ -48,7 +59,7 @@ def result_pass_name(name: str) -> str:
     return RESULT_NAMES_5.get(name, name) if bpy.app.version >= (5, 0, 0) else name
 
 
-_PASS_TYPES = {"RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "XYZW": "VECTOR", "Z": "VALUE", "X": "VALUE"}
+_PASS_TYPES = {"rgba": "COLOR", "RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "XYZW": "VECTOR", "Z": "VALUE", "X": "VALUE"}
 
 
 def pass_enabled(view_layer, name: str) -> bool:
@@ -88,10 +99,13 @@ def denoising_active(scene) -> bool:
 
 
 def registered_passes(scene, view_layer) -> tuple[str, ...]:
-    """The passes a render of this view layer writes: the enabled ones, and Noisy Image when denoising."""
+    """The passes a render of this view layer writes: the enabled ones (a Cryptomatte pass as its rank
+    passes), and Noisy Image when denoising."""
     extra = (NOISY_IMAGE,) if scene is not None and denoising_active(scene) else ()
-    return enabled_passes(view_layer) + tuple(name for name, _ in view_layer_aovs(view_layer)) + \
-        _lightgroup_passes(view_layer) + extra
+    levels = view_layer.pass_cryptomatte_depth
+    written = tuple(rank for name in enabled_passes(view_layer)
+                    for rank in (cryptomatte_passes(name, levels) if name in CRYPTOMATTE_PASSES else (name,)))
+    return written + tuple(name for name, _ in view_layer_aovs(view_layer)) + _lightgroup_passes(view_layer) + extra
 
 
 def _lightgroup_passes(view_layer) -> tuple[str, ...]:
@@ -137,6 +151,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         sample_start=drt.sample_offset,
         sample_end=drt.sample_offset + drt.sample_count if drt.sample_count else 0,
         pass_alpha_threshold=view_layer.pass_alpha_threshold,
+        cryptomatte_levels=view_layer.pass_cryptomatte_depth,
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),
         use_denoising=drt.use_denoising,
         denoising_prefilter=drt.denoising_prefilter,

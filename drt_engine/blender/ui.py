@@ -316,6 +316,22 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer.drt, "use_pass_noise")
 
 
+class DRT_PT_passes_cryptomatte(DRTButtonsPanel, bpy.types.Panel):
+    """The view layer's Cryptomatte passes and their levels (as Cycles' panel)."""
+
+    bl_label = "Cryptomatte"
+    bl_context = "view_layer"
+    bl_parent_id = "DRT_PT_passes"
+
+    def draw(self, context):
+        view_layer = context.view_layer
+        col = split(self.layout).column(heading="Include", align=True)
+        col.prop(view_layer, "use_pass_cryptomatte_object", text="Object")
+        col.prop(view_layer, "use_pass_cryptomatte_material", text="Material")
+        col.prop(view_layer, "use_pass_cryptomatte_asset", text="Asset")
+        col.prop(view_layer, "pass_cryptomatte_depth", text="Levels")
+
+
 class DRT_PT_passes_aov(DRTButtonsPanel, bpy.types.Panel):
     """The view layer's shader AOVs: passes the materials' AOV Output nodes write (as Cycles' panel)."""
 
@@ -404,6 +420,7 @@ classes = (
     DRT_PT_camera_panorama,
     DRT_PT_performance,
     DRT_PT_passes,
+    DRT_PT_passes_cryptomatte,
     DRT_PT_passes_aov,
     DRT_PT_passes_lightgroups,
     DRT_PT_object_lightgroup,

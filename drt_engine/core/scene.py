@@ -260,6 +260,9 @@ class Instance:
     an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
     lightgroup: int = -1
     """The light group its emission counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    asset: str = ""
+    """The name of its object's top-level parent, Cryptomatte's asset (empty: the object has none, its own
+    name)."""
     motion_pass: np.ndarray | None = None
     """For the Vector pass: object-to-world (2, 4, 4) at the previous and the next frame (None: it
     stands still there, or the pass is off)."""

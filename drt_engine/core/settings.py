@@ -28,6 +28,9 @@ PASSES = (
     "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
     "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
     "Vector",  # Cycles' motion vectors in pixels: to the previous frame's position, from the next's (core.film.vector)
+    "CryptoObject",  # Cryptomatte of the objects' names, written as CryptoObject00, 01, ... (core.film.cryptomatte)
+    "CryptoMaterial",  # of the materials' names
+    "CryptoAsset",  # of the objects' top-level parents' names
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -56,6 +59,24 @@ WEIGHTED_PASSES = ("Vector",)
 """Passes whose sums carry one more channel, the count of samples that wrote them, and read as the
 sum over it (Cycles' motion weight: a pixel's vector is the mean of its samples that hit a surface,
 the background's samples count for nothing)."""
+CRYPTOMATTE_PASSES = ("CryptoObject", "CryptoMaterial", "CryptoAsset")
+"""Passes whose sums are (id, weight) slots, read out as ``cryptomatte_levels`` RGBA passes each of two
+ranks (core.film.cryptomatte)."""
+CRYPTOMATTE_CHANNELS = "rgba"
+"""A Cryptomatte rank pass's channels, as Cycles registers them (id, weight, id, weight)."""
+
+
+def cryptomatte_passes(name: str, levels: int) -> tuple[str, ...]:
+    """The rank passes of Cryptomatte pass ``name`` at ``levels``: ``<name>00``, ``<name>01``, ...,
+    one per two levels rounded up (at most 16 levels), as Cycles names them."""
+    return tuple(f"{name}{i:02d}" for i in range((min(16, levels) + 1) // 2))
+
+
+def pass_of(image: str) -> str:
+    """The pass an image of the film belongs to: a Cryptomatte rank pass's own pass, else the image's name."""
+    return image[:-2] if image[:-2] in CRYPTOMATTE_PASSES and image[-2:].isdigit() else image
+
+
 AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 """Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
 writes: 1 per sample whose camera path wrote the AOV)."""
@@ -76,6 +97,8 @@ def pass_channels(name: str, aovs=()) -> str:
     AOVs ``aovs`` ((name, type) pairs, ``RenderSettings.aovs``)."""
     if name in PASS_CHANNELS:
         return PASS_CHANNELS[name]
+    if pass_of(name) in CRYPTOMATTE_PASSES:
+        return CRYPTOMATTE_CHANNELS
     aov = dict(aovs).get(name)
     if aov is None and name.startswith(LIGHTGROUP_PREFIX):
         return "RGB"
@@ -140,6 +163,9 @@ class RenderSettings:
     # the view layer's Alpha Threshold: a hit at least this opaque ends the index passes (IndexOB,
     # IndexMA) of its path; a more transparent one hands them on to the hit behind it (Cycles' rule)
     pass_alpha_threshold: float = 0.5
+    # the view layer's Cryptomatte Levels: (id, weight) ranks kept per pixel, two per pass, for the
+    # Cryptomatte passes among ``passes`` (core.film.cryptomatte)
+    cryptomatte_levels: int = 6
     # Cycles from Blender 5.2 on scales Denoising Normal by the feature walk's mean throughput
     # (measured: seen in a mirror of tint t, |n| = mean(t)); 5.0 and older write unit normals
     weighted_denoising_normal: bool = False

@@ -34,7 +34,8 @@ def write_output(output: Path, merger) -> None:
     images = merger.images(merge_denoiser(merger))
     try:
         output.parent.mkdir(parents=True, exist_ok=True)
-        merge.write_exr(output, images, merger.first.header["view_layer"], merger.first.settings().aovs)
+        header = merger.first.header
+        merge.write_exr(output, images, header["view_layer"], merger.first.settings().aovs, header.get("metadata"))
     except OSError as error:
         raise CLIError(f"cannot write {output}: {error.strerror or error}") from None
 

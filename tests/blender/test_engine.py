@@ -23,7 +23,7 @@ from drt_engine.blender.properties import result_pass_name
 from drt_engine.blender.status import done_line, stats_line
 from drt_engine.core.render.render import WAVE, Renderer
 from drt_engine.core.scene import DEFAULT_MATERIAL, Camera, Closure, Instance, Material, Mesh, SceneData
-from drt_engine.core.settings import PASSES, RenderSettings
+from drt_engine.core.settings import CRYPTOMATTE_PASSES, PASSES, RenderSettings, cryptomatte_passes
 
 from tests.support.datablocks import new_compositor
 
@@ -91,15 +91,21 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
     view_layer = scene.view_layers[LAYER]
     for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_diffuse_color",
                  "use_pass_glossy_color", "use_pass_emit", "use_pass_environment", "use_pass_mist",
-                 "use_pass_object_index", "use_pass_material_index", "use_pass_vector"):
+                 "use_pass_object_index", "use_pass_material_index", "use_pass_vector",
+                 "use_pass_cryptomatte_object", "use_pass_cryptomatte_material", "use_pass_cryptomatte_asset"):
         setattr(view_layer, attr, True)
     view_layer.drt.use_pass_sample_count = True
     view_layer.drt.use_pass_noise = True
     view_layer.drt.use_pass_denoising_data = True
     channels = bl.render_exr(scene, tmp_path / "all.exr")
-    assert bl.passes_in(channels, LAYER) == {result_pass_name(name) for name in PASSES}
+    ranks = [rank for name in CRYPTOMATTE_PASSES for rank in cryptomatte_passes(name, view_layer.pass_cryptomatte_depth)]
+    assert bl.passes_in(channels, LAYER) == {result_pass_name(name) for name in PASSES
+                                             if name not in CRYPTOMATTE_PASSES} | set(ranks)
     for name in PASSES:
-        assert np.all(np.isfinite(bl.pass_pixels(channels, LAYER, name))), name
+        if name not in CRYPTOMATTE_PASSES:
+            assert np.all(np.isfinite(bl.pass_pixels(channels, LAYER, name))), name
+    for rank in ranks:
+        assert all(np.all(np.isfinite(channels[f"{LAYER}.{rank}.{c}"])) for c in "rgba"), rank
     np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Emit"), STRENGTH, rtol=1e-4)
     np.testing.assert_allclose(bl.pass_pixels(channels, LAYER, "Env"), 0.0, atol=1e-6)
     np.testing.assert_array_equal(bl.pass_pixels(channels, LAYER, "Sample Count"), scene.drt.samples)

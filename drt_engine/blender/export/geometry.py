@@ -397,7 +397,7 @@ class GeometryExporter:
                                            color=tuple(obj.color), pass_index=obj.pass_index, random=random,
                                            holdout=self._holdout(parent or obj),
                                            lightgroup=lightgroup_of(obj, self.light_groups),
-                                           **ray_visibility(obj, parent)))
+                                           asset=asset_name(obj), **ray_visibility(obj, parent)))
             self.keys.append(key)
 
     def _holdout(self, obj) -> bool:
@@ -466,6 +466,15 @@ class GeometryExporter:
 
 
 RAY_KINDS = ("camera", "shadow", "diffuse", "glossy", "transmission")
+
+
+def asset_name(obj) -> str:
+    """Cryptomatte's asset of ``obj``: its top-level parent's name, empty for an object without a
+    parent (its own name; Cycles' sync_object)."""
+    top = obj.parent
+    while top is not None and top.parent is not None:
+        top = top.parent
+    return "" if top is None else top.name
 
 
 def ray_visibility(obj, parent=None) -> dict:

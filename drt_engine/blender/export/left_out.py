@@ -27,9 +27,6 @@ PASSES = (  # view-layer toggle, the pass as Blender's Passes panel names it
     ("use_pass_transmission_indirect", "Transmission Indirect"),
     ("use_pass_transmission_color", "Transmission Color"),
     ("use_pass_ambient_occlusion", "Ambient Occlusion"),
-    ("use_pass_cryptomatte_object", "Cryptomatte Object"),
-    ("use_pass_cryptomatte_material", "Cryptomatte Material"),
-    ("use_pass_cryptomatte_asset", "Cryptomatte Asset"),
 )
 """Cycles' passes DRT does not write yet (its Diffuse and Glossy Color it does): a view layer that
 asks for them gets no such pass, so the warning names them."""

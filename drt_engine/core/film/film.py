@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..settings import FIRST_SAMPLE_PASSES, WEIGHTED_PASSES, pass_channels
+from ..settings import CRYPTOMATTE_PASSES, FIRST_SAMPLE_PASSES, WEIGHTED_PASSES, cryptomatte_passes, pass_channels
+from .cryptomatte import add_slots, ranks, slot_count
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 
 _TABLE = 1024
@@ -179,7 +180,9 @@ def _extend_range(pixel, combined, lo, hi):
 class Film:
     """Sums per pixel of the window: samples, every pass, and Combined RGB over class A; the
     ``FIRST_SAMPLE_PASSES`` hold only their pixel's first sample, read as it is; the
-    ``WEIGHTED_PASSES`` sum one more channel, their weight, and are read over it.
+    ``WEIGHTED_PASSES`` sum one more channel, their weight, and are read over it; the
+    ``CRYPTOMATTE_PASSES`` keep (id, weight) slots for ``cryptomatte_levels`` and are read as their
+    rank passes (core.film.cryptomatte).
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
@@ -190,11 +193,14 @@ class Film:
     """
 
     def __init__(self, width: int, height: int, passes: tuple[str, ...], track_range: bool = False,
-                 ratio: bool = False, halved: tuple[str, ...] = (), aovs: tuple = ()):
+                 ratio: bool = False, halved: tuple[str, ...] = (), aovs: tuple = (), cryptomatte_levels: int = 6):
         self.width, self.height = width, height
         self.n = width * height
         self.passes = passes
-        self.channels = {name: len(pass_channels(name, aovs)) for name in passes}
+        self.cryptomatte_levels = cryptomatte_levels
+        slots = 2 * slot_count(cryptomatte_levels)
+        self.channels = {name: slots if name in CRYPTOMATTE_PASSES else len(pass_channels(name, aovs))
+                         for name in passes}
         self.count = np.zeros(self.n)
         self.sums = {name: np.zeros((self.n, self.channels[name] + (name in WEIGHTED_PASSES)))
                      for name in passes if name not in ("Sample Count", "Noise")}
@@ -219,6 +225,8 @@ class Film:
                 _splat_ratio(pixel, sample, values[name], replicate, total)
             elif name in FIRST_SAMPLE_PASSES:
                 _splat_first(pixel, sample, values[name], replicate, total)
+            elif name in CRYPTOMATTE_PASSES:
+                add_slots(pixel, values[name], total)
             else:
                 _splat(pixel, values[name], total)
         for name, total in self.sums_a.items():
@@ -289,11 +297,22 @@ class Film:
         """
         out = {}
         for name in self.passes if names is None else [n for n in self.passes if n in names]:
+            if name in CRYPTOMATTE_PASSES:
+                out.update(self._cryptomatte_images(name))
+                continue
             img = np.empty((self.n, self.channels[name]), np.float32)
             for span in self.blocks():
                 img[span] = self._pass_block(name, span)
             out[name] = img.reshape(self.height, self.width, -1)
         return out
+
+    def _cryptomatte_images(self, name: str) -> dict[str, np.ndarray]:
+        """Cryptomatte pass ``name`` as its rank passes, (height, width, 4) float32 each."""
+        img = np.empty((self.n, self.channels[name]), np.float32)
+        for span in self.blocks():
+            img[span] = ranks(self.sums[name][span], self.count[span])
+        img = img.reshape(self.height, self.width, -1)
+        return {rank: img[..., 4 * i:4 * i + 4] for i, rank in enumerate(cryptomatte_passes(name, self.cryptomatte_levels))}
 
     def _pass_block(self, name: str, span: slice) -> np.ndarray:
         count = self.count[span]

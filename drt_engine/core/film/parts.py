@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import DRTError
-from ..settings import RenderSettings
+from ..settings import CRYPTOMATTE_PASSES, RenderSettings
+from .cryptomatte import add_slots
 from .film import Film
 from .ratio_sums import RATIO
 
@@ -245,12 +246,16 @@ def _difference(a, b) -> str:
 
 
 def add(film: Film, part: Part) -> None:
-    """Add a part's sums into ``film`` (a film of the same size, passes and halved passes)."""
+    """Add a part's sums into ``film`` (a film of the same size, passes and halved passes); a
+    Cryptomatte pass's slots merge id by id (core.film.cryptomatte)."""
     film.count += part.count
     film.count_a += part.count_a
     film.sum_a += part.sum_a
     for name, total in film.sums.items():
-        total += part.sums[name]
+        if name in CRYPTOMATTE_PASSES:
+            add_slots(np.arange(film.n, dtype=np.int64), part.sums[name], total)
+        else:
+            total += part.sums[name]
     for name, total in film.sums_a.items():
         total += part.sums_a[name]
 

@@ -27,6 +27,7 @@ from ..bsdf.blur import blur_roughness
 from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
 from ..bsdf.specular_normal import valid_specular_reflection
+from ..film.cryptomatte import SceneIds, slot_count, write_hits
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
@@ -35,7 +36,7 @@ from ..geometry import camera as camera_rays
 from ..geometry.motion_vectors import MotionVectors
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
-from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
+from ..settings import AOV_CHANNELS, CRYPTOMATTE_PASSES, LIGHTGROUP_PREFIX
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, camera_bounces, reads_light_path
 from ..shading.bevel import bevels
 from ..shading.occlusion import OcclusionRays, traces
@@ -150,6 +151,8 @@ class Integrator:
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
         self.motion_vectors = MotionVectors(scene.camera, scene.instances, scene.meshes) \
             if "Vector" in settings.passes else None
+        self.cryptomatte = [name for name in CRYPTOMATTE_PASSES if name in settings.passes]
+        self.cryptomatte_ids = SceneIds(scene).ids if self.cryptomatte else None
         aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
@@ -206,6 +209,8 @@ class Integrator:
         aux.update((name, np.zeros((n, 3))) for name in self.group_passes)
         if self.motion_vectors is not None:
             aux["Vector"] = np.zeros((n, 5))  # the vector and its weight (core.film.film WEIGHTED_PASSES)
+        slots = 2 * slot_count(s.cryptomatte_levels)
+        aux.update((name, np.zeros((n, slots))) for name in self.cryptomatte)  # per path (id, weight) slots
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if self.groups is not None:
@@ -272,7 +277,7 @@ class Integrator:
                     self._colors(group, shader, out)
                 if out.features is not None:
                     out.features.surface(group, shader)
-                if self.mist is not None or out.indexed is not None:
+                if self.mist is not None or out.indexed is not None or self.cryptomatte:
                     self._data_passes(group, shader, out)
                 if light is not None and shader.lobes:
                     # no ray leaves the last depth: its light is light sampling's alone
@@ -448,15 +453,21 @@ class Integrator:
         as Cycles' film_write_data_passes: each hit takes (1 - mist) of Mist, weighted by the path's
         throughput times the hit's opacity; an index is the last such hit's until one is at least
         as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film);
-        that hit alone writes the Vector pass, with weight 1 (core.geometry.motion_vectors)."""
+        that hit alone writes the Vector pass, with weight 1 (core.geometry.motion_vectors). Each hit
+        writes its Cryptomatte ids with Mist's weight (core.film.cryptomatte)."""
         rows = np.flatnonzero(group.straight)
         if len(rows) == 0:
             return
         path = group.path[rows]
         opacity = np.clip(1.0 - shader.transparency(group.wo_l[rows, 2], rows), 0.0, 1.0)
+        seen = (group.throughput[rows] * opacity).mean(axis=1)
         if self.mist is not None:
-            seen = (group.throughput[rows] * opacity).mean(axis=1)
             out.aux["Mist"][path, 0] -= (1.0 - self.mist.amount(group.pos[rows])) * seen
+        if self.cryptomatte:
+            instance = self.geometry.source_of(group.prim[rows])[:, 0]
+            for name in self.cryptomatte:
+                owner = group.mat[rows] if name == "CryptoMaterial" else instance
+                write_hits(out.aux[name], path, self.cryptomatte_ids[name][owner], seen)
         if out.indexed is not None:
             open_ = ~out.indexed[path]
             rows, path = rows[open_], path[open_]

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..film.denoising import ALBEDO, NORMAL, PASSES as FEATURES
 from ..film.film import Film
-from ..settings import NOISY_IMAGE
+from ..settings import NOISY_IMAGE, pass_of
 from .adaptive import RELMSE_EPSILON, TRUE_FLOOR
 
 
@@ -104,7 +104,7 @@ def denoised_passes(passes: dict, denoised: Denoised, wanted) -> dict:
     noisy = passes["Combined"]
     combined = noisy.copy()
     combined[..., :3] = denoised.rgb
-    out = {name: image for name, image in passes.items() if name in wanted}
+    out = {name: image for name, image in passes.items() if pass_of(name) in wanted}
     out["Combined"], out[NOISY_IMAGE] = combined, noisy
     return out
 

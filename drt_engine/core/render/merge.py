@@ -13,7 +13,7 @@ import numpy as np
 
 from ..film import parts as parts_mod
 from ..film.film import Film
-from ..settings import pass_channels
+from ..settings import pass_channels, pass_of
 from .denoise import denoise_film, denoised_passes, figures
 from .report import ErrorLog, report_dict
 
@@ -38,7 +38,7 @@ class Merger:
             self.first = part
             self.film = Film(part.width, part.height, tuple(part.header["passes"]),
                              ratio=parts_mod.RATIO in part.header["channels"], halved=tuple(part.header["halved"]),
-                             aovs=part.settings().aovs)
+                             aovs=part.settings().aovs, cryptomatte_levels=part.settings().cryptomatte_levels)
         else:
             parts_mod.check_same(self.first, part, "the first part", name)
         if part.sample_range not in self.ranges:
@@ -76,7 +76,7 @@ class Merger:
         settings = self.first.settings()
         passes = self.film.images()
         if not (self.denoising and denoiser is not None):
-            return {name: image for name, image in passes.items() if name in settings.passes}
+            return {name: image for name, image in passes.items() if pass_of(name) in settings.passes}
         if self.denoised is None:
             with denoiser.filters() as filters:
                 self.denoised = denoise_film(self.film, filters, settings.denoising_prefilter,
@@ -116,9 +116,10 @@ def merge_parts(parts: list[parts_mod.Part], names: list[str]) -> Merger:
     return merger
 
 
-def write_exr(path, images: dict, view_layer: str, aovs=()) -> None:
+def write_exr(path, images: dict, view_layer: str, aovs=(), metadata=None) -> None:
     """Every pass of ``images`` ((h, w, channels), rows from the bottom) as Blender's multilayer EXR
-    names it (``layer.pass.channel``), float32, top row first; ``aovs``: the shader AOVs among them."""
+    names it (``layer.pass.channel``), float32, top row first; ``aovs``: the shader AOVs among them;
+    ``metadata``: header fields (the Cryptomatte passes' stamps, as Blender writes them)."""
     import OpenImageIO as oiio
 
     names = [f"{view_layer}.{name}.{c}" for name in images for c in pass_channels(name, aovs)]
@@ -126,6 +127,8 @@ def write_exr(path, images: dict, view_layer: str, aovs=()) -> None:
     spec = oiio.ImageSpec(pixels.shape[1], pixels.shape[0], len(names), oiio.FLOAT)
     spec.channelnames = tuple(names)
     spec.attribute("compression", "zip")
+    for key, value in (metadata or {}).items():
+        spec.attribute(key, value)
     out = oiio.ImageOutput.create(str(path))
     if out is None or not out.open(str(path), spec):
         raise OSError(f"cannot write {path}: {(out.geterror() if out else '') or oiio.geterror()}")

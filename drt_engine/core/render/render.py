@@ -24,7 +24,7 @@ from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import RenderSettings
+from ..settings import RenderSettings, pass_of
 from ..validate import validate_camera
 from . import adaptive
 from .denoise import Schedule, denoise_film, denoised_passes, figures
@@ -85,7 +85,8 @@ class Renderer:
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
-                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs)
+                         halved=FEATURE_PASSES if settings.use_denoising else (), aovs=settings.aovs,
+                         cryptomatte_levels=settings.cryptomatte_levels)
 
     @property
     def rays(self) -> dict:
@@ -189,7 +190,7 @@ class Renderer:
         passes = film.images()
         warnings = list(self.warnings)
         if s.use_denoising and s.partial:  # the part's film keeps the features for the merge
-            passes = {name: image for name, image in passes.items() if name in s.passes}
+            passes = {name: image for name, image in passes.items() if pass_of(name) in s.passes}
             warnings.append("this render is one range of the samples (a farm part): it is not denoised here; "
                             "merging the parts denoises the merged image")
         if self.denoising and outcome.stopped != "cancelled":
