@@ -27,6 +27,13 @@ PASSES = (
     "Mist",  # Cycles' mist: 0 near, 1 far and for the background, by the world's mist settings
     "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
     "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
+    "DiffDir",  # Cycles' light passes (core.integrator.lightpasses): light by the first hit's diffuse lobes,
+    "DiffInd",  # direct (light samples at the first hit, emission its bounce ray finds) and indirect
+    "GlossDir",  # (what later vertices bring), each read out divided by its colour pass
+    "GlossInd",
+    "TransDir",
+    "TransInd",
+    "TransCol",  # transmission albedo of the first hit
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -44,12 +51,32 @@ PASS_CHANNELS = {
     "Mist": "Z",
     "IndexOB": "X",
     "IndexMA": "X",
+    "DiffDir": "RGB",
+    "DiffInd": "RGB",
+    "GlossDir": "RGB",
+    "GlossInd": "RGB",
+    "TransDir": "RGB",
+    "TransInd": "RGB",
+    "TransCol": "RGB",
     "Noisy Image": "RGBA",
 }
 FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
 """Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
 mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
 writes these at sample 0 only, core.film.film)."""
+LIGHT_PASSES = {"DiffDir": "DiffCol", "DiffInd": "DiffCol", "GlossDir": "GlossCol", "GlossInd": "GlossCol",
+                "TransDir": "TransCol", "TransInd": "TransCol"}
+"""Cycles' light passes and the colour pass each is read out divided by (Cycles' divide_even_color):
+a render of one also sums its colour (``with_light_pass_colours``), as Cycles allocates it."""
+
+
+def with_light_pass_colours(passes) -> tuple[str, ...]:
+    """``passes`` and the colour passes its light passes are divided by."""
+    passes = tuple(passes)
+    return passes + tuple(dict.fromkeys(LIGHT_PASSES[name] for name in passes
+                                        if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
+
+
 AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 """Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
 writes: 1 per sample whose camera path wrote the AOV)."""
@@ -178,6 +205,7 @@ class RenderSettings:
         self.passes = tuple(self.passes) + tuple(name for name, _ in self.aovs if name not in self.passes)
         if "Combined" not in self.passes:
             self.passes = ("Combined",) + tuple(self.passes)
+        self.passes = with_light_pass_colours(self.passes)
         start, end = self.sample_range()
         if not 0 <= start < end <= self.samples:
             raise SettingsError(f"sample range {start}:{end} is not inside the {self.samples} samples 0:{self.samples}")

@@ -1018,21 +1018,3 @@ def test_metallic_bsdf_is_a_principled_metal(fresnel):
         np.testing.assert_allclose(closure.color, f0, rtol=1e-6)
         np.testing.assert_allclose(closure.specular_tint, tint, rtol=1e-6)
         assert len(data.warnings) == 1 and "Physical Conductor" in data.warnings[0]
-
-
-def test_light_passes_drt_does_not_write_are_named_in_the_warning():
-    """Cycles' Diffuse / Glossy / Transmission Direct and Indirect and Transmission Color: a view layer
-    asking for them gets no such pass from DRT, and says so (Diffuse / Glossy Color it writes)."""
-    scene = empty_scene()
-    add_object(scene, "Cube", cube_mesh())
-    layer = scene.view_layers[0]
-    layer.use_pass_diffuse_color = layer.use_pass_glossy_color = True
-    assert render_export(scene).warnings == []
-    layer.use_pass_diffuse_direct = layer.use_pass_glossy_indirect = layer.use_pass_transmission_color = True
-    try:
-        (warning,) = render_export(scene).warnings
-    finally:
-        layer.use_pass_diffuse_direct = layer.use_pass_glossy_indirect = layer.use_pass_transmission_color = False
-        layer.use_pass_diffuse_color = layer.use_pass_glossy_color = False
-    assert "Diffuse Direct" in warning and "Glossy Indirect" in warning and "Transmission Color" in warning
-    assert "Diffuse Color" not in warning and "Glossy Direct" not in warning

@@ -16,7 +16,7 @@ from ...core.scene import SceneData
 from ..properties import lightgroup_of, view_layer_lightgroups
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
-from .left_out import LeftOut, passes_left_out
+from .left_out import LeftOut
 from .lights import export_light
 from .materials import MaterialTable
 from .motion import add_motion, instance_key
@@ -76,8 +76,6 @@ def export_scene(
     geometry.finish()
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
     warnings.extend(left_out.warnings())
-    if depsgraph.mode == "RENDER":  # the viewport writes no passes
-        warnings.extend(passes_left_out(depsgraph.view_layer))
     scene_data = SceneData(
         camera=camera,
         meshes=geometry.meshes,

@@ -1,7 +1,6 @@
 """What of a scene Cycles renders and DRT does not yet, found while exporting: objects of the types
-it leaves out (one warning), object and light settings it does not read (another) and the view
-layer's passes it does not write (a third), so that a scene relying on them is never rendered
-differently without a word.
+it leaves out (one warning) and object and light settings it does not read (another), so that a
+scene relying on them is never rendered differently without a word.
 
 Each object is looked at once (its instances share its settings). Objects' and lights' ray
 visibility, lights' Cast Shadow, objects' Holdout and the world's ray visibility are read (export.geometry,
@@ -15,18 +14,6 @@ meshes; empties, armatures, grease pencil and the like render in neither)."""
 
 SHOWN = 3
 """Object names a setting's entry shows before "and N more"."""
-
-LIGHT_PASSES = (  # view-layer toggle, the pass as Blender's Passes panel names it
-    ("use_pass_diffuse_direct", "Diffuse Direct"),
-    ("use_pass_diffuse_indirect", "Diffuse Indirect"),
-    ("use_pass_glossy_direct", "Glossy Direct"),
-    ("use_pass_glossy_indirect", "Glossy Indirect"),
-    ("use_pass_transmission_direct", "Transmission Direct"),
-    ("use_pass_transmission_indirect", "Transmission Indirect"),
-    ("use_pass_transmission_color", "Transmission Color"),
-)
-"""Cycles' light passes DRT does not write yet (its Diffuse and Glossy Color it does): a view layer
-that asks for them gets no such pass, so the warning names them."""
 
 OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning calls another value
     ("is_shadow_catcher", False, "shadow catcher"),
@@ -87,11 +74,3 @@ class LeftOut:
             more = f" and {len(names) - SHOWN} more" if len(names) > SHOWN else ""
             parts.append(f"{what} ({shown}{more})")
         return out + ["object and light settings DRT does not render yet, rendered as if unset: " + "; ".join(parts)]
-
-
-def passes_left_out(view_layer) -> list[str]:
-    """One line naming the view layer's enabled passes DRT does not write (none: no line)."""
-    names = [name for toggle, name in LIGHT_PASSES if getattr(view_layer, toggle, False)]
-    if not names:
-        return []
-    return ["passes DRT does not write yet (not in the render result): " + ", ".join(names)]

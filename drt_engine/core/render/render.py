@@ -20,6 +20,7 @@ from ..film.film import Film
 from ..integrator.aovs import AOV_TRANSPARENCY
 from ..integrator.bounces import LIMIT_TRANSPARENCY
 from ..integrator.integrator import Integrator
+from ..integrator.lightpasses import RATIO_LEFT_OUT, SHADOWS_LEFT_OUT
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
@@ -97,13 +98,18 @@ class Renderer:
 
     def _setting_warnings(self) -> list[str]:
         """What these settings make DRT approximate in this scene: shader AOVs behind transparency
-        (core.integrator.aovs), paths a bounce limit ends before transparency (core.integrator.bounces)."""
+        (core.integrator.aovs), paths a bounce limit ends before transparency (core.integrator.bounces),
+        light passes without transparent shadows' or the ratio estimator's share (core.integrator.lightpasses)."""
         transparent = any(c.kind == "TRANSPARENT" for m in self.scene.materials for c in m.closures)
         warnings = []
         if self.integrator.aovs is not None and transparent:
             warnings.append(AOV_TRANSPARENCY)
         if self.integrator.limited and transparent:
             warnings.append(LIMIT_TRANSPARENCY)
+        if self.integrator.light_passes and self.integrator.shadows is not None:
+            warnings.append(SHADOWS_LEFT_OUT)
+        if self.integrator.light_passes and self.integrator.ratio:
+            warnings.append(RATIO_LEFT_OUT)
         return warnings
 
     def render(self, progress=None) -> RenderResult:
