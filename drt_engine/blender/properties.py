@@ -34,6 +34,7 @@ BLENDER_PASS_TOGGLES = {
     "Mist": "use_pass_mist",
     "IndexOB": "use_pass_object_index",
     "IndexMA": "use_pass_material_index",
+    "Vector": "use_pass_vector",
 }
 """Passes Blender has its own view-layer toggle for (the compositor knows them by these names)."""
 
@@ -54,7 +55,7 @@ def result_pass_name(name: str) -> str:
     return RESULT_NAMES_5.get(name, name) if bpy.app.version >= (5, 0, 0) else name
 
 
-_PASS_TYPES = {"RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "Z": "VALUE", "X": "VALUE"}
+_PASS_TYPES = {"RGBA": "COLOR", "RGB": "COLOR", "XYZ": "VECTOR", "XYZW": "VECTOR", "Z": "VALUE", "X": "VALUE"}
 
 
 def pass_enabled(view_layer, name: str) -> bool:

@@ -298,6 +298,9 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_normal")
         col.prop(view_layer, "use_pass_position")
         col.prop(view_layer, "use_pass_mist")
+        sub = col.column()
+        sub.active = not context.scene.render.use_motion_blur  # as Cycles: with motion blur the pass is 0
+        sub.prop(view_layer, "use_pass_vector")
         col.prop(view_layer.drt, "use_pass_denoising_data")
         col = layout.column(heading="Indexes", align=True)
         col.prop(view_layer, "use_pass_object_index")

@@ -181,7 +181,9 @@ class Mesh:
     object space (smooth, flat or custom split normals alike); ``None`` means flat.
     ``material_indices`` (T,) index ``SceneData.materials``. ``uvs`` (T, 3, 2) or None.
     ``motion_vertices`` (S, V, 3): object-space vertices at S evenly spaced shutter times
-    for a mesh that deforms (same topology throughout), else None.
+    for a mesh that deforms (same topology throughout), else None. ``motion_pass_vertices``
+    (2, V, 3): for the Vector pass, its object-space vertices at the previous and the next frame
+    when they move (None: they stand still, or the pass is off).
     ``attributes``: per-corner data by name, (T, 3, 2) for UV maps, (T, 3, 4) for colour
     attributes, (T, 3, 1 to 4) for other attributes (a float, a 2D or 3D vector, a colour, a
     quaternion); ``uvs`` is the default (active render) UV map and ``colors`` the default
@@ -196,6 +198,7 @@ class Mesh:
     corner_normals: np.ndarray | None = None
     uvs: np.ndarray | None = None
     motion_vertices: np.ndarray | None = None
+    motion_pass_vertices: np.ndarray | None = None
     attributes: dict = field(default_factory=dict)
     colors: np.ndarray | None = None
     texspace: tuple | None = None
@@ -204,6 +207,9 @@ class Mesh:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
         if self.motion_vertices is not None:
             self.motion_vertices = np.asarray(self.motion_vertices, dtype=np.float64).reshape(-1, len(self.vertices), 3)
+        if self.motion_pass_vertices is not None:
+            self.motion_pass_vertices = np.asarray(self.motion_pass_vertices, np.float64).reshape(
+                2, len(self.vertices), 3)
         self.triangles = np.ascontiguousarray(self.triangles, dtype=np.int32).reshape(-1, 3)
         self.material_indices = np.ascontiguousarray(self.material_indices, dtype=np.int32).reshape(-1)
         if self.material_indices.size == 1 and len(self.triangles) != 1:
@@ -218,6 +224,10 @@ class Mesh:
             self.colors = np.asarray(self.colors, dtype=np.float32).reshape(-1, 3, 4)
         self.attributes = {k: np.asarray(v, dtype=np.float32).reshape(len(self.triangles), 3, -1)
                            for k, v in self.attributes.items()}
+
+
+LIGHT_SETS_ALL = (1 << 64) - 1
+"""An emitter's light-set membership when it lights every object (no light linking)."""
 
 
 @dataclass
@@ -250,10 +260,23 @@ class Instance:
     an emissive object lights only the BSDF parts of the kinds that see it, as in Cycles)."""
     lightgroup: int = -1
     """The light group its emission counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    motion_pass: np.ndarray | None = None
+    """For the Vector pass: object-to-world (2, 4, 4) at the previous and the next frame (None: it
+    stands still there, or the pass is off)."""
+    receiver_light_set: int = 0
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking (core.lights.linking): the receiver set the object is in (0: the default) and,
+    for its emission, the sets it lights."""
+    blocker_shadow_set: int = 0
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking, alike: the blocker set the object is in and, for its emission, the blocker
+    sets that cast its shadows."""
 
     def __post_init__(self):
         self.color = np.asarray(self.color, dtype=np.float64).reshape(4)
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+        if self.motion_pass is not None:
+            self.motion_pass = np.asarray(self.motion_pass, dtype=np.float64).reshape(2, 4, 4)
 
     @property
     def matrix(self) -> np.ndarray:
@@ -310,6 +333,10 @@ class Light:
     name: str = ""
     lightgroup: int = -1
     """The light group its light counts to (an index into ``SceneData.light_groups``; -1: none)."""
+    light_set_membership: int = LIGHT_SETS_ALL
+    """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
+    shadow_set_membership: int = LIGHT_SETS_ALL
+    """Shadow linking: the objects' blocker sets that cast its shadows."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:
@@ -422,9 +449,14 @@ class Camera:
     rolling_shutter: float | None = None
     """Rolling shutter (rows read from the top down over the shutter): Cycles' rolling shutter
     duration, None when off."""
+    motion_pass: np.ndarray | None = None
+    """For the Vector pass: camera-to-world (2, 4, 4) at the previous and the next frame (None: it
+    stands still there, or the pass is off)."""
 
     def __post_init__(self):
         self.matrices = np.asarray(self.matrices, dtype=np.float64).reshape(-1, 4, 4)
+        if self.motion_pass is not None:
+            self.motion_pass = np.asarray(self.motion_pass, dtype=np.float64).reshape(2, 4, 4)
         w, h = (int(v) for v in self.resolution)
         if w < 1 or h < 1:
             raise ValueError(f"camera resolution must be positive, got {w}x{h}")

@@ -34,6 +34,7 @@ PASSES = (
     "TransDir",
     "TransInd",
     "TransCol",  # transmission albedo of the first hit
+    "Vector",  # Cycles' motion vectors in pixels: to the previous frame's position, from the next's (core.film.vector)
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -58,6 +59,7 @@ PASS_CHANNELS = {
     "TransDir": "RGB",
     "TransInd": "RGB",
     "TransCol": "RGB",
+    "Vector": "XYZW",
     "Noisy Image": "RGBA",
 }
 FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
@@ -77,6 +79,10 @@ def with_light_pass_colours(passes) -> tuple[str, ...]:
                                         if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
 
 
+WEIGHTED_PASSES = ("Vector",)
+"""Passes whose sums carry one more channel, the count of samples that wrote them, and read as the
+sum over it (Cycles' motion weight: a pixel's vector is the mean of its samples that hit a surface,
+the background's samples count for nothing)."""
 AOV_CHANNELS = {"COLOR": "RGBA", "VALUE": "X"}
 """Channels of a shader AOV pass by its type, as Cycles registers them (a colour's alpha counts the
 writes: 1 per sample whose camera path wrote the AOV)."""

@@ -91,7 +91,7 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
     view_layer = scene.view_layers[LAYER]
     for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_diffuse_color",
                  "use_pass_glossy_color", "use_pass_emit", "use_pass_environment", "use_pass_mist",
-                 "use_pass_object_index", "use_pass_material_index", "use_pass_diffuse_direct",
+                 "use_pass_object_index", "use_pass_material_index", "use_pass_vector", "use_pass_diffuse_direct",
                  "use_pass_diffuse_indirect", "use_pass_glossy_direct", "use_pass_glossy_indirect",
                  "use_pass_transmission_direct", "use_pass_transmission_indirect", "use_pass_transmission_color"):
         setattr(view_layer, attr, True)

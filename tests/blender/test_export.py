@@ -932,8 +932,8 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
 
 
 def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Shadow catcher and light linking change Cycles' image; until DRT reads them, a scene using
-    them says so (objects named, a long list cut short). Light groups are read: not named."""
+    """Shadow catcher changes Cycles' image; until DRT reads it, a scene using it says so (objects
+    named, a long list cut short). Light groups and light linking are read: not named."""
     scene = empty_scene()
     cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
     for cube in cubes[:5]:
@@ -942,14 +942,48 @@ def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
     cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
     data = render_export(scene)
     (warning,) = data.warnings
-    for expected in ("shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)", "light or shadow linking ('Cube3')"):
-        assert expected in warning, warning
+    assert "shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)" in warning, warning
     assert "Cube5" not in warning and "visibility" not in warning and "holdout" not in warning
-    assert "light group" not in warning
+    assert "light group" not in warning and "linking" not in warning
     for cube in cubes[:5]:
         cube.is_shadow_catcher = False
     cubes[3].light_linking.receiver_collection = None
     assert not render_export(scene).warnings
+
+
+def test_light_and_shadow_linking_are_exported():
+    """A receiver collection excluding one cube and a blocker collection including another: the
+    excluded cube gets its own receiver set, which the emitter's membership leaves out; the
+    included cube its own blocker set, the emitter's shadow membership that set alone."""
+    scene = empty_scene()
+    cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(3)]
+    receivers, blockers = bpy.data.collections.new("Receivers"), bpy.data.collections.new("Blockers")
+    receivers.objects.link(cubes[1])
+    receivers.collection_objects[0].light_linking.link_state = "EXCLUDE"
+    blockers.objects.link(cubes[2])
+    cubes[0].light_linking.receiver_collection = receivers
+    cubes[0].light_linking.blocker_collection = blockers
+    data = render_export(scene)
+    by_name = {i.name: i for i in data.instances}
+    emitter, excluded, blocker = by_name["Cube0"], by_name["Cube1"], by_name["Cube2"]
+    assert excluded.receiver_light_set == 1 and by_name["Cube2"].receiver_light_set == 0
+    assert emitter.light_set_membership == (1 << 64) - 1 - 2
+    assert blocker.blocker_shadow_set == 1 and excluded.blocker_shadow_set == 0
+    assert emitter.shadow_set_membership == 2
+    assert excluded.light_set_membership == (1 << 64) - 1 and not data.warnings
+
+
+def test_more_blocker_sets_than_drt_tells_apart_are_named():
+    """Each of 28 emitters' blocker collection includes a cube of its own: 28 blocker sets, past the
+    26 DRT's shadow masks tell apart (the 27th and 28th cubes cast every shadow): one warning."""
+    scene = empty_scene()
+    for i in range(28):
+        emitter = add_object(scene, f"Emitter{i}", cube_mesh(f"Emitter{i}"))
+        blockers = bpy.data.collections.new(f"Blockers{i}")
+        blockers.objects.link(add_object(scene, f"Blocker{i}", cube_mesh(f"Blocker{i}")))
+        emitter.light_linking.blocker_collection = blockers
+    warnings = [w for w in render_export(scene).warnings if "shadow linking" in w]
+    assert len(warnings) == 1 and "28 sets" in warnings[0], warnings
 
 
 def test_light_groups_are_exported():
@@ -1018,3 +1052,25 @@ def test_metallic_bsdf_is_a_principled_metal(fresnel):
         np.testing.assert_allclose(closure.color, f0, rtol=1e-6)
         np.testing.assert_allclose(closure.specular_tint, tint, rtol=1e-6)
         assert len(data.warnings) == 1 and "Physical Conductor" in data.warnings[0]
+
+
+def test_passes_drt_does_not_write_are_named_in_the_warning():
+    """Cycles' Ambient Occlusion and Cryptomatte: a view layer asking for them gets no such pass from
+    DRT, and says so (Diffuse / Glossy / Transmission Color, Direct and Indirect it writes)."""
+    scene = empty_scene()
+    add_object(scene, "Cube", cube_mesh())
+    layer = scene.view_layers[0]
+    light = ("use_pass_diffuse_color", "use_pass_glossy_color", "use_pass_diffuse_direct", "use_pass_glossy_indirect",
+             "use_pass_transmission_direct", "use_pass_transmission_indirect", "use_pass_transmission_color")
+    for toggle in light:
+        setattr(layer, toggle, True)
+    try:
+        assert render_export(scene).warnings == []
+        layer.use_pass_ambient_occlusion = layer.use_pass_cryptomatte_material = True
+        (warning,) = render_export(scene).warnings
+    finally:
+        for toggle in light:
+            setattr(layer, toggle, False)
+        layer.use_pass_ambient_occlusion = layer.use_pass_cryptomatte_material = False
+    assert "Ambient Occlusion" in warning and "Cryptomatte Material" in warning
+    assert "Diffuse" not in warning and "Glossy" not in warning and "Transmission" not in warning

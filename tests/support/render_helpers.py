@@ -35,6 +35,7 @@ PASS_TOGGLES = {
     "Mist": ("use_pass_mist", "Z"),
     "IndexOB": ("use_pass_object_index", "X"),
     "IndexMA": ("use_pass_material_index", "X"),
+    "Vector": ("use_pass_vector", "XYZW"),
 }
 """Passes both renderers write, by Blender's view-layer toggle and channel ids."""
 

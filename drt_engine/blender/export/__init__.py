@@ -16,10 +16,11 @@ from ...core.scene import SceneData
 from ..properties import lightgroup_of, view_layer_lightgroups
 from .camera import export_camera
 from .geometry import GeometryExporter, MeshCache
-from .left_out import LeftOut
+from .left_out import LeftOut, passes_left_out
+from .linking import LightLinks
 from .lights import export_light
 from .materials import MaterialTable
-from .motion import add_motion, instance_key
+from .motion import add_motion, add_motion_pass, instance_key
 from .shader_graph import ImageTable
 from .world import export_world
 
@@ -37,8 +38,8 @@ def export_scene(
     """Export the scene seen by ``depsgraph`` from ``camera_object`` (default: the scene camera).
 
     With ``frame_set`` (the render engine's) and motion blur on, motion over the
-    shutter is sampled too. ``meshes`` (the viewport's) keeps meshes between exports: one
-    found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
+    shutter is sampled too; with the Vector pass on instead, the previous and next frames.
+    ``meshes`` (the viewport's) keeps meshes between exports: one found there is not read again. Raises ``SceneError`` for a scene that cannot be rendered
     and ``RenderCancelled`` when ``cancel()`` returns True.
     """
     scene = depsgraph.scene
@@ -56,6 +57,7 @@ def export_scene(
     lights = []
     light_keys = []
     left_out = LeftOut(depsgraph.mode == "RENDER")
+    links = LightLinks()
     for count, instance in enumerate(depsgraph.object_instances):
         if cancel is not None and count % CANCEL_CHECK_INTERVAL == 0 and cancel():
             raise RenderCancelled("Render cancelled during scene export")
@@ -63,6 +65,7 @@ def export_scene(
             continue
         obj = instance.object
         rendered = left_out.look_at(obj, instance.is_instance)
+        links.look_at(obj)
         matrix = np.array(instance.matrix_world, dtype=np.float64)
         if obj.type == "LIGHT":
             light = export_light(obj, matrix, warnings)
@@ -74,8 +77,11 @@ def export_scene(
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
     geometry.finish()
+    links.apply(lights, geometry.instances, warnings)
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
     warnings.extend(left_out.warnings())
+    if depsgraph.mode == "RENDER":  # the viewport writes no passes
+        warnings.extend(passes_left_out(depsgraph.view_layer))
     scene_data = SceneData(
         camera=camera,
         meshes=geometry.meshes,
@@ -91,5 +97,6 @@ def export_scene(
     )
     if frame_set is not None:
         add_motion(scene_data, depsgraph, frame_set, geometry.keys, light_keys, camera_object.name)
+        add_motion_pass(scene_data, depsgraph, frame_set, geometry.keys, camera_object.name)
     return scene_data
 

@@ -112,6 +112,13 @@ def _vertices(obj) -> np.ndarray | None:
     return co.reshape(-1, 3).astype(np.float64)
 
 
+def _kept_vertices(obj, mesh) -> np.ndarray | None:
+    """The evaluated object's vertices where they are as many as the exported ``mesh``'s (Cycles
+    keeps no vertex motion for a mesh whose topology changes), else None."""
+    v = _vertices(obj)
+    return v if v is not None and len(v) == len(mesh.vertices) else None
+
+
 def _steps_of(depsgraph, wanted: dict, light_index: dict, camera_name: str):
     """Each wanted instance's, light's and the camera's motion steps (``motion_steps``, at least
     ``long_shutter_steps``) and whether each instance's mesh may deform (its Deformation switch),
@@ -179,8 +186,8 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
                 seen[i, k] = True
                 mesh_index = scene_data.instances[i].mesh
                 if users[mesh_index] == 1 and deform[i] and inst_steps[i]:
-                    v = _vertices(instance.object)
-                    if v is not None and len(v) == len(scene_data.meshes[mesh_index].vertices):
+                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
+                    if v is not None:
                         vertices.setdefault(mesh_index, (i, [None] * steps))[1][k] = v
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:
@@ -200,3 +207,51 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
             stack = np.stack(per_step)
             if not np.allclose(stack, stack[:1]):
                 scene_data.meshes[mesh_index].motion_vertices = own_steps(stack, inst_steps[i], _vertices_between)
+
+
+def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], None], instance_keys: list,
+                    camera_name: str) -> None:
+    """For the Vector pass, each instance's and the camera's transforms at the previous and the next
+    frame, and the vertices there of meshes that deform (Cycles' motion for passes: frame -1 and +1
+    when motion blur is off; with it on Cycles' pass is 0, and so is DRT's without them). As for
+    motion blur, a mesh's vertices are read when one object uses it, its Deformation switch is on and
+    its vertex count stays (Cycles keeps no vertex motion otherwise)."""
+    scene = depsgraph.scene
+    if not depsgraph.view_layer.use_pass_vector or scene.render.use_motion_blur:
+        return
+    wanted = {key: i for i, key in enumerate(instance_keys)}
+    users = np.bincount([inst.mesh for inst in scene_data.instances], minlength=len(scene_data.meshes))
+    matrices = np.zeros((len(instance_keys), 2, 4, 4))
+    seen = np.zeros((len(instance_keys), 2), bool)
+    camera = np.repeat(scene_data.camera.matrix[None], 2, 0)
+    vertices: dict[int, list] = {}  # mesh -> its vertices at the previous and the next frame
+    frame, subframe = scene.frame_current, scene.frame_subframe
+    try:
+        for k, step in enumerate((-1, 1)):
+            frame_set(frame + step, subframe)
+            for instance in depsgraph.object_instances:
+                i = wanted.get(instance_key(instance))
+                if i is None or instance.object.type == "LIGHT":
+                    continue
+                matrices[i, k] = np.array(instance.matrix_world, dtype=np.float64)
+                seen[i, k] = True
+                mesh_index = scene_data.instances[i].mesh
+                if users[mesh_index] == 1 and deforms_in_motion(instance.object.original):
+                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
+                    if v is not None:
+                        vertices.setdefault(mesh_index, [None, None])[k] = v
+            cam = depsgraph.objects.get(camera_name)
+            if cam is not None:
+                camera[k] = without_scale(cam.matrix_world)
+    finally:
+        frame_set(frame, subframe)
+    for i, inst in enumerate(scene_data.instances):
+        if seen[i].all() and not np.allclose(matrices[i], inst.matrix[None]):
+            inst.motion_pass = matrices[i]
+    if not np.allclose(camera, scene_data.camera.matrix[None]):
+        scene_data.camera.motion_pass = camera
+    for mesh_index, (pre, post) in vertices.items():
+        mesh = scene_data.meshes[mesh_index]
+        if pre is not None and post is not None and not (np.allclose(pre, mesh.vertices)
+                                                         and np.allclose(post, mesh.vertices)):
+            mesh.motion_pass_vertices = np.stack([pre, post])

@@ -616,6 +616,12 @@ class MaterialShader:
         """Its diffuse part is Lambert about the shading normal (no Oren-Nayar, no translucent lobe)."""
         return all(lobe.kind == "diffuse" for lobe in self.lobes if lobe.diffuse)
 
+    @property
+    def keeps_normal(self) -> bool:
+        """Lambert's lobes only: shaded about its normal as it is even where wo lies below it, as
+        Cycles shades a diffuse closure (the others' normal is raised: core.bsdf.specular_normal)."""
+        return self.lambertian and not self.sampled
+
     def bind(self, values: dict) -> "MaterialShader":
         """A copy whose lobes take per-hit values: ``values[closure index]`` maps "weight" and
         "color" to (N, 3) arrays (the shader was built with those set to one)."""

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..settings import FIRST_SAMPLE_PASSES, LIGHT_PASSES, pass_channels
+from ..settings import FIRST_SAMPLE_PASSES, LIGHT_PASSES, WEIGHTED_PASSES, pass_channels
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 
 _TABLE = 1024
@@ -178,7 +178,8 @@ def _extend_range(pixel, combined, lo, hi):
 
 class Film:
     """Sums per pixel of the window: samples, every pass, and Combined RGB over class A; the
-    ``FIRST_SAMPLE_PASSES`` hold only their pixel's first sample, read as it is.
+    ``FIRST_SAMPLE_PASSES`` hold only their pixel's first sample, read as it is; the
+    ``WEIGHTED_PASSES`` sum one more channel, their weight, and are read over it.
 
     With ``track_range`` it also keeps each pixel's smallest and largest sample RGB
     (contrast-driven refinement needs them); with ``ratio`` the ratio estimator's sums
@@ -195,7 +196,7 @@ class Film:
         self.passes = passes
         self.channels = {name: len(pass_channels(name, aovs)) for name in passes}
         self.count = np.zeros(self.n)
-        self.sums = {name: np.zeros((self.n, self.channels[name]))
+        self.sums = {name: np.zeros((self.n, self.channels[name] + (name in WEIGHTED_PASSES)))
                      for name in passes if name not in ("Sample Count", "Noise")}
         if ratio:
             self.sums[RATIO] = np.zeros((self.n, FILM_CHANNELS))
@@ -305,6 +306,9 @@ class Film:
             return np.sqrt(var)
         if name in FIRST_SAMPLE_PASSES:
             return self.sums[name][span]
+        if name in WEIGHTED_PASSES:  # over the samples that wrote it (its last channel counts them)
+            total = self.sums[name][span]
+            return total[:, :-1] / np.maximum(total[:, -1:], 1e-12)
         mean = self.sums[name][span] / np.maximum(count, 1)[:, None]
         if name == "Combined" and self.ratio:
             mean[:, :3] = self.rgb(span)

@@ -31,10 +31,10 @@ import numpy as np
 from ..base.jit import kernel
 from ..base.vectors import unit
 from ..errors import SceneError
-from ..scene import Mesh, SceneData
+from ..scene import LIGHT_SETS_ALL, Mesh, SceneData
 from . import embree
 from .motion import deforms, frame_at, invert_frame, moves
-from .visibility import EVERY, SHADOW, instance_mask
+from .visibility import EVERY, SHADOW, instance_mask, shadow_ray_mask
 
 _EPS_REL = 2.0**-16  # ~64 float32 ulps: covers origin rounding plus Embree's own test error
 _EPS_ABS = 2.0**-34  # with _EPS_REL: ~4 float64 ulps of the world coordinates hit points are rebuilt in
@@ -175,11 +175,16 @@ class Geometry:
             self.warnings.append(f"{dropped} triangles with NaN or infinite vertex coordinates were left out")
         self._motion_steps(kept)
         self._mesh_scenes(kept, analysed, known)
-        masks = [instance_mask(scene.instances[k]) for k, _, _ in kept]
+        self.shadow_linking = any(i.blocker_shadow_set for i in scene.instances) or any(
+            e.shadow_set_membership != LIGHT_SETS_ALL for e in (*scene.instances, *scene.lights))
+        """Some emitter's shadows are cast by some objects alone (shadow linking): every object's
+        mask then holds the shadow bit of its blocker set (core.geometry.visibility)."""
+        masks = [instance_mask(scene.instances[k], self.shadow_linking) for k, _, _ in kept]
         self.masked = any(mask != EVERY for mask in masks)
         """Some object is hidden from some ray kind: rays then carry their kind's mask."""
-        self.shadow_mask = SHADOW if self.masked else EVERY
-        """The Embree mask of shadow rays."""
+        self.shadow_mask = (shadow_ray_mask(LIGHT_SETS_ALL) if self.shadow_linking else SHADOW) if self.masked \
+            else EVERY
+        """The Embree mask of shadow rays (of emitters whose shadows every object casts)."""
         self._instances(kept, masks)
         self._triangle_tables(kept)
         self.tables = self._tables()

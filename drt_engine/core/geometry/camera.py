@@ -168,12 +168,13 @@ def _panorama_points(lens, m, points, out):
         out[i, 0], out[i, 1] = panorama_point(lens, x, y, z)
 
 
-def panorama_window(camera: Camera, points: np.ndarray) -> np.ndarray:
+def panorama_window(camera: Camera, points: np.ndarray, matrix: np.ndarray | None = None) -> np.ndarray:
     """(N, 2) image points (0 to 1 over the unshifted image) of world ``points`` through a
-    panoramic camera at mid-shutter, as Cycles' camera_world_to_ndc has them."""
+    panoramic camera at mid-shutter (or placed by camera-to-world ``matrix``), as Cycles'
+    camera_world_to_ndc has them."""
     out = np.empty((len(points), 2))
-    _panorama_points(lens_table(camera), np.ascontiguousarray(np.linalg.inv(camera.matrix)[:3]),
-                     np.ascontiguousarray(points, np.float64), out)
+    view = np.linalg.inv(camera.matrix if matrix is None else matrix)[:3]
+    _panorama_points(lens_table(camera), np.ascontiguousarray(view), np.ascontiguousarray(points, np.float64), out)
     return out
 
 

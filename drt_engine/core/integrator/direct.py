@@ -16,7 +16,7 @@ from ..bsdf.bump_shadowing import smooth_local
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
-from ..lights.strategies import NO_SHADOW, UNRESTRICTED
+from ..lights.strategies import NO_MIS, NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
 from .clamp import clamped, limit_at
 from .lightpasses import add_split, add_weighted, eval_parts
@@ -77,8 +77,8 @@ def unlit_parts(restrict, k):
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path,
                  limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
-                 exclude, group, scene, center, shadow_mask, times, radiance, grouped, split, weights, passed, f_diff,
-                 visibility, cuts, clear, allowed, qf, qi):
+                 exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, split, weights, passed,
+                 f_diff, visibility, cuts, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
     ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 
@@ -100,7 +100,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
     core.integrator.lightpasses): at a path's first hit (``passed[path[j]]``, its bounces, 0) by the
     diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the sample, Direct; later
     by the path's ``weights``, Indirect. Shadow rays see the objects whose
-    Embree mask shares a bit with ``shadow_mask``. ``times``: each hit's shutter time (empty when
+    Embree mask shares a bit with ``shadow_mask``, or with each sample's ``masks`` row (shadow
+    linking; empty: none), and a sample whose light is light sampling's alone (``NO_MIS`` in
+    ``exclude``) takes its whole weight. ``times``: each hit's shutter time (empty when
     nothing moves).
     ``f_diff``, ``visibility`` and ``cuts`` (strategy by hit) are filled when they have rows (the
     ratio estimator reads them): the diffuse part toward each sample, what became of its ray and
@@ -119,6 +121,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
     excluding = exclude.size > 0
     grouping = group.size > 0
     splitting = split.shape[0] > 0
+    masking = masks.size > 0
     traced = queued = 0
     for j in range(len(pos)):
         first = splitting and passed[path[j]] == 0
@@ -144,12 +147,13 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
             lz = wx * frame[j, 2, 0] + wy * frame[j, 2, 1] + wz * frame[j, 2, 2]
             above = lz > 0  # the shading hemisphere decides, as in Cycles, not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~NO_SHADOW),
+                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS)),
                            sx, sy, sz, model)
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
-            w = power(pdf[k, j], f[6]) if continues else 1.0
+            w = power(pdf[k, j], f[6]) if continues and not left_out & NO_MIS else 1.0
+            mask = masks[k, j] if masking else shadow_mask
             c0 = throughput[j, 0] * v0 * (d0 + n0 * w)
             c1 = throughput[j, 1] * v1 * (d1 + n1 * w)
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
@@ -157,7 +161,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
                 continue
             e0 = e1 = e2 = h0 = h1 = h2 = 0.0  # the diffuse and glossy parts, at a first hit
             if first:
-                unlit = unlit_parts(restrict, k) | (left_out & ~NO_SHADOW)
+                unlit = unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS))
                 fd = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
                                 inside[j], sel, bits, unlit | UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model)
                 e0 = throughput[j, 0] * v0 * (fd[0] + fd[3] * w)
@@ -183,15 +187,15 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, 
             elif see_through:
                 traced += 1
                 what, hit, t, hu, hv = first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, wx, wy, wz,
-                                                     tmax, time, shadow_mask)
+                                                     tmax, time, mask)
                 hidden = what != OPEN
                 if what == SEE_THROUGH and allowed[j] > 0:
                     enqueue(qf, qi, queued, c0, c1, c2, ox, oy, oz, wx, wy, wz, tmax, time, hu, hv, t, path[j], hit,
-                            j, 0, allowed[j], group[k, j] if grouping else -1)
+                            j, 0, allowed[j], group[k, j] if grouping else -1, mask)
                     queued += 1
             else:
                 traced += 1
-                hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time, shadow_mask)
+                hidden = blocked(scene, center, rayhit, ox, oy, oz, wx, wy, wz, tmax, time, mask)
             if keep:
                 visibility[k, j] = BLOCKED if hidden else VISIBLE
             # area lights are not geometry: a nearer area light does not block (lights cast shadows

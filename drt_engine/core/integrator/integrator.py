@@ -26,11 +26,13 @@ from ..base.vectors import Frame
 from ..bsdf.blur import blur_roughness
 from ..bsdf.bump_shadowing import model_code
 from ..bsdf.shader import see_through
+from ..bsdf.specular_normal import valid_specular_reflection
 from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
 from ..film.ratio_sums import RATIO
 from ..geometry import camera as camera_rays
+from ..geometry.motion_vectors import MotionVectors
 from ..lights.strategies import LightSamples
 from ..sampling import dims as D
 from ..settings import AOV_CHANNELS, LIGHTGROUP_PREFIX
@@ -153,6 +155,8 @@ class Integrator:
         indexed = {"IndexOB", "IndexMA"} & set(settings.passes)
         self.object_index = np.array([float(i.pass_index) for i in scene.instances]) if indexed else None
         self.material_index = np.array([float(m.pass_index) for m in scene.materials]) if indexed else None
+        self.motion_vectors = MotionVectors(scene.camera, scene.instances, scene.meshes) \
+            if "Vector" in settings.passes else None
         aovs = ShaderAOVs(prepared.shading, scene.world, scene.film_transparent, settings.aovs) if settings.aovs \
             else None
         self.aovs = aovs if aovs is not None and aovs.writes_any() else None  # AOVs no material writes stay 0
@@ -208,6 +212,8 @@ class Integrator:
         aux = {name: np.zeros((n, len(ch))) for name, ch in _AUX if name in s.passes}
         aux.update((name, np.zeros((n, len(AOV_CHANNELS[kind])))) for name, kind in s.aovs)
         aux.update((name, np.zeros((n, 3))) for name in self.group_passes)
+        if self.motion_vectors is not None:
+            aux["Vector"] = np.zeros((n, 5))  # the vector and its weight (core.film.film WEIGHTED_PASSES)
         out = WaveOutput(np.zeros((n, 3)), np.ones(n), aux,
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if self.groups is not None:
@@ -218,7 +224,7 @@ class Integrator:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
             out.aux["Mist"][:] = 1.0  # Cycles' background: nothing subtracted
-        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None:
+        if "IndexOB" in out.aux or "IndexMA" in out.aux or self.aovs is not None or self.motion_vectors is not None:
             out.indexed = np.zeros(n, bool)
         if self.aovs is not None:
             out.aov_reach = np.ones(n)
@@ -317,7 +323,8 @@ class Integrator:
                           prev_shading=np.zeros((n, 3)), straight=np.ones(n, bool), time=time,
                           bounces=camera_bounces(n) if self.carried else None,
                           mis_origin=cam.origins if self.shadows is not None else None,
-                          min_pdf=np.full(n, np.inf) if self.min_pdf else None)
+                          min_pdf=np.full(n, np.inf) if self.min_pdf else None,
+                          receiver=np.zeros(n, np.int64) if self.lights.linking else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray:
@@ -334,6 +341,14 @@ class Integrator:
     def _lights_hit(self, rays: PathState, t, light_id, le, out: WaveOutput):
         """Lights hit directly: always by reflected and refracted rays, by the camera if asked; the
         rays go on to what is behind, which alone decides the pixel's alpha."""
+        if len(rays) and rays.receiver is not None:  # light linking: camera rays see every light
+            keep = np.flatnonzero(rays.straight | self.lights.light_links(light_id, rays.receiver))
+            rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
+        if len(rays) and self.lights.shadow_linking:  # light sampling's alone (strategies.NO_MIS), but after a
+            # delta lobe, which light sampling does not light
+            keep = np.flatnonzero(rays.straight | np.isinf(rays.prev_pdf)
+                                  | ~self.lights.shadow_linked(light_id=light_id))
+            rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
         if len(rays) == 0:
             return
 
@@ -377,7 +392,7 @@ class Integrator:
         if len(bounced):
             # with light groups, each group's suns apart (a sun's light goes to its group)
             for group in [None] if self.groups is None else np.unique(lights.light_group):
-                sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group)
+                sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group, bounced.receiver)
                 e = add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
                                 lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
                                 None if group is None else self._group(lambda: np.full(len(bounced), group)))
@@ -388,7 +403,8 @@ class Integrator:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
         facing the ray (core.integrator.hits)."""
         return surface_records(self.geometry, hits.prim, hits.u, hits.v, ray_times, rows, state.dirs,
-                               path=state.path[rows], mat=mat, throughput=state.throughput[rows],
+                               self.prepared.keeps_normal, path=state.path[rows], mat=mat,
+                               throughput=state.throughput[rows],
                                straight=state.straight[rows], time=state.time[rows],
                                bounces=None if state.bounces is None else state.bounces[rows])
 
@@ -411,6 +427,12 @@ class Integrator:
         glowing = np.flatnonzero(glows[surf.mat]) if len(glows) else np.zeros(0, np.int64)
         if self.holdouts is not None and len(glowing):  # an object holdout the camera sees gives no light
             glowing = glowing[~self.holdouts.whole(surf.take(glowing))]
+        if state.receiver is not None and len(glowing):  # light linking: camera rays see every emitter
+            seen = self.lights.triangle_links(surf.prim[glowing], state.receiver[surf.row[glowing]])
+            glowing = glowing[surf.straight[glowing] | seen]
+        if self.lights.shadow_linking and len(glowing):  # light sampling's alone (strategies.NO_MIS)
+            glowing = glowing[surf.straight[glowing] | np.isinf(state.prev_pdf[surf.row[glowing]])
+                              | ~self.lights.shadow_linked(prim=surf.prim[glowing])]
         if len(glowing) == 0:
             return
         prim = surf.prim[glowing]
@@ -445,7 +467,8 @@ class Integrator:
         """Mist and the index passes at the hits the camera sees directly or through transparency,
         as Cycles' film_write_data_passes: each hit takes (1 - mist) of Mist, weighted by the path's
         throughput times the hit's opacity; an index is the last such hit's until one is at least
-        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film)."""
+        as opaque as the view layer's alpha threshold (the film keeps the first sample's, core.film.film);
+        that hit alone writes the Vector pass, with weight 1 (core.geometry.motion_vectors)."""
         rows = np.flatnonzero(group.straight)
         if len(rows) == 0:
             return
@@ -463,7 +486,13 @@ class Integrator:
                 out.aux["IndexMA"][path, 0] = self.material_index[group.mat[rows]]
             if out.aov_reach is not None:
                 out.aov_reach[path] *= reach_scale(shader, group, rows)
-            out.indexed[path] = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
+            closed = opacity[open_].mean(axis=1) >= self.settings.pass_alpha_threshold
+            out.indexed[path] = closed
+            if self.motion_vectors is not None and closed.any():
+                rows, path = rows[closed], path[closed]
+                source = self.geometry.source_of(group.prim[rows])
+                out.aux["Vector"][path, :4] = self.motion_vectors.vectors(group.pos[rows], source[:, 0], source[:, 1])
+                out.aux["Vector"][path, 4] = 1.0
 
     def _shader_aovs(self, surf: SurfaceHits, hits, out: WaveOutput, occlusion: OcclusionRays | None = None):
         """The materials' AOV Output nodes at the hits the camera sees directly or through
@@ -545,7 +574,7 @@ class Integrator:
                 group = replace(group, frame=frame, wo_l=frame.to_local(wo), smooth=smooth)
             for sub, shader in groups:
                 taken = group.take(sub)
-                if facing_away is not None and shader.lambertian and not shader.sampled:
+                if facing_away is not None and shader.keeps_normal:
                     taken = _about(taken, facing_away[sub])
                 yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
 
@@ -587,7 +616,9 @@ class Integrator:
                                      joined([u.light for _, u in lit]),
                                      joined([h.time for h in hits]) if self.timed else None,
                                      joined([h.bounces for h in hits]) if self.light_path else None,
-                                     groups=self.groups is not None)
+                                     groups=self.groups is not None,
+                                     receivers=self.lights.receivers(joined([h.prim for h in hits]))
+                                     if self.lights.linking else None)
         if self.groups is not None:
             out.group = self.groups.column(out.group)
         return out
@@ -668,6 +699,9 @@ class Integrator:
             prev_normal = np.where(kept, state.prev_normal[rows], prev_normal)
             prev_shading = np.where(kept, state.prev_shading[rows], prev_shading)
             mis_origin = np.where(kept, state.mis_origin[rows], origin)
+        receiver = None
+        if state.receiver is not None:  # light linking: the object bounced off, kept through pass-throughs
+            receiver = np.where(passthrough, state.receiver[hits.row[sel]], self.lights.receivers(hits.prim[sel]))
         min_pdf = None
         if state.min_pdf is not None:  # Cycles' min_ray_pdf: the least density of non-transparent bounces
             before = state.min_pdf[hits.row[sel]]
@@ -676,7 +710,7 @@ class Integrator:
                          throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin,
-                         min_pdf=min_pdf)
+                         min_pdf=min_pdf, receiver=receiver)
 
 
 def _material_slices(mat):
@@ -732,27 +766,3 @@ def _coat_turned(shader, hits: SurfaceHits):
     nc = valid_specular_reflection(ng, hits.wo, nc)
     nc = np.where((vec.dot(hits.wo, nc) <= 1e-6)[:, None], n, nc)
     return shader.turn_coat(hits.frame.to_local(nc), hits.wo_l)
-
-
-def valid_specular_reflection(ng, wo, n):
-    """Cycles' ensure_valid_specular_reflection (kernel/closure/bsdf_util.h) over rows: where wo
-    mirrored about the shading normal ``n`` leaves below min(0.9 cos(wo, ng), 0.01) of the
-    geometric normal ``ng`` (facing wo), ``n`` turned toward ``ng`` in their plane just enough
-    that the mirror image leaves at that threshold."""
-    r = 2.0 * vec.dot(n, wo)[:, None] * n - wo
-    iz = vec.dot(wo, ng)
-    threshold = np.minimum(0.9 * iz, 0.01)
-    bad = vec.dot(ng, r) < threshold
-    if not np.any(bad):
-        return n
-    x = n - vec.dot(n, ng)[:, None] * ng
-    length = vec.norm(x)
-    x = np.where((length > 1e-20)[:, None], x / np.maximum(length, 1e-20)[:, None], n)
-    ix = vec.dot(wo, x)
-    a = ix * ix + iz * iz
-    b = 2.0 * (a + iz * threshold)
-    c = (threshold + iz) ** 2
-    root = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
-    nz2 = 0.25 * np.where(ix < 0, b + root, b - root) / np.maximum(a, 1e-30)
-    raised = np.sqrt(np.maximum(1.0 - nz2, 0.0))[:, None] * x + np.sqrt(np.maximum(nz2, 0.0))[:, None] * ng
-    return np.where(bad[:, None], raised, n)

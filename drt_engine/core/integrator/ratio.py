@@ -37,6 +37,7 @@ from ..base.jit import kernel
 from ..film.ratio_sums import NDU_CHANNELS
 from ..lights.collection import closed_forms
 from ..lights.kinds import unoccluded
+from ..scene import LIGHT_SETS_ALL
 from .direct import VISIBLE
 
 
@@ -49,12 +50,14 @@ def delta_light(light) -> bool:
 
 def ratio_strategies(lights, estimator: str) -> list[int]:
     """The light strategies whose diffuse part the ratio estimator takes: one light each
-    (not a choice among many), standing still, of some extent and with a closed form."""
+    (not a choice among many), standing still, of some extent and with a closed form, lighting
+    every object (its closed form knows nothing of light linking)."""
     if estimator != "RATIO" or lights.selecting or not lights.lights:
         return []
     closed = closed_forms(lights.table)
     return [k for k in range(lights.light_slots)
-            if k not in lights.motions and not delta_light(lights.lights[k]) and closed[k]]
+            if k not in lights.motions and not delta_light(lights.lights[k]) and closed[k]
+            and lights.lights[k].light_set_membership == LIGHT_SETS_ALL]
 
 
 @kernel

@@ -63,7 +63,9 @@ class PathState(Rows):
     bounce's pdf, normals and origin, as Cycles keeps its MIS state through transparent bounces,
     since light sampling from there reaches through the transparent surface too; ``min_pdf`` (with
     Filter Glossy) the least density of the path's non-transparent bounces so far (inf: none or
-    only delta ones; core.bsdf.blur)."""
+    only delta ones; core.bsdf.blur); ``receiver`` (with light linking) the receiver light set of
+    the object the path last bounced off, not counting transparent pass-throughs (Cycles'
+    mis_ray_object; 0 for camera rays, which see every emitter)."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -78,6 +80,7 @@ class PathState(Rows):
     bounces: np.ndarray | None = None
     mis_origin: np.ndarray | None = None
     min_pdf: np.ndarray | None = None
+    receiver: np.ndarray | None = None
 
     def mis_ray(self, rows, t):
         """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs

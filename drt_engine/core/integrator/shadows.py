@@ -29,10 +29,11 @@ from .records import ShadowRays
 
 OPEN, OPAQUE, SEE_THROUGH = 0, 1, 2
 """What a shadow ray meets first: nothing, a surface that blocks it, a surface that may not."""
-QF, QI = 14, 6
+QF, QI = 14, 7
 """Columns of a queue's float rows (contribution RGB, origin, direction, distance left, time,
 u, v, length from the shaded point) and int rows (path, triangle, the row of its paths' depths in
-the batch that queued it, surfaces passed, surfaces allowed, light group or -1)."""
+the batch that queued it, surfaces passed, surfaces allowed, light group or -1, the ray's Embree
+mask)."""
 _FAR = np.float32(3.0e38)
 
 
@@ -63,18 +64,19 @@ def first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tm
 
 @kernel(inline="always")
 def enqueue(qf, qi, m, c0, c1, c2, ox, oy, oz, dx, dy, dz, tmax, time, u, v, length, path, prim, hit, passed,
-            allowed, group):
+            allowed, group, mask):
     """Row m of a queue: a shadow ray stopped on a see-through surface (QF, QI)."""
     qf[m, 0], qf[m, 1], qf[m, 2] = c0, c1, c2
     qf[m, 3], qf[m, 4], qf[m, 5] = ox, oy, oz
     qf[m, 6], qf[m, 7], qf[m, 8] = dx, dy, dz
     qf[m, 9], qf[m, 10], qf[m, 11], qf[m, 12], qf[m, 13] = tmax, time, u, v, length
-    qi[m, 0], qi[m, 1], qi[m, 2], qi[m, 3], qi[m, 4], qi[m, 5] = path, prim, hit, passed, allowed, group
+    qi[m, 0], qi[m, 1], qi[m, 2], qi[m, 3], qi[m, 4], qi[m, 5], qi[m, 6] = path, prim, hit, passed, allowed, group, mask
 
 
 @kernel
-def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radiance, grouped, out_f, out_i):
-    """Sends each queued ray (``mask``: the shadow rays' Embree mask) (its contribution already attenuated by its surface) on from the far
+def pass_through(scene, geo, clear, qf, qi, pos, ng, scale, limit, radiance, grouped, out_f, out_i):
+    """Sends each queued ray (its contribution already attenuated by its surface, its own Embree
+    mask in its int row) on from the far
     side of the surface at ``pos`` (geometric normal ``ng`` facing the ray, offset ``scale``):
     open, its contribution goes to ``radiance``, clamped to ``limit[r]`` (core.integrator.clamp), and
     to its light group's in ``grouped`` (empty: no light groups);
@@ -90,7 +92,7 @@ def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radianc
         along = (ox - qf[r, 3]) * dx + (oy - qf[r, 4]) * dy + (oz - qf[r, 5]) * dz
         tmax = max(qf[r, 9] - along, 0.0)
         what, prim, t, u, v = first_surface(scene, geo, clear, rayhit, scratch, ox, oy, oz, dx, dy, dz, tmax,
-                                            qf[r, 10], mask)
+                                            qf[r, 10], np.int32(qi[r, 6]))
         if what == OPEN:
             p = qi[r, 0]
             c0, c1, c2, _ = clamped(qf[r, 0], qf[r, 1], qf[r, 2], limit_at(limit, r))
@@ -104,7 +106,7 @@ def pass_through(scene, geo, clear, mask, qf, qi, pos, ng, scale, limit, radianc
                 grouped[p, g, 2] += c2
         elif what == SEE_THROUGH and qi[r, 3] + 1 < qi[r, 4]:
             enqueue(out_f, out_i, m, qf[r, 0], qf[r, 1], qf[r, 2], ox, oy, oz, dx, dy, dz, tmax, qf[r, 10], u, v,
-                    qf[r, 13] + along + t, qi[r, 0], prim, r, qi[r, 3] + 1, qi[r, 4], qi[r, 5])
+                    qf[r, 13] + along + t, qi[r, 0], prim, r, qi[r, 3] + 1, qi[r, 4], qi[r, 5], qi[r, 6])
             m += 1
     return len(qf), m
 
@@ -157,7 +159,7 @@ class TransparentShadows:
             qf = np.ascontiguousarray(f[go])
             qf[:, 0:3] = c[go]
             out_f, out_i = new_queue(len(go), True)
-            traced, m = pass_through(geo.handle, geo.tables, self.clear, geo.shadow_mask, qf,
+            traced, m = pass_through(geo.handle, geo.tables, self.clear, qf,
                                      np.ascontiguousarray(i[go]),
                                      surf.pos[go], surf.ng[go], surf.scale[go],
                                      row_limits(self.clamp, rays.bounces[go, DEPTH] == 0), radiance, grouped,

@@ -27,13 +27,16 @@ from ..base.jit import kernel
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION
 from ..errors import SceneError
 from ..geometry.motion import Motion
-from ..scene import Light, SceneData
+from ..geometry.visibility import shadow_ray_mask
+from ..scene import LIGHT_SETS_ALL, Light, SceneData
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
-from .strategies import MAP_WORLD, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples, sample_strategies
+from .linking import lights as links
+from .strategies import (MAP_WORLD, NO_MIS, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples,
+                         sample_strategies)
 from .table import light_row, light_table
 from .triangles import pdf_emissive_batch
 from .world import lights_shown_batch, pdf_world_batch, world_shown_batch
@@ -110,6 +113,7 @@ class Lights:
         self._emitters(geometry, scene)
         self._excludes(scene, geometry)
         self._groups(scene, geometry)
+        self._links(scene)
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
@@ -178,10 +182,14 @@ class Lights:
             return ((0 if item.visible_diffuse else UNLIT_DIFFUSE) | (0 if item.visible_glossy else UNLIT_REFLECTION)
                     | (0 if item.visible_transmission else UNLIT_TRANSMISSION))
 
-        self.light_exclude = np.array([unlit(light) | (0 if light.cast_shadow else NO_SHADOW) for light in self.lights],
-                                      np.int8)
+        def alone(item):  # shadow linking: light sampling's alone (strategies.NO_MIS)
+            return NO_MIS if item.shadow_set_membership != LIGHT_SETS_ALL else 0
+
+        self.light_exclude = np.array([unlit(light) | (0 if light.cast_shadow else NO_SHADOW) | alone(light)
+                                       for light in self.lights], np.int8)
         sources = geometry.source_of(self.emissive)[:, 0] if len(self.emissive) else np.zeros(0, np.int64)
-        self.emissive_exclude = np.array([unlit(scene.instances[k]) for k in sources], np.int8)
+        self.emissive_exclude = np.array([unlit(scene.instances[k]) | alone(scene.instances[k]) for k in sources],
+                                         np.int8)
         self.excluding = bool(self.light_exclude.any() or self.emissive_exclude.any())
 
     def _groups(self, scene: SceneData, geometry) -> None:
@@ -193,6 +201,41 @@ class Lights:
         self.grouped = bool(scene.light_groups) and bool(
             (self.light_group >= 0).any() or (self.instance_group >= 0).any() or self.world_group >= 0)
         """Some emitter is in a light group."""
+
+    def _links(self, scene: SceneData) -> None:
+        """Light linking (lights.linking): per light and per instance the receiver sets it lights,
+        per instance its own set; ``linking`` only when some emitter leaves some set out."""
+        self.light_membership = np.array([light.light_set_membership for light in self.lights], np.uint64)
+        self.instance_membership = np.array([i.light_set_membership for i in scene.instances], np.uint64)
+        self.instance_receiver = np.array([i.receiver_light_set for i in scene.instances], np.int64)
+        every = np.uint64(LIGHT_SETS_ALL)
+        self.linking = bool((self.light_membership != every).any() or (self.instance_membership != every).any())
+        self.shadow_linking = bool(self.geometry.shadow_linking)
+        """Some emitter's shadows are cast by some objects alone: its shadow rays carry their own mask."""
+        self.light_shadow_mask = np.array([shadow_ray_mask(light.shadow_set_membership) for light in self.lights],
+                                          np.int32)
+        self.instance_shadow_mask = np.array([shadow_ray_mask(i.shadow_set_membership) for i in scene.instances],
+                                             np.int32)
+        self.light_shadow_linked = np.array([light.shadow_set_membership != LIGHT_SETS_ALL for light in self.lights],
+                                            bool)
+        self.instance_shadow_linked = np.array([i.shadow_set_membership != LIGHT_SETS_ALL for i in scene.instances],
+                                               bool)
+
+    def receivers(self, prim: np.ndarray) -> np.ndarray:
+        """The receiver light sets of the objects of triangles ``prim``."""
+        if len(prim) == 0:
+            return np.zeros(0, np.int64)
+        return self.instance_receiver[self.geometry.source_of(prim)[:, 0]]
+
+    def light_links(self, light_id: np.ndarray, receiver: np.ndarray) -> np.ndarray:
+        """Whether lights ``light_id`` light objects of receiver sets ``receiver``."""
+        return links(self.light_membership[light_id], receiver)
+
+    def triangle_links(self, prim: np.ndarray, receiver: np.ndarray) -> np.ndarray:
+        """Whether emissive triangles ``prim`` light objects of receiver sets ``receiver``."""
+        if len(prim) == 0:
+            return np.zeros(0, bool)
+        return links(self.instance_membership[self.geometry.source_of(prim)[:, 0]], receiver)
 
     def group_of_triangles(self, prim: np.ndarray) -> np.ndarray:
         """The light group of the emissive triangles ``prim`` (their objects')."""
@@ -268,7 +311,8 @@ class Lights:
 
     # -- next-event estimation ----------------------------------------------------
     def sample_all(self, pos: np.ndarray, normal: np.ndarray, u: np.ndarray, time: np.ndarray | None = None,
-                   bounces: np.ndarray | None = None, groups: bool = False) -> LightSamples:
+                   bounces: np.ndarray | None = None, groups: bool = False,
+                   receivers: np.ndarray | None = None) -> LightSamples:
         """Every strategy at shading points ``pos`` in one kernel call (lights.strategies);
         ``normal`` faces the incoming ray (the world is sampled about it); ``u`` (N, S, 2, 2): per
         strategy the point and the choice. With many lights, strategies below ``light_slots``
@@ -276,7 +320,10 @@ class Lights:
         pick. Moving lights are sampled again in their own frames at ``time``; textured emission
         and the environment's radiance come from their shader programs, which see the points'
         paths' ``bounces`` as light samples do (core.shading.lightpath). With ``groups``, each
-        sample's light group (``LightSamples.group``)."""
+        sample's light group (``LightSamples.group``). With ``receivers`` (the points' objects'
+        receiver light sets, under light linking), samples of emitters that do not light a point
+        are zero, as Cycles' light_link_object_match rejects them (every strategy keeps its
+        density: each light is one, so nothing is renormalised)."""
         n, strategies = len(pos), self.strategies
         pos, normal, u = (np.ascontiguousarray(a, np.float64) for a in (pos, normal, u))
         out = LightSamples.empty(strategies, n)
@@ -307,11 +354,42 @@ class Lights:
                 out.value[w, k] = self.environment.radiance(out.wi[w, k], path) / out.pdf[w, k, None]
             if self.world_lobes is not None:
                 out.restrict[w] = self.world_lobes
+        if receivers is not None and self.linking:
+            self._unlinked(out, pick, receivers)
+        if self.shadow_linking:
+            out.mask = self._sample_masks(pick)
         if self.excluding:
             out.exclude = self._sample_excludes(pick)
         if groups:
             out.group = self._sample_groups(pick)
         return out
+
+    def _sample_masks(self, pick) -> np.ndarray:
+        """Each sample's shadow-ray mask (shadow linking), strategy by hit; the world's the scene's."""
+        out = np.full(pick.shape, self.geometry.shadow_mask, np.int32)
+        slots = self.light_slots
+        if slots:
+            out[:slots] = self.light_shadow_mask[pick[:slots]]
+        if len(self.emissive):
+            out[slots] = self.instance_shadow_mask[self.geometry.source_of(pick[slots])[:, 0]]
+        return out
+
+    def shadow_linked(self, light_id=None, prim=None) -> np.ndarray:
+        """Whether lights ``light_id`` (or the emissive triangles ``prim``) have shadow linking: rays
+        that find them do not count them (strategies.NO_MIS)."""
+        if light_id is not None:
+            return self.light_shadow_linked[light_id]
+        if len(prim) == 0:
+            return np.zeros(0, bool)
+        return self.instance_shadow_linked[self.geometry.source_of(prim)[:, 0]]
+
+    def _unlinked(self, out: LightSamples, pick, receivers) -> None:
+        """Zero the samples of lights and emissive triangles that do not light their points."""
+        slots = self.light_slots
+        if slots:
+            out.value[:slots][~links(self.light_membership[pick[:slots]], receivers[None])] = 0.0
+        if len(self.emissive):
+            out.value[slots][~self.triangle_links(pick[slots], receivers)] = 0.0
 
     def _sample_excludes(self, pick) -> np.ndarray:
         """``LightSamples.exclude`` of samples whose lights or triangles are ``pick`` (strategy by hit)."""
@@ -392,16 +470,34 @@ class Lights:
                 pdf[k] = _pdf_batch(table, self.table, ids[k], slots, o, d, t[k], origins[k])
         return pdf
 
-    def suns_seen(self, origins, dirs, time=None, group=None):
+    def suns_seen(self, origins, dirs, time=None, group=None, receiver=None):
         """Radiance and light-sampling density of sun disks (angle > 0) in directions dirs (with
-        ``group``, of the suns in that light group alone)."""
-        radiance = np.zeros((len(dirs), 3))
-        pdf = np.zeros(len(dirs))
-        slots = self.light_slots if self.selecting else 0
+        ``group``, of the suns in that light group alone; with ``receiver``, the receiver light
+        sets of the objects the rays left, of the suns that light them, light linking). Suns with
+        shadow linking are light sampling's alone (strategies.NO_MIS) and not seen here."""
         fixed, moving = self._fixed_suns, self._moving_suns
+        if self.shadow_linking:
+            fixed = fixed[~self.light_shadow_linked[fixed]]
+            moving = [i for i in moving if not self.light_shadow_linked[i]]
         if group is not None:
             fixed = fixed[self.light_group[fixed] == group]
             moving = [i for i in moving if self.light_group[i] == group]
+        if receiver is None or not self.linking:
+            return self._suns_seen(origins, dirs, time, fixed, moving)
+        radiance, pdf = np.zeros((len(dirs), 3)), np.zeros(len(dirs))
+        for i in list(fixed) + moving:  # each sun at the rays whose objects it lights
+            rows = np.flatnonzero(links(self.light_membership[np.full(len(dirs), i)], receiver))
+            one = np.array([i], np.int64) if i in fixed else np.zeros(0, np.int64)
+            r, p = self._suns_seen(origins[rows], dirs[rows], None if time is None else time[rows], one,
+                                   [i] if i in moving else [])
+            radiance[rows] += r
+            pdf[rows] += p
+        return radiance, pdf
+
+    def _suns_seen(self, origins, dirs, time, fixed, moving):
+        radiance = np.zeros((len(dirs), 3))
+        pdf = np.zeros(len(dirs))
+        slots = self.light_slots if self.selecting else 0
         if len(fixed):
             _suns_batch(self.table, self.table, fixed, slots, origins, dirs, radiance, pdf)
         for i in moving:

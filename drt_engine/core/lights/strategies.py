@@ -26,8 +26,14 @@ NO_WORLD, UNIFORM_WORLD, MAP_WORLD = 0, 1, 2
 NO_SHADOW = 8
 """A bit of ``LightSamples.exclude`` beside bsdf.mixture's ``UNLIT_*``: the sample's light casts no
 shadow (Cycles' Cast Shadow off), its shadow ray is not traced."""
+NO_MIS = 16
+"""Another: the sample's light is light sampling's alone, not weighed against BSDF rays, which do
+not count it (an emitter with shadow linking: Cycles finds it behind the objects that cast none of
+its shadows with a dedicated light ray, weighed against light sampling; light sampling alone has
+the same expectation)."""
 _NOTHING_EXCLUDED = np.zeros((0, 0), np.int8)
 _NO_GROUPS = np.zeros((0, 0), np.int64)
+_NO_MASKS = np.zeros((0, 0), np.int32)
 
 
 @dataclass
@@ -38,7 +44,8 @@ class LightSamples:
     lights (core.integrator.direct's ``restrict``) and per sample what its light leaves out
     (``exclude``: bsdf.mixture's ``UNLIT_*`` bits and ``NO_SHADOW``, from the ray visibility of
     the light or emissive object sampled; empty when no light leaves anything out) and each
-    sample's light group (``group``, core.integrator.lightgroups; empty without light groups)."""
+    sample's light group (``group``, core.integrator.lightgroups; empty without light groups) and
+    each sample's shadow-ray Embree mask (``mask``, shadow linking; empty: the scene's)."""
 
     wi: np.ndarray
     dist: np.ndarray
@@ -48,6 +55,7 @@ class LightSamples:
     restrict: np.ndarray
     exclude: np.ndarray = field(default_factory=lambda: _NOTHING_EXCLUDED)
     group: np.ndarray = field(default_factory=lambda: _NO_GROUPS)
+    mask: np.ndarray = field(default_factory=lambda: _NO_MASKS)
 
     @classmethod
     def empty(cls, strategies: int, n: int) -> "LightSamples":
@@ -66,7 +74,8 @@ class LightSamples:
     def take(self, rows) -> "LightSamples":
         return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
                             self.stop[:, rows], self.restrict, self.exclude[:, rows] if self.exclude.size else
-                            self.exclude, self.group[:, rows] if self.group.size else self.group)
+                            self.exclude, self.group[:, rows] if self.group.size else self.group,
+                            self.mask[:, rows] if self.mask.size else self.mask)
 
     def arrays(self) -> tuple:
         """The fields, contiguous, in the order core.integrator.direct's kernel takes them."""

@@ -134,6 +134,7 @@ class PreparedScene:
         self.lit = np.array([bool(sh.lobes) or m.varying for sh, m in zip(self.shaders, self.shading)] + [False])
         self.continues = np.array([sh.can_continue or m.varying for sh, m in zip(self.shaders, self.shading)]
                                   + [False])
+        self.keeps_normal = np.array([sh.keeps_normal for sh in self.shaders] + [False])
         # what shader programs read at hits: a varying material's, or the AOVs' of any with a program
         programs = any(s.material.program is not None for s in self.shading)
         self.attributes = SurfaceAttributes(self.scene, self.geometry) if programs else None

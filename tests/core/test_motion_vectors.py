@@ -1,0 +1,137 @@
+"""The Vector pass against closed forms (core.geometry.motion_vectors, core.film.film): a point moved
+between frames by its object or seen by a moving camera shifts by the projected distance in pixels,
+(previous - now, now - next), x right and y up; in a render a pixel's vector is the mean over the
+samples that hit a surface (Cycles' motion weight), and parts merge into the whole render's."""
+import numpy as np
+import pytest
+
+from drt_engine.core.film import parts
+from drt_engine.core.geometry.motion_vectors import MotionVectors
+from drt_engine.core.render import merge
+from drt_engine.core.scene import Camera, Instance, Mesh
+from tests.core.test_mist_index import RES, render
+from tests.core.test_mist_index import scene as quads
+from tests.core.test_mist_index import settings as mist_settings
+from tests.support.core_cases import rendered_part
+from tests.support.scenes import translation
+
+DEPTH = 5.0  # the point's distance in front of the perspective camera
+PRE, POST = 0.5, 1.5  # the object's x at the previous and next frame, from 0 now
+
+
+def perspective(motion_pass=None):
+    """A camera at the origin looking down -z, window (-1, 1) x (-0.5, 0.5) on z = -1, 32 x 16 pixels:
+    16 pixels per unit on that plane."""
+    return Camera(np.eye(4)[None], (-1, 1, -0.5, 0.5), (32, 16), motion_pass=motion_pass)
+
+
+def moving(pre=PRE, post=POST, y=0.0):
+    return Instance(0, np.eye(4), motion_pass=np.stack([translation(pre, y), translation(post, -y)]))
+
+
+POINT = np.array([[0.0, 0.0, -DEPTH]])
+
+
+def test_object_motion_projects_into_pixels():
+    v = MotionVectors(perspective(), [moving()]).vectors(POINT, np.array([0]))[0]
+    scale = 16.0 / DEPTH
+    assert np.allclose(v, [PRE * scale, 0.0, -POST * scale, 0.0], rtol=1e-12)
+
+
+def test_y_is_up():
+    v = MotionVectors(perspective(), [moving(0.0, 0.0, y=0.25)]).vectors(POINT, np.array([0]))[0]
+    assert np.allclose(v, [0.0, 0.25 * 16 / DEPTH, 0.0, 0.25 * 16 / DEPTH], rtol=1e-12)
+
+
+def test_a_moving_camera_sees_the_opposite_motion():
+    """The camera moved by -x sees a still point as an object moved by +x sees it from a still camera."""
+    cam = perspective(np.stack([translation(-PRE), translation(-POST)]))
+    seen = MotionVectors(cam, [Instance(0, np.eye(4))]).vectors(POINT, np.array([0]))
+    assert np.allclose(seen, MotionVectors(perspective(), [moving()]).vectors(POINT, np.array([0])), rtol=1e-12)
+
+
+def test_nothing_moves_gives_exactly_zero():
+    points = np.random.default_rng(1).normal(size=(64, 3)) - [0, 0, 5]
+    assert np.all(MotionVectors(perspective(), [Instance(0, np.eye(4))]).vectors(points, np.zeros(64, int)) == 0)
+
+
+def test_a_deforming_mesh_carries_its_points_with_its_vertices():
+    """A point at barycentric (0.2, 0.3, 0.5) of a triangle whose corners move differently lands at
+    the same place among the moved corners (the object moved too: its transform there applies)."""
+    tri = np.array([[-1.0, -1.0, -DEPTH], [1.0, -1.0, -DEPTH], [0.0, 1.0, -DEPTH]])
+    shift = np.array([[[0.1, 0, 0], [0.3, 0.2, 0], [0, 0, 0]], [[-0.4, 0, 0], [0, 0.5, 0], [0.2, 0, 0]]])
+    mesh = Mesh("tri", tri, [[0, 1, 2]], [0], motion_pass_vertices=tri + shift)
+    weights = np.array([0.2, 0.3, 0.5])
+    point = (weights @ tri)[None]
+    v = MotionVectors(perspective(), [moving(0.25, 0.0)], [mesh]).vectors(point, np.array([0]), np.array([0]))[0]
+    pre, post = weights @ shift[0] + [0.25, 0, 0], weights @ shift[1]
+    scale = 16.0 / DEPTH
+    assert np.allclose(v, [pre[0] * scale, pre[1] * scale, -post[0] * scale, -post[1] * scale], rtol=1e-9)
+
+
+def test_orthographic_scale():
+    cam = Camera(np.eye(4)[None], (-2, 2, -1, 1), (32, 16), type="ORTHO")
+    v = MotionVectors(cam, [moving()]).vectors(POINT * 3, np.array([0]))[0]
+    assert np.allclose(v, [PRE * 8, 0.0, -POST * 8, 0.0], rtol=1e-12)  # 8 pixels per unit, any depth
+
+
+def scene():
+    """The index passes' quads (core test_mist_index) seen from above: quad B (under 0 < x < 0.5,
+    8 pixels per unit) at x -0.25 the previous frame and +0.5 the next, quad A still."""
+    data = quads()
+    data.instances[1].motion_pass = np.stack([translation(-0.25), translation(0.5)])
+    return data
+
+
+B_VECTOR = (-2.0, 0.0, -4.0, 0.0)
+
+
+def settings(**kw):
+    return mist_settings(passes=("Combined", "Vector"), **kw)
+
+
+@pytest.mark.parametrize("pattern", ["SOBOL", "GRID"])
+def test_pixels_read_the_vector_of_their_hits(pattern):
+    """With a wide Gaussian, pixels beside quad B's outer edge mix its samples with the background's:
+    they still read B's vector (the background's samples weigh nothing), A's pixels 0, the background 0."""
+    s = settings(pattern=pattern)
+    s.filter_type, s.filter_size = "GAUSSIAN", 3.0
+    v = render(scene(), s)[1].passes["Vector"]
+    assert v.shape == (RES, RES, 4)
+    b = np.all(np.isclose(v, B_VECTOR, atol=1e-9), axis=-1)
+    zero = np.all(v == 0.0, axis=-1)
+    assert np.all((b | zero)[:, RES // 2 + 2:])  # (beside A's edge B's and A's hits mix, both weighing 1)
+    assert np.all(b[:, RES // 2 + 2:3 * RES // 4]) and np.all(zero[:, :RES // 2 - 2])
+    assert zero[:, -1].all()
+    if pattern == "SOBOL":  # past the edge: B's where its samples reach (8 grid samples stay closer)
+        assert b[:, 3 * RES // 4:].any()
+
+
+def test_an_unweighted_mean_would_be_diluted():
+    """The same pixels read as a plain mean over all samples fall between B's vector and 0."""
+    s = settings()
+    s.filter_type, s.filter_size = "GAUSSIAN", 3.0
+    renderer, _ = render(scene(), s)
+    total = renderer.film.sums["Vector"]
+    plain = total[:, :4] / renderer.film.count[:, None]
+    assert np.any((plain[:, 0] < -0.01) & (plain[:, 0] > -1.99))
+
+
+def test_no_work_when_off():
+    renderer, result = render(scene(), mist_settings(passes=("Combined",)))
+    assert "Vector" not in result.passes and renderer.integrator.motion_vectors is None
+
+
+def test_parts_merge_into_the_whole_render(tmp_path):
+    data = scene()
+
+    def part(start, end):
+        return rendered_part(data, settings(start=start, end=end))
+
+    _, whole = part(0, 0)
+    pieces = [part(a, b)[0] for a, b in ((3, 8), (0, 3))]
+    for i, piece in enumerate(pieces):
+        parts.write(tmp_path / f"{i}.exr", piece)
+    images = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).film.images()
+    assert np.allclose(images["Vector"], whole.passes["Vector"], rtol=1e-6, atol=1e-12)
+
