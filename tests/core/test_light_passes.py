@@ -49,7 +49,9 @@ def test_emit_env_and_light_passes_times_colours_sum_to_combined(settings):
     # each holds light (TransDir hardly: light reaches a closed glass sphere's far side after two bounces)
     for name in ("DiffDir", "GlossDir", "GlossInd", "TransInd"):
         assert (p[name] * p[LIGHT_PASSES[name]]).mean() > 1e-3 * combined.mean(), name
-    assert (p["DiffInd"].mean() > 0) == bool(settings.get("diffuse_bounces"))  # no diffuse bounce, no light
+    # without diffuse bounces too: a glossy bounce off the floor carries its diffuse lobe's share of the
+    # BSDF there (Cycles' pass weights of the whole closure mixture)
+    assert p["DiffInd"].mean() > 1e-3 * p["DiffDir"].mean()
 
 
 def test_light_passes_leave_combined_as_it_was():

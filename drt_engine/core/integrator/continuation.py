@@ -35,9 +35,9 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside,
     ``min_bounces`` (bounces, transparent bounces; -1: no roulette) a path past them goes on with
     Cycles' probability min(sqrt(max throughput), 1) (``roulette``), decided by ``u_roulette[j]``.
     Where ``first[j]`` (empty: no light passes) and the path bounces (not through a transparent
-    lobe), ``shares[j]`` its light passes' weights (core.integrator.lightpasses): the diffuse
-    lobes' and the other lobes' reflection's shares of the continued lobes' BSDF toward the new
-    direction (Cycles' bsdf_eval_pass_*_weight), a delta lobe's whole by its side.
+    lobe), ``shares[j]`` its light passes' weights (core.integrator.lightpasses, ``pass_shares``): the
+    diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
+    (Cycles' bsdf_eval_pass_*_weight), a delta lobe's whole by its side.
     Shader and hits as core.integrator.direct has them."""
     sel_nd = np.empty((1, max(n_sampled, 1)))
     sel_all = np.empty((1, max(lp.shape[0], 1)))
@@ -92,13 +92,20 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, wo_l, inside,
 
 @kernel(inline="always")
 def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, inside, sel, bits, sx, sy, sz, model, shares):
-    """``shares[j]``: the diffuse and glossy weights of a path continued toward local (x, y, z)."""
-    for c in range(3):
-        shares[j, 0, c] = shares[j, 1, c] = 0.0
+    """``shares[j]``: the diffuse and glossy weights of a path continued toward local (x, y, z).
+    Rows 0-1, for what the path brings from further on (Indirect): the shares of the whole mixture's
+    BSDF there, the diffuse lobes no ray continues through (no diffuse bounce left) included, as
+    Cycles' bsdf_eval of a sampled direction sums every closure (closure MIS). Rows 2-3, for the
+    emission this ray finds (Direct): the shares of the lobes it continues through, the BSDF its MIS
+    weighs against light sampling (the other diffuse lobes' direct light is light sampling's alone,
+    core.integrator.direct): Cycles' Direct passes hold each kind's own direct light."""
+    for i in range(4):
+        for c in range(3):
+            shares[j, i, c] = 0.0
     if delta:  # a mirror or glass's sharp reflection is glossy, its refraction transmission
         if not crosses:
             for c in range(3):
-                shares[j, 1, c] = 1.0
+                shares[j, 1, c] = shares[j, 3, c] = 1.0
         return
     above = not crosses
     f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits, 0,
@@ -106,12 +113,14 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, inside, sel
     fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
                     UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model)
     for c in range(3):
-        shares[j, 0, c] = share(fd[3 + c], f[3 + c])
+        shares[j, 0, c] = share(fd[c] + fd[3 + c], f[c] + f[3 + c])
+        shares[j, 2, c] = share(fd[3 + c], f[3 + c])
     if above:
         fg = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
                         UNLIT_DIFFUSE | UNLIT_TRANSMISSION, sx, sy, sz, model)
         for c in range(3):
-            shares[j, 1, c] = share(fg[3 + c], f[3 + c])
+            shares[j, 1, c] = share(fg[3 + c], f[c] + f[3 + c])
+            shares[j, 3, c] = share(fg[3 + c], f[3 + c])
 
 
 @kernel(inline="always")

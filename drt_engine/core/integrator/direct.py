@@ -77,8 +77,8 @@ def unlit_parts(restrict, k):
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, wo_l, inside, scale, throughput, path,
                  limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
-                 exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, split, weights, passed,
-                 f_diff, visibility, cuts, clear, allowed, qf, qi):
+                 exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, split, weights,
+                 passed, f_diff, visibility, cuts, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
     ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 

@@ -11,8 +11,10 @@ everything later. What the camera sees itself (Emit, Env) is in none of them. Ea
 the clamp, as Combined; the film reads each out divided by its colour pass (core.film.film).
 
 The wave carries ``split`` (paths, 6, 3: kind x direct / indirect, ``COLUMNS``), per path its
-``weights`` (paths, 2, 3: diffuse and glossy share after the first bounce) and ``bounces`` (its
-non-transparent bounces so far). A render with none of these passes carries nothing of this.
+``weights`` (paths, 4, 3: diffuse and glossy share after the first bounce, of the whole mixture for
+Indirect, then of the lobes the ray continued through for the emission it finds, Direct:
+core.integrator.continuation.pass_shares) and ``bounces`` (its non-transparent bounces so far).
+A render with none of these passes carries nothing of this.
 """
 from __future__ import annotations
 
@@ -30,7 +32,7 @@ RATIO_LEFT_OUT = "light passes: the Ratio shadow estimator's correction is in Co
 COLUMNS = ("DiffDir", "DiffInd", "GlossDir", "GlossInd", "TransDir", "TransInd")
 """The ``split`` columns: kind (diffuse, glossy, transmission) by direct (even) and indirect (odd)."""
 NO_SPLIT = np.zeros((0, 6, 3))
-NO_WEIGHTS = np.zeros((0, 2, 3))
+NO_WEIGHTS = np.zeros((0, 4, 3))
 NO_BOUNCES = np.zeros(0, np.int64)
 """The kernels' arrays when no light pass is asked for."""
 
@@ -45,7 +47,7 @@ class WaveSplit:
 
     def __init__(self, n: int):
         self.split = np.zeros((n, 6, 3))
-        self.weights = np.zeros((n, 2, 3))
+        self.weights = np.zeros((n, 4, 3))
         self.bounces = np.zeros(n, np.int64)
 
     def arrays(self) -> tuple:
@@ -54,13 +56,14 @@ class WaveSplit:
 
     def add_found(self, path: np.ndarray, e: np.ndarray):
         """Emission rays found (``e`` per row, clamped, MIS-weighted) on paths ``path``: by their
-        bounce weights, Direct after one bounce, Indirect after more, nothing before any."""
+        bounce weights, Direct after one bounce (the continued lobes' shares), Indirect after more
+        (the whole mixture's), nothing before any."""
         b = self.bounces[path]
         rows = np.flatnonzero(b >= 1)
         if len(rows) == 0:
             return
         p, e, indirect = path[rows], e[rows], (b[rows] > 1).astype(np.int64)
-        w = self.weights[p]
+        w = self.weights[p[:, None], 2 * (1 - indirect)[:, None] + np.arange(2)]
         rest = e * (1.0 - w[:, 0] - w[:, 1])
         for kind, part in enumerate((e * w[:, 0], e * w[:, 1], rest)):
             np.add.at(self.split, (p, 2 * kind + indirect), part)
