@@ -69,14 +69,16 @@ writes these at sample 0 only, core.film.film)."""
 LIGHT_PASSES = {"DiffDir": "DiffCol", "DiffInd": "DiffCol", "GlossDir": "GlossCol", "GlossInd": "GlossCol",
                 "TransDir": "TransCol", "TransInd": "TransCol"}
 """Cycles' light passes and the colour pass each is read out divided by (Cycles' divide_even_color):
-a render of one also sums its colour (``with_light_pass_colours``), as Cycles allocates it."""
+a render of one also sums its colour (``read_over``), as Cycles allocates it."""
 
 
-def with_light_pass_colours(passes) -> tuple[str, ...]:
-    """``passes`` and the colour passes its light passes are divided by."""
+def read_over(passes) -> tuple[str, ...]:
+    """The colour passes the light passes among ``passes`` are divided by that ``passes`` lacks: a
+    render traces and sums them (core.render.render) but returns only what was asked, as Cycles
+    allocates them for itself and hands Blender only the enabled passes."""
     passes = tuple(passes)
-    return passes + tuple(dict.fromkeys(LIGHT_PASSES[name] for name in passes
-                                        if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
+    return tuple(dict.fromkeys(LIGHT_PASSES[name] for name in passes
+                               if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
 
 
 WEIGHTED_PASSES = ("Vector",)
@@ -211,7 +213,6 @@ class RenderSettings:
         self.passes = tuple(self.passes) + tuple(name for name, _ in self.aovs if name not in self.passes)
         if "Combined" not in self.passes:
             self.passes = ("Combined",) + tuple(self.passes)
-        self.passes = with_light_pass_colours(self.passes)
         start, end = self.sample_range()
         if not 0 <= start < end <= self.samples:
             raise SettingsError(f"sample range {start}:{end} is not inside the {self.samples} samples 0:{self.samples}")

@@ -60,6 +60,15 @@ def test_light_passes_leave_combined_as_it_was():
     assert np.array_equal(with_passes, without)
 
 
+def test_a_light_pass_alone_returns_no_colour_pass():
+    """Its colour is summed to divide by (as Cycles allocates it) but not returned, as Cycles writes
+    only the enabled passes: the pass reads the same as with its colour asked for."""
+    alone = render(scene(), passes=("Combined", "GlossInd"))
+    assert set(alone) == {"Combined", "GlossInd"}
+    with_colour = render(scene(), passes=("Combined", "GlossInd", "GlossCol"))
+    np.testing.assert_array_equal(alone["GlossInd"], with_colour["GlossInd"])
+
+
 def test_divide_even_color_is_cycles():
     """Cycles' safe_divide_even_color: a zero channel of the divisor takes the others' quotients."""
     a = np.array([[1.0, 2.0, 3.0]] * 5)

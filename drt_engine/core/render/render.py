@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -25,7 +25,7 @@ from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import RenderSettings
+from ..settings import RenderSettings, read_over
 from ..validate import validate_camera
 from . import adaptive
 from .denoise import Schedule, denoise_film, denoised_passes, figures
@@ -77,6 +77,9 @@ class Renderer:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
         if settings.use_denoising:  # the features guide the denoiser (a part's, the merge's): traced even
             settings = with_features(settings)  # when not asked for as passes
+        self._read_over = read_over(settings.passes)  # light passes' colours, summed (parts keep them), not returned
+        if self._read_over:
+            settings = replace(settings, passes=tuple(settings.passes) + self._read_over)
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
@@ -192,7 +195,7 @@ class Renderer:
                  "adaptive_threshold": outcome.threshold if s.use_adaptive_sampling else None,
                  "adaptive_first_test": outcome.first if s.use_adaptive_sampling else None,
                  "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
-        passes = film.images()
+        passes = {name: image for name, image in film.images().items() if name not in self._read_over}
         warnings = list(self.warnings)
         if s.use_denoising and s.partial:  # the part's film keeps the features for the merge
             passes = {name: image for name, image in passes.items() if name in s.passes}
