@@ -75,3 +75,27 @@ def test_divide_even_color_is_cycles():
     b = np.array([[2.0, 4.0, 6.0], [0.0, 4.0, 3.0], [0.0, 0.0, 6.0], [2.0, 0.0, 0.0], [2.0, 4.0, 0.0]])
     np.testing.assert_allclose(divide_even_color(a, b), [[0.5, 0.5, 0.5], [0.75, 0.5, 1.0], [0.5, 0.5, 0.5],
                                                          [0.5, 0.5, 0.5], [0.5, 0.5, 0.5]])
+
+
+def test_a_light_pass_alone_travels_through_parts_and_merge(tmp_path):
+    """A split render's parts keep the colour a light pass is divided by; merged, the pass is the whole
+    render's and the colour is not among the merged passes."""
+    from drt_engine.core.film import parts
+    from drt_engine.core.render import merge, report
+
+    def part(start, end):
+        data = scene()
+        settings = RenderSettings(samples=8, threads=1, max_depth=4, passes=("Combined", "DiffInd"),
+                                  sample_start=start, sample_end=end)
+        renderer = Renderer(data, settings)
+        result = renderer.render()
+        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data),
+                  "report": report.report_dict(settings, result.stats, result.log, report.scene_summary(data))}
+        return parts.from_film(renderer.film, settings, header), result
+
+    _, whole = part(0, 0)
+    for i, (a, b) in enumerate(((0, 3), (3, 8))):
+        parts.write(tmp_path / f"{i}.exr", part(a, b)[0])
+    merged = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).images()
+    assert set(merged) == {"Combined", "DiffInd"}
+    np.testing.assert_allclose(merged["DiffInd"], whole.passes["DiffInd"], rtol=1e-5, atol=1e-7)
