@@ -306,9 +306,12 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_object_index")
         col.prop(view_layer, "use_pass_material_index")
         col.prop(view_layer, "pass_alpha_threshold")
+        for heading, kind in (("Diffuse", "diffuse"), ("Glossy", "glossy"), ("Transmission", "transmission")):
+            col = layout.column(heading=heading, align=True)  # Cycles' Light passes, as its panel lays them out
+            col.prop(view_layer, f"use_pass_{kind}_direct", text="Direct")
+            col.prop(view_layer, f"use_pass_{kind}_indirect", text="Indirect")
+            col.prop(view_layer, f"use_pass_{kind}_color", text="Color")
         col = layout.column(heading="Light", align=True)
-        col.prop(view_layer, "use_pass_diffuse_color", text="Diffuse Color")
-        col.prop(view_layer, "use_pass_glossy_color", text="Glossy Color")
         col.prop(view_layer, "use_pass_emit", text="Emission")
         col.prop(view_layer, "use_pass_environment")
         col = layout.column(heading="Sampling", align=True)

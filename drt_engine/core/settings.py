@@ -27,6 +27,13 @@ PASSES = (
     "Mist",  # Cycles' mist: 0 near, 1 far and for the background, by the world's mist settings
     "IndexOB",  # the first sample's object pass index, unfiltered (Cycles' Object Index)
     "IndexMA",  # the first sample's material pass index, unfiltered (Cycles' Material Index)
+    "DiffDir",  # Cycles' light passes (core.integrator.lightpasses): light by the first hit's diffuse lobes,
+    "DiffInd",  # direct (light samples at the first hit, emission its bounce ray finds) and indirect
+    "GlossDir",  # (what later vertices bring), each read out divided by its colour pass
+    "GlossInd",
+    "TransDir",
+    "TransInd",
+    "TransCol",  # transmission albedo of the first hit
     "Vector",  # Cycles' motion vectors in pixels: to the previous frame's position, from the next's (core.film.vector)
     "CryptoObject",  # Cryptomatte of the objects' names, written as CryptoObject00, 01, ... (core.film.cryptomatte)
     "CryptoMaterial",  # of the materials' names
@@ -48,6 +55,13 @@ PASS_CHANNELS = {
     "Mist": "Z",
     "IndexOB": "X",
     "IndexMA": "X",
+    "DiffDir": "RGB",
+    "DiffInd": "RGB",
+    "GlossDir": "RGB",
+    "GlossInd": "RGB",
+    "TransDir": "RGB",
+    "TransInd": "RGB",
+    "TransCol": "RGB",
     "Vector": "XYZW",
     "Noisy Image": "RGBA",
 }
@@ -55,6 +69,21 @@ FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
 """Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
 mean: an index is an identity, which averaging across an edge would turn into another one (Cycles
 writes these at sample 0 only, core.film.film)."""
+LIGHT_PASSES = {"DiffDir": "DiffCol", "DiffInd": "DiffCol", "GlossDir": "GlossCol", "GlossInd": "GlossCol",
+                "TransDir": "TransCol", "TransInd": "TransCol"}
+"""Cycles' light passes and the colour pass each is read out divided by (Cycles' divide_even_color):
+a render of one also sums its colour (``read_over``), as Cycles allocates it."""
+
+
+def read_over(passes) -> tuple[str, ...]:
+    """The colour passes the light passes among ``passes`` are divided by that ``passes`` lacks: a
+    render traces and sums them (core.render.render) but returns only what was asked, as Cycles
+    allocates them for itself and hands Blender only the enabled passes."""
+    passes = tuple(passes)
+    return tuple(dict.fromkeys(LIGHT_PASSES[name] for name in passes
+                               if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
+
+
 WEIGHTED_PASSES = ("Vector",)
 """Passes whose sums carry one more channel, the count of samples that wrote them, and read as the
 sum over it (Cycles' motion weight: a pixel's vector is the mean of its samples that hit a surface,

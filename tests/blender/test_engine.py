@@ -92,7 +92,10 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
     for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_diffuse_color",
                  "use_pass_glossy_color", "use_pass_emit", "use_pass_environment", "use_pass_mist",
                  "use_pass_object_index", "use_pass_material_index", "use_pass_vector",
-                 "use_pass_cryptomatte_object", "use_pass_cryptomatte_material", "use_pass_cryptomatte_asset"):
+                 "use_pass_cryptomatte_object", "use_pass_cryptomatte_material", "use_pass_cryptomatte_asset",
+                 "use_pass_diffuse_direct", "use_pass_diffuse_indirect", "use_pass_glossy_direct",
+                 "use_pass_glossy_indirect", "use_pass_transmission_direct", "use_pass_transmission_indirect",
+                 "use_pass_transmission_color"):
         setattr(view_layer, attr, True)
     view_layer.drt.use_pass_sample_count = True
     view_layer.drt.use_pass_noise = True

@@ -1055,22 +1055,22 @@ def test_metallic_bsdf_is_a_principled_metal(fresnel):
 
 
 def test_passes_drt_does_not_write_are_named_in_the_warning():
-    """Cycles' Diffuse / Glossy / Transmission Direct and Indirect, Transmission Color and Ambient
-    Occlusion: a view layer asking for them gets no such pass from DRT, and says so (Diffuse / Glossy
-    Color and Cryptomatte it writes)."""
+    """Cycles' Ambient Occlusion: a view layer asking for it gets no such pass from DRT, and says so
+    (Diffuse / Glossy / Transmission Color, Direct and Indirect and Cryptomatte it writes)."""
     scene = empty_scene()
     add_object(scene, "Cube", cube_mesh())
     layer = scene.view_layers[0]
-    layer.use_pass_diffuse_color = layer.use_pass_glossy_color = True
-    assert render_export(scene).warnings == []
-    layer.use_pass_diffuse_direct = layer.use_pass_glossy_indirect = layer.use_pass_transmission_color = True
-    layer.use_pass_ambient_occlusion = layer.use_pass_cryptomatte_material = True
+    light = ("use_pass_diffuse_color", "use_pass_glossy_color", "use_pass_diffuse_direct", "use_pass_glossy_indirect",
+             "use_pass_transmission_direct", "use_pass_transmission_indirect", "use_pass_transmission_color")
+    for toggle in light:
+        setattr(layer, toggle, True)
     try:
+        assert render_export(scene).warnings == []
+        layer.use_pass_ambient_occlusion = layer.use_pass_cryptomatte_material = True
         (warning,) = render_export(scene).warnings
     finally:
-        layer.use_pass_diffuse_direct = layer.use_pass_glossy_indirect = layer.use_pass_transmission_color = False
+        for toggle in light:
+            setattr(layer, toggle, False)
         layer.use_pass_ambient_occlusion = layer.use_pass_cryptomatte_material = False
-        layer.use_pass_diffuse_color = layer.use_pass_glossy_color = False
-    assert "Diffuse Direct" in warning and "Glossy Indirect" in warning and "Transmission Color" in warning
     assert "Ambient Occlusion" in warning and "Cryptomatte" not in warning
-    assert "Diffuse Color" not in warning and "Glossy Direct" not in warning
+    assert "Diffuse" not in warning and "Glossy" not in warning and "Transmission" not in warning

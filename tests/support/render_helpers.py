@@ -23,6 +23,13 @@ PASS_TOGGLES = {
     "Normal": ("use_pass_normal", "XYZ"),
     "DiffCol": ("use_pass_diffuse_color", "RGB"),
     "GlossCol": ("use_pass_glossy_color", "RGB"),
+    "DiffDir": ("use_pass_diffuse_direct", "RGB"),
+    "DiffInd": ("use_pass_diffuse_indirect", "RGB"),
+    "GlossDir": ("use_pass_glossy_direct", "RGB"),
+    "GlossInd": ("use_pass_glossy_indirect", "RGB"),
+    "TransDir": ("use_pass_transmission_direct", "RGB"),
+    "TransInd": ("use_pass_transmission_indirect", "RGB"),
+    "TransCol": ("use_pass_transmission_color", "RGB"),
     "Emit": ("use_pass_emit", "RGB"),
     "Env": ("use_pass_environment", "RGB"),
     "Mist": ("use_pass_mist", "Z"),
@@ -33,7 +40,10 @@ PASS_TOGGLES = {
 """Passes both renderers write, by Blender's view-layer toggle and channel ids."""
 
 BLENDER5_NAMES = {"DiffCol": "Diffuse Color", "GlossCol": "Glossy Color", "Emit": "Emission", "Env": "Environment",
-                  "IndexOB": "Object Index", "IndexMA": "Material Index"}
+                  "IndexOB": "Object Index", "IndexMA": "Material Index", "DiffDir": "Diffuse Direct",
+                  "DiffInd": "Diffuse Indirect", "GlossDir": "Glossy Direct", "GlossInd": "Glossy Indirect",
+                  "TransDir": "Transmission Direct", "TransInd": "Transmission Indirect",
+                  "TransCol": "Transmission Color"}
 """Names Cycles in Blender 5.0 writes for the passes Blender 4 (and DRT) call by their short names."""
 
 

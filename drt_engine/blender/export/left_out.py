@@ -19,17 +19,11 @@ SHOWN = 3
 """Object names a setting's entry shows before "and N more"."""
 
 PASSES = (  # view-layer toggle, the pass as Blender's Passes panel names it
-    ("use_pass_diffuse_direct", "Diffuse Direct"),
-    ("use_pass_diffuse_indirect", "Diffuse Indirect"),
-    ("use_pass_glossy_direct", "Glossy Direct"),
-    ("use_pass_glossy_indirect", "Glossy Indirect"),
-    ("use_pass_transmission_direct", "Transmission Direct"),
-    ("use_pass_transmission_indirect", "Transmission Indirect"),
-    ("use_pass_transmission_color", "Transmission Color"),
     ("use_pass_ambient_occlusion", "Ambient Occlusion"),
 )
-"""Cycles' passes DRT does not write yet (its Diffuse and Glossy Color it does): a view layer that
-asks for them gets no such pass, so the warning names them."""
+"""Cycles' passes DRT does not write yet (its Diffuse, Glossy and Transmission Color, Direct and
+Indirect it does, core.integrator.lightpasses): a view layer that asks for them gets no such pass,
+so the warning names them."""
 
 OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning calls another value
     ("is_shadow_catcher", False, "shadow catcher"),

@@ -179,6 +179,16 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
 
 
 @kernel(inline="always")
+def side_of(wiz, crosses, diffuse, dx, dy):
+    """The side of the surface ``eval_lobes`` weighs a sampled direction on: the one it leaves by,
+    but for a ``diffuse`` lobe's sample about the diffuse lobes' own normal (dx, dy, ...: at a rim),
+    whose side for the other lobes is the frame's."""
+    if tilted(dx, dy) and diffuse:
+        return wiz > 0.0
+    return not crosses
+
+
+@kernel(inline="always")
 def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
     """Sample lobe l alone: (wi, weight f |cos| / pdf of this lobe RGB, valid)."""
     kind = int(lp[l, P_KIND])
@@ -262,9 +272,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         crosses = kind == TRANSLUCENT if tilted(dx, dy) else wiz < 0.0
     else:
         crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
-    above = not crosses
-    if tilted(dx, dy) and diffuse_kind(kind):  # the side the other lobes are weighed on: the frame's
-        above = wiz > 0.0
+    above = side_of(wiz, crosses, diffuse_kind(kind), dx, dy)
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
                                               sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz)

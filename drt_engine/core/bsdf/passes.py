@@ -1,4 +1,4 @@
-"""What a hit's lobes show in the passes: DiffCol / GlossCol, Cycles' Denoising Albedo, and the
+"""What a hit's lobes show in the passes: DiffCol / GlossCol / TransCol, Cycles' Denoising Albedo, and the
 transparency Mist and the index passes weigh a hit by."""
 from __future__ import annotations
 
@@ -47,6 +47,24 @@ def colours(lp, lt, hp, r, mu, mu_o):
             g1 += s1 * hp[r, l, H_TINT_R + 1] * f
             g2 += s2 * hp[r, l, H_TINT_R + 2] * f
     return d0, d1, d2, g0, g1, g2
+
+
+@kernel(inline="always")
+def transmission_colour(lp, lt, hp, r, mu, mu_o):
+    """The transmission colour RGB as the TransCol pass shows it: Cycles' surface_shader_transmission,
+    each glass lobe's transmitted share (its transmission tint times 1 - Fresnel at wo; the whole tint
+    of a Refraction BSDF's), which its transmission closures' albedo estimate gives for a smooth surface."""
+    j, t = locate(mu, mu_o)
+    c0 = c1 = c2 = 0.0
+    for l in range(lp.shape[0]):
+        if int(lp[l, P_KIND]) != GLASS:
+            continue
+        s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
+        f = 0.0 if lp[l, P_REFRACT_ONLY] != 0.0 else mf.fresnel_dielectric1(mu_o, lp[l, P_ETA])
+        c0 += s0 * hp[r, l, H_TINT_T] * (1.0 - f)
+        c1 += s1 * hp[r, l, H_TINT_T + 1] * (1.0 - f)
+        c2 += s2 * hp[r, l, H_TINT_T + 2] * (1.0 - f)
+    return c0, c1, c2
 
 
 DENOISE_ROUGH = 0.075

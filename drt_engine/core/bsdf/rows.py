@@ -6,7 +6,7 @@ import numpy as np
 
 from ..base.jit import kernel
 from .mixture import eval_lobes, sample_lobes, selection
-from .passes import colours, denoising_albedos, transparency
+from .passes import colours, denoising_albedos, transmission_colour, transparency
 from .tables import lobe_scale, locate, ms_factor
 
 
@@ -45,6 +45,12 @@ def colours_rows(lp, lt, hp, prow, mu, mu_o, diff, gloss):
         v = colours(lp, lt, hp, prow[i], mu, mu_o[i])
         diff[i, 0], diff[i, 1], diff[i, 2] = v[0], v[1], v[2]
         gloss[i, 0], gloss[i, 1], gloss[i, 2] = v[3], v[4], v[5]
+
+
+@kernel
+def transmission_rows(lp, lt, hp, prow, mu, mu_o, out):
+    for i in range(len(mu_o)):
+        out[i, 0], out[i, 1], out[i, 2] = transmission_colour(lp, lt, hp, prow[i], mu, mu_o[i])
 
 
 @kernel

@@ -31,8 +31,8 @@ from . import microfacet as mf
 from . import thin_film as tf
 from .records import BsdfSample, BsdfValue
 from .sheen import sheen_albedo, sheen_rows
-from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transparency_rows,
-                   weights_rows)
+from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transmission_rows,
+                   transparency_rows, weights_rows)
 
 
 @dataclass(eq=False)
@@ -781,6 +781,13 @@ class MaterialShader:
         gloss = np.empty((n, 3))
         colours_rows(self.lp, self.lt, self.hp, self.hit_rows(n, rows), self.mu, _floats(mu_o), diff, gloss)
         return diff, gloss
+
+    def transmission_color(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
+        """The transmission colour as the TransCol pass shows it (zero without glass lobes)."""
+        out = np.zeros((len(mu_o), 3))
+        if self.has_glass:
+            transmission_rows(self.lp, self.lt, self.hp, self.hit_rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
+        return out
 
     def denoising_albedos(self, mu_o: np.ndarray, inside: np.ndarray, rows=None):
         """(diffuse-like albedo, specular-like albedo, takes the features) per hit, as Cycles

@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..settings import CRYPTOMATTE_PASSES, FIRST_SAMPLE_PASSES, WEIGHTED_PASSES, cryptomatte_passes, pass_channels
+from ..settings import (CRYPTOMATTE_PASSES, FIRST_SAMPLE_PASSES, LIGHT_PASSES, WEIGHTED_PASSES, cryptomatte_passes,
+                        pass_channels)
 from .cryptomatte import add_slots, ranks, slot_count
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
 
@@ -331,7 +332,24 @@ class Film:
         mean = self.sums[name][span] / np.maximum(count, 1)[:, None]
         if name == "Combined" and self.ratio:
             mean[:, :3] = self.rgb(span)
+        if name in LIGHT_PASSES:  # read out as Cycles: over its colour pass
+            return divide_even_color(mean, self.sums[LIGHT_PASSES[name]][span] / np.maximum(count, 1)[:, None])
         return mean
+
+
+def divide_even_color(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cycles' safe_divide_even_color over rows (util/color.h): a / b per channel, 0 where b is 0, and
+    a channel of b that is 0 takes the others' quotient (their mean where two are left), so that a
+    light pass over a colour without, say, blue stays grey rather than turning yellow."""
+    b0 = b == 0.0
+    q = np.where(b0, 0.0, a / np.where(b0, 1.0, b))
+    x, y, z = q[:, 0], q[:, 1], q[:, 2]
+    zx, zy, zz = b0[:, 0], b0[:, 1], b0[:, 2]
+    out = q.copy()
+    out[:, 0] = np.where(zx & zy, z, np.where(zx & zz, y, np.where(zx, 0.5 * (y + z), x)))
+    out[:, 1] = np.where(zx & zy, z, np.where(~zx & zy & zz, x, np.where(~zx & zy, 0.5 * (x + z), y)))
+    out[:, 2] = np.where(zx & zz, y, np.where(~zx & zy & zz, x, np.where(~zx & ~zy & zz, 0.5 * (x + y), z)))
+    return out
 
 
 def _variance(n, na, total_a, total_b):

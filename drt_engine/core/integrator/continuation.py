@@ -10,17 +10,18 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.mixture import sample_lobes, selection
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, selection, side_of
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
 from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
 from .bounces import diffuse_bits
+from .lightpasses import eval_parts, share
 
 
 @kernel
 def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, inside, u_select, u2, throughput, pos, ng,
                    scale, bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf,
-                   passthrough, transmit, next_bounces, diffuse):
+                   passthrough, transmit, next_bounces, diffuse, first, shares):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
     world direction ``wi``, the path's new throughput ``weight``, the density that sampled the
     direction (``prev_pdf``, inf for a delta lobe), whether the transparent lobe was taken, whether
@@ -33,6 +34,10 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     (reflected) or transmission one; ``diffuse[j]``: a diffuse lobe was taken. With
     ``min_bounces`` (bounces, transparent bounces; -1: no roulette) a path past them goes on with
     Cycles' probability min(sqrt(max throughput), 1) (``roulette``), decided by ``u_roulette[j]``.
+    Where ``first[j]`` (empty: no light passes) and the path bounces (not through a transparent
+    lobe), ``shares[j]`` its light passes' weights (core.integrator.lightpasses, ``pass_shares``): the
+    diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
+    (Cycles' bsdf_eval_pass_*_weight), a delta lobe's whole by its side.
     Shader and hits as core.integrator.direct has them."""
     sel_nd = np.empty((1, max(n_sampled, 1)))
     sel_all = np.empty((1, max(lp.shape[0], 1)))
@@ -68,6 +73,9 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
         weight[j, 0], weight[j, 1], weight[j, 2] = t0, t1, t2
         prev_pdf[j] = np.inf if s[7] else s[6]
         passthrough[j], transmit[j], diffuse[j] = s[9], crosses, s[10]
+        if len(first) and first[j] and not s[9]:
+            pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, x, y, z, crosses, s[7], side_of(z, crosses, s[10], dn[j, 0],
+                        dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], shares)
         if len(bounces):
             next_bounces[j] = bounces[j]
             if s[9]:
@@ -80,6 +88,41 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
                 next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | GLOSSY | (SINGULAR if s[7] else 0)
                 next_bounces[j, DEPTH] += 1
                 next_bounces[j, TRANSMISSION_DEPTH if crosses else GLOSSY_DEPTH] += 1
+
+
+@kernel(inline="always")
+def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, bits, sx, sy, sz, model, dx, dy,
+                dz, shares):
+    """``shares[j]``: the diffuse and glossy weights of a path continued toward local (x, y, z) (on
+    the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the diffuse lobes'
+    normal (dx, dy, dz)).
+    Rows 0-1, for what the path brings from further on (Indirect): the shares of the whole mixture's
+    BSDF there, the diffuse lobes no ray continues through (no diffuse bounce left) included, as
+    Cycles' bsdf_eval of a sampled direction sums every closure (closure MIS). Rows 2-3, for the
+    emission this ray finds (Direct): the shares of the lobes it continues through, the BSDF its MIS
+    weighs against light sampling (the other diffuse lobes' direct light is light sampling's alone,
+    core.integrator.direct): Cycles' Direct passes hold each kind's own direct light."""
+    for i in range(4):
+        for c in range(3):
+            shares[j, i, c] = 0.0
+    if delta:  # a mirror or glass's sharp reflection is glossy, its refraction transmission
+        if not crosses:
+            for c in range(3):
+                shares[j, 1, c] = shares[j, 3, c] = 1.0
+        return
+    f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits, 0,
+                   sx, sy, sz, model, dx, dy, dz)
+    fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+                    UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
+    for c in range(3):
+        shares[j, 0, c] = share(fd[c] + fd[3 + c], f[c] + f[3 + c])
+        shares[j, 2, c] = share(fd[3 + c], f[3 + c])
+    if above:
+        fg = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+                        UNLIT_DIFFUSE | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
+        for c in range(3):
+            shares[j, 1, c] = share(fg[3 + c], f[c] + f[3 + c])
+            shares[j, 3, c] = share(fg[3 + c], f[3 + c])
 
 
 @kernel(inline="always")

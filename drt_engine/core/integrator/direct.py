@@ -19,6 +19,7 @@ from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_MIS, NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
 from .clamp import clamped, limit_at
+from .lightpasses import add_split, add_weighted, eval_parts
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
@@ -76,8 +77,8 @@ def unlit_parts(restrict, k):
 @kernel
 def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo_l, inside, scale, throughput, path,
                  limit, bounces, diffuse_limit, continues, geo, prim, u, v, lifted, wi, dist, value, pdf, stop, restrict,
-                 exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, f_diff, visibility, cuts,
-                 clear, allowed, qf, qi):
+                 exclude, group, masks, scene, center, shadow_mask, times, radiance, grouped, split, weights,
+                 passed, f_diff, visibility, cuts, clear, allowed, qf, qi):
     """Adds every hit's unblocked direct light to ``radiance[path[j]]``, each strategy's clamped to
     ``limit[j]`` (core.integrator.clamp); returns the shadow rays traced and the rows queued.
 
@@ -97,7 +98,10 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     (``restrict``) and what each sample's light leaves out (``exclude``, lights.strategies: BSDF
     parts, and its shadow ray with NO_SHADOW; empty: nothing) and each sample's light group
     (``group``; empty: no light groups): what gets through is added to ``grouped[path[j], group]``
-    as well (core.integrator.lightgroups; no group: -1). Shadow rays see the objects whose
+    as well (core.integrator.lightgroups; no group: -1), and to the light passes' ``split`` (empty: none;
+    core.integrator.lightpasses): at a path's first hit (``passed[path[j]]``, its bounces, 0) by the
+    diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the sample, Direct; later
+    by the path's ``weights``, Indirect. Shadow rays see the objects whose
     Embree mask shares a bit with ``shadow_mask``, or with each sample's ``masks`` row (shadow
     linking; empty: none), and a sample whose light is light sampling's alone (``NO_MIS`` in
     ``exclude``) takes its whole weight. ``times``: each hit's shutter time (empty when
@@ -118,9 +122,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     see_through = len(clear) > 0
     excluding = exclude.size > 0
     grouping = group.size > 0
+    splitting = split.shape[0] > 0
     masking = masks.size > 0
     traced = queued = 0
     for j in range(len(pos)):
+        first = splitting and passed[path[j]] == 0
         bits = diffuse_bits(bounces, j, diffuse_limit)
         sel = sel_nd if bits == 0 else sel_all
         selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
@@ -156,6 +162,21 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
             if not _positive(c0, c1, c2):
                 continue
+            e0 = e1 = e2 = h0 = h1 = h2 = 0.0  # the diffuse and glossy parts, at a first hit
+            if first:
+                unlit = unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS))
+                fd = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
+                                inside[j], sel, bits, unlit | UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model,
+                                dn[j, 0], dn[j, 1], dn[j, 2])
+                e0 = throughput[j, 0] * v0 * (fd[0] + fd[3] * w)
+                e1 = throughput[j, 1] * v1 * (fd[1] + fd[4] * w)
+                e2 = throughput[j, 2] * v2 * (fd[2] + fd[5] * w)
+                if above:  # the other lobes' reflection (glass's on its reflected side) is glossy
+                    fg = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
+                                    inside[j], sel, bits, unlit | UNLIT_DIFFUSE | UNLIT_TRANSMISSION, sx, sy, sz,
+                                    model, dn[j, 0], dn[j, 1], dn[j, 2])
+                    h0, h1, h2 = throughput[j, 0] * v0 * fg[3] * w, throughput[j, 1] * v1 * fg[4] * w, \
+                        throughput[j, 2] * v2 * fg[5] * w
             ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, cd,
                                        hx, hy, hz, scale[j])
             tmax = math.inf
@@ -196,6 +217,11 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
                     grouped[path[j], g, 0] += c0
                     grouped[path[j], g, 1] += c1
                     grouped[path[j], g, 2] += c2
+                if first:
+                    add_split(split, path[j], c0, c1, c2, e0 * cut, e1 * cut, e2 * cut, h0 * cut, h1 * cut, h2 * cut,
+                              0)
+                elif splitting:
+                    add_weighted(split, weights, path[j], c0, c1, c2)
         p = path[j]
         radiance[p, 0] += s0
         radiance[p, 1] += s1

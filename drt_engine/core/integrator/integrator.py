@@ -49,6 +49,7 @@ from .direct import direct_light
 from .hits import surface_records
 from .holdout import Holdouts
 from .lightgroups import NO_GROUPS, light_groups
+from .lightpasses import NO_BOUNCES, NO_SPLIT, NO_WEIGHTS, WaveSplit, asked
 from .masks import ray_masks
 from .mis import add_emitted
 from .ratio import RatioEstimator
@@ -62,7 +63,8 @@ _NOTHING_CLEAR, _NO_LIMITS = np.zeros(0, bool), np.zeros(0, np.int64)  # the ker
 _NO_BUMP = np.zeros((0, 4))  # the kernels' smooth normals where no bump replaced the shading normal
 _AUX = (("Depth", "Z"), ("Normal", "XYZ"), ("Position", "XYZ"), ("DiffCol", "RGB"), ("GlossCol", "RGB"),
         ("Emit", "RGB"), ("Env", "RGB"), ("Denoising Albedo", "RGB"), ("Denoising Normal", "XYZ"), ("Mist", "Z"),
-        ("IndexOB", "X"), ("IndexMA", "X"))
+        ("IndexOB", "X"), ("IndexMA", "X"), ("DiffDir", "RGB"), ("DiffInd", "RGB"), ("GlossDir", "RGB"),
+        ("GlossInd", "RGB"), ("TransDir", "RGB"), ("TransInd", "RGB"), ("TransCol", "RGB"))
 
 
 @dataclass
@@ -112,6 +114,8 @@ class WaveOutput:
     # per path, with light groups: each group's share of the radiance (core.integrator.lightgroups)
     grouped: np.ndarray | None = None
     group_names: tuple = ()
+    # with light passes: their per-path split and the paths' weights (core.integrator.lightpasses)
+    split: WaveSplit | None = None
 
     def values(self) -> dict:
         radiance, ratio = self.radiance, None if self.ratio is None else self.ratio.ndu
@@ -121,6 +125,9 @@ class WaveOutput:
         radiance = np.where(finite, radiance, 0.0)
         for column, name in enumerate(self.group_names):  # a path Combined drops, its groups drop too
             self.aux[name] = np.where(finite, self.grouped[:, column], 0.0)
+        if self.split is not None:  # so do its light passes
+            self.split.split[~finite.all(axis=1)] = 0.0
+            self.split.passes(self.aux)
         out = {"Combined": np.concatenate([radiance, np.clip(self.alpha, 0.0, 1.0)[:, None]], axis=1)}
         if ratio is not None:
             out[RATIO] = out_ratio
@@ -187,6 +194,7 @@ class Integrator:
         self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
             m.shader.holds_out for m in prepared.shading) else None
         self.groups = light_groups(scene, self.lights, settings.passes)  # None: no group to fill
+        self.light_passes = asked(settings.passes)  # Diffuse / Glossy / Transmission Direct and Indirect
         self.group_passes = [name for name in settings.passes if name.startswith(LIGHTGROUP_PREFIX)
                              and name not in dict(settings.aovs)]
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0,
@@ -215,6 +223,8 @@ class Integrator:
                          ratio=RatioEstimator(self.lights.table, self.ratio, n) if self.ratio else None)
         if self.groups is not None:
             out.grouped, out.group_names = self.groups.new(n), tuple(self.groups.names)
+        if self.light_passes:
+            out.split = WaveSplit(n)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
@@ -287,7 +297,7 @@ class Integrator:
                         queued.append(queue)
                     start += len(group)
                 if (shader.can_continue or (self.diffuse and shader.lobes)) and depth < s.max_depth:
-                    nxt = self._continue(shader, group, u_g, state)
+                    nxt = self._continue(shader, group, u_g, state, out.split)
                     if nxt is not None:
                         continued.append(nxt)
             if queued:
@@ -351,8 +361,12 @@ class Integrator:
             origins, dist = rays.mis_ray(smooth, t[smooth])
             return self.lights.pdf(light_id[smooth], origins, rays.dirs[smooth], dist, rays.time[smooth])
 
-        add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight),
-                    self._group(lambda: self.lights.light_group[light_id]))
+        e = add_emitted(out, rays.path, rays.throughput, le, rays.prev_pdf, light_pdf, self._limits(rays.straight),
+                        self._group(lambda: self.lights.light_group[light_id]))
+        if "Emit" in out.aux:  # lights the camera sees are in Cycles' Emit too
+            out.aux["Emit"][rays.path[rays.straight]] += e[rays.straight]
+        if out.split is not None:
+            out.split.add_found(rays.path, e)
 
     def _escaped(self, rays: PathState, out: WaveOutput):
         """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
@@ -375,16 +389,20 @@ class Integrator:
         if len(rays) and lights.world_seen:
             sampled = None if lights.world is None else (  # a world light sampling can find
                 lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
-            add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled, self._limits(rays.straight),
-                        self._group(lambda: np.full(len(rays), lights.world_group)))
+            e = add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled,
+                            self._limits(rays.straight), self._group(lambda: np.full(len(rays), lights.world_group)))
+            if out.split is not None:
+                out.split.add_found(rays.path, e)
         bounced = rays.take(np.flatnonzero(~rays.straight)) if len(rays) else rays
         if len(bounced):
             # with light groups, each group's suns apart (a sun's light goes to its group)
             for group in [None] if self.groups is None else np.unique(lights.light_group):
                 sun, pdf_sun = lights.suns_seen(bounced.origins, bounced.dirs, bounced.time, group, bounced.receiver)
-                add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
-                            lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
-                            None if group is None else self._group(lambda: np.full(len(bounced), group)))
+                e = add_emitted(out, bounced.path, bounced.throughput, sun, bounced.prev_pdf,
+                                lambda smooth: pdf_sun[smooth], self._limits(bounced.straight),
+                                None if group is None else self._group(lambda: np.full(len(bounced), group)))
+                if out.split is not None:
+                    out.split.add_found(bounced.path, e)
 
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
@@ -438,6 +456,8 @@ class Integrator:
         if "Emit" in out.aux:
             first = surf.straight[glowing]
             out.aux["Emit"][surf.path[glowing[first]]] += e[first]
+        if out.split is not None:
+            out.split.add_found(surf.path[glowing], e)
 
     def _first_hit_passes(self, surf: SurfaceHits, cam, t, out: WaveOutput):
         aux = out.aux
@@ -500,8 +520,10 @@ class Integrator:
                             out.aov_reach[group.path])
 
     def _colors(self, group: SurfaceHits, shader, out: WaveOutput):
-        """The diffuse and glossy colour passes of the camera's own hits."""
+        """The diffuse, glossy and transmission colour passes of the camera's own hits."""
         aux = out.aux
+        if "TransCol" in aux:
+            aux["TransCol"][group.path] = shader.transmission_color(group.wo_l[:, 2])
         if "DiffCol" in aux or "GlossCol" in aux:
             diff, gloss = shader.colors(group.wo_l[:, 2])
             if "DiffCol" in aux:
@@ -637,31 +659,42 @@ class Integrator:
             self.diffuse if continues else 0, continues, geo.tables,
             group.prim, hits.u[group.row], hits.v[group.row], lifted, *light.arrays(),
             geo.handle, geo.center, geo.shadow_mask, geo.time_values(group.time if self.timed else None),
-            wave.radiance, NO_GROUPS if wave.grouped is None else wave.grouped, f_diff, visibility, cuts, clear,
-            allowed, qf, qi)
+            wave.radiance, NO_GROUPS if wave.grouped is None else wave.grouped,
+            *((NO_SPLIT, NO_WEIGHTS, NO_BOUNCES) if wave.split is None else wave.split.arrays()),
+            f_diff, visibility, cuts, clear, allowed, qf, qi)
         self._count("shadow", traced)
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility, cuts)
         return stopped(qf, qi, m, group.bounces)
 
     # -- continuation through one lobe -------------------------------------------------
-    def _continue(self, shader, hits: SurfaceHits, u: StepSamples, state: PathState) -> PathState | None:
+    def _continue(self, shader, hits: SurfaceHits, u: StepSamples, state: PathState,
+                  split: WaveSplit | None = None) -> PathState | None:
         """The paths of these hits (rows ``hits.row`` of ``state``) continued through one sampled
-        lobe (None if none goes on; core.integrator.continuation)."""
+        lobe (None if none goes on; core.integrator.continuation); with light passes (``split``),
+        the paths' weights set at their first bounce and their bounces counted."""
         n = len(hits)
         go, passthrough, transmit, diffuse = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
         origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
         bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
         next_bounces = np.empty_like(bounces)
+        first = np.zeros(0, bool) if split is None else split.bounces[hits.path] == 0
+        shares = np.empty((n if split is not None else 0, 4, 3))
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m), _smooth(hits), _c(hits.dn),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
                        _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, self.diffuse, _c(u.roulette),
-                       self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse)
+                       self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse,
+                       first, shares)
         sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
         passthrough, transmit, diffuse = passthrough[sel], transmit[sel], diffuse[sel]
+        if split is not None:  # a bounce (not a pass-through) counts; the first sets the weights
+            bounced = sel[~passthrough]
+            set_now = bounced[first[bounced]]
+            split.weights[hits.path[set_now]] = shares[set_now]
+            split.bounces[hits.path[bounced]] += 1
         self._count("diffuse", diffuse.sum())
         self._count("refraction", (transmit & ~passthrough & ~diffuse).sum())
         self._count("reflection", (~transmit & ~diffuse).sum())

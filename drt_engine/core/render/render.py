@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -20,11 +20,12 @@ from ..film.film import Film
 from ..integrator.aovs import AOV_TRANSPARENCY
 from ..integrator.bounces import LIMIT_TRANSPARENCY
 from ..integrator.integrator import Integrator
+from ..integrator.lightpasses import RATIO_LEFT_OUT, SHADOWS_LEFT_OUT
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
-from ..settings import RenderSettings, pass_of
+from ..settings import RenderSettings, pass_of, read_over
 from ..validate import validate_camera
 from . import adaptive
 from .denoise import Schedule, denoise_film, denoised_passes, figures
@@ -76,6 +77,9 @@ class Renderer:
             raise SettingsError("denoising is on but no OpenImageDenoise library was found")
         if settings.use_denoising:  # the features guide the denoiser (a part's, the merge's): traced even
             settings = with_features(settings)  # when not asked for as passes
+        self._read_over = read_over(settings.passes)  # light passes' colours, summed (parts keep them), not returned
+        if self._read_over:
+            settings = replace(settings, passes=tuple(settings.passes) + self._read_over)
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
         self.geometry, self.lights, self.shaders = prepared.geometry, prepared.lights, prepared.shaders
         self.sampler = Sampler(settings.sampling_pattern, settings.samples, settings.seed)
@@ -98,13 +102,18 @@ class Renderer:
 
     def _setting_warnings(self) -> list[str]:
         """What these settings make DRT approximate in this scene: shader AOVs behind transparency
-        (core.integrator.aovs), paths a bounce limit ends before transparency (core.integrator.bounces)."""
+        (core.integrator.aovs), paths a bounce limit ends before transparency (core.integrator.bounces),
+        light passes without transparent shadows' or the ratio estimator's share (core.integrator.lightpasses)."""
         transparent = any(c.kind == "TRANSPARENT" for m in self.scene.materials for c in m.closures)
         warnings = []
         if self.integrator.aovs is not None and transparent:
             warnings.append(AOV_TRANSPARENCY)
         if self.integrator.limited and transparent:
             warnings.append(LIMIT_TRANSPARENCY)
+        if self.integrator.light_passes and self.integrator.shadows is not None:
+            warnings.append(SHADOWS_LEFT_OUT)
+        if self.integrator.light_passes and self.integrator.ratio:
+            warnings.append(RATIO_LEFT_OUT)
         return warnings
 
     def render(self, progress=None) -> RenderResult:
@@ -187,7 +196,7 @@ class Renderer:
                  "adaptive_threshold": outcome.threshold if s.use_adaptive_sampling else None,
                  "adaptive_first_test": outcome.first if s.use_adaptive_sampling else None,
                  "plan": self.plan.as_dict(), "plan_summary": self.plan.summary()}
-        passes = film.images()
+        passes = {name: image for name, image in film.images().items() if name not in self._read_over}
         warnings = list(self.warnings)
         if s.use_denoising and s.partial:  # the part's film keeps the features for the merge
             passes = {name: image for name, image in passes.items() if pass_of(name) in s.passes}
