@@ -40,20 +40,6 @@ def _diffuse(name, color, roughness=0.5, metallic=0.0):
     return mat
 
 
-def _light(scene, name, kind, energy, color, location, group, size=0.0):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    light.data.color = color
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = size
-    ps.aim(light, location)
-    light.lightgroup = group
-    scene.collection.objects.link(light)
-    return light
-
-
 def groups_scene():
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -7.0, 4.0))
@@ -72,8 +58,8 @@ def groups_scene():
     glow = ps.add_primitive(bpy.ops.mesh.primitive_cube_add, _emission("Glow", (1.0, 0.8, 0.2), 4.0), "Glow",
                             size=0.6, location=(-1.6, -0.5, 0.3))
     glow.lightgroup = "glow"
-    _light(scene, "Warm", "AREA", 300.0, (1.0, 0.3, 0.1), (3.0, -2.0, 4.0), "warm", size=1.5)
-    _light(scene, "Cool", "POINT", 400.0, (0.1, 0.4, 1.0), (-3.0, 1.0, 3.5), "cool", size=0.3)
+    ps.add_light(scene, "Warm", "AREA", 300.0, (3.0, -2.0, 4.0), size=1.5, color=(1.0, 0.3, 0.1)).lightgroup = "warm"
+    ps.add_light(scene, "Cool", "POINT", 400.0, (-3.0, 1.0, 3.5), color=(0.1, 0.4, 1.0), radius=0.3).lightgroup = "cool"
     return scene
 
 

@@ -37,18 +37,6 @@ def _principled(name, color, roughness, metallic=0.0, transmission=0.0):
     return mat
 
 
-def _light(scene, name, kind, energy, color, location, size):
-    light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
-    light.data.energy = energy
-    light.data.color = color
-    if kind == "AREA":
-        light.data.size = size
-    else:
-        light.data.shadow_soft_size = size
-    ps.aim(light, location)
-    scene.collection.objects.link(light)
-
-
 def passes_scene(diffuse_bounces):
     scene = ps._scene(WIDTH, HEIGHT)
     ps.aim(scene.camera, (0.0, -7.0, 4.0))
@@ -67,8 +55,8 @@ def passes_scene(diffuse_bounces):
                                                                        transmission=1.0), "Glass",
                      radius=0.9, location=(-1.3, 0.0, 0.9), segments=48, ring_count=24)
     bpy.ops.object.shade_smooth()
-    _light(scene, "Key", "AREA", 300.0, (1.0, 0.8, 0.6), (3.0, -2.0, 4.0), 1.5)
-    _light(scene, "Fill", "POINT", 300.0, (0.5, 0.7, 1.0), (-3.0, 1.0, 3.5), 0.3)
+    ps.add_light(scene, "Key", "AREA", 300.0, (3.0, -2.0, 4.0), size=1.5, color=(1.0, 0.8, 0.6))
+    ps.add_light(scene, "Fill", "POINT", 300.0, (-3.0, 1.0, 3.5), color=(0.5, 0.7, 1.0), radius=0.3)
     return scene
 
 
@@ -138,7 +126,7 @@ def test_emit_holds_the_lights_the_camera_sees(drt, tmp_path):
     ps.black_world(scene)
     ps.add_primitive(bpy.ops.mesh.primitive_plane_add, _principled("Ground", (0.5, 0.5, 0.5), 0.5), "Ground",
                      size=20.0)
-    _light(scene, "Panel", "AREA", 200.0, (1.0, 0.8, 0.6), (0.0, 2.0, 1.0), 1.5)
+    ps.add_light(scene, "Panel", "AREA", 200.0, (0.0, 2.0, 1.0), size=1.5, color=(1.0, 0.8, 0.6))
     bpy.data.objects["Panel"].visible_camera = True  # a light made by bpy.data starts hidden from the camera
     drt_emit, cycles0, cycles1 = [rh.render(scene, engine, 16, seed, tmp_path, passes=("Emit",), name="emit")
                                   .passes["Emit"] for engine, seed in ps.RUNS]

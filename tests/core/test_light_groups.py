@@ -6,10 +6,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from drt_engine.core.render.render import Renderer
+from drt_engine.core.render import merge
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings, lightgroup_pass
-from tests.support.scenes import plane, top_camera, translation, uv_sphere
+from tests.support import split_render
+from tests.support.scenes import plane, render_passes, top_camera, translation, uv_sphere
 
 GROUPS = ["key", "fill", "glow"]
 PASSES = ("Combined",) + tuple(lightgroup_pass(g) for g in GROUPS)
@@ -38,8 +39,7 @@ def scene(key=0, fill=1, glow=2, world=2) -> SceneData:
 
 
 def render(data, passes=PASSES, **settings):
-    s = RenderSettings(**{"samples": 8, "threads": 1, "max_depth": 4, "passes": passes, **settings})
-    return Renderer(data, s).render().passes
+    return render_passes(data, passes, **settings)
 
 
 @pytest.mark.parametrize("settings", [{}, {"diffuse_bounces": 2}, {"sample_clamp_direct": 0.5,
@@ -76,23 +76,13 @@ def test_group_passes_leave_combined_as_it_was():
 
 def test_group_passes_travel_through_parts_and_merge(tmp_path):
     """A split render's parts carry the group passes; merged, they are the whole render's."""
-    from drt_engine.core.film import parts
-    from drt_engine.core.render import merge, report
-
     def part(start, end):
-        data = scene()
         settings = RenderSettings(samples=8, threads=1, max_depth=4, passes=PASSES, sample_start=start,
                                   sample_end=end)
-        renderer = Renderer(data, settings)
-        result = renderer.render()
-        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data),
-                  "report": report.report_dict(settings, result.stats, result.log, report.scene_summary(data))}
-        return parts.from_film(renderer.film, settings, header), result
+        return split_render.render_part(scene(), settings)
 
     _, whole = part(0, 0)
-    for i, (a, b) in enumerate(((0, 3), (3, 8))):
-        parts.write(tmp_path / f"{i}.exr", part(a, b)[0])
-    merged = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).film.images()
+    merged = split_render.merged([part(a, b)[0] for a, b in ((0, 3), (3, 8))], tmp_path).film.images()
     for group in GROUPS:
         name = lightgroup_pass(group)
         np.testing.assert_allclose(merged[name], whole.passes[name], rtol=1e-5, atol=1e-7)

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from drt_engine.core.film.film import divide_even_color
-from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import LIGHT_PASSES, RenderSettings
-from tests.support.scenes import plane, top_camera, translation, uv_sphere
+from tests.support import split_render
+from tests.support.scenes import plane, render_passes, top_camera, translation, uv_sphere
 
 LIGHT = tuple(LIGHT_PASSES)
 PASSES = ("Combined", "Emit", "Env", "DiffCol", "GlossCol", "TransCol") + LIGHT
@@ -34,8 +34,7 @@ def scene() -> SceneData:
 
 
 def render(data, passes=PASSES, **settings):
-    s = RenderSettings(**{"samples": 8, "threads": 1, "max_depth": 4, "passes": passes, **settings})
-    return Renderer(data, s).render().passes
+    return render_passes(data, passes, **settings)
 
 
 @pytest.mark.parametrize("settings", [{}, {"diffuse_bounces": 2}, {"sample_clamp_direct": 0.5,
@@ -80,22 +79,12 @@ def test_divide_even_color_is_cycles():
 def test_a_light_pass_alone_travels_through_parts_and_merge(tmp_path):
     """A split render's parts keep the colour a light pass is divided by; merged, the pass is the whole
     render's and the colour is not among the merged passes."""
-    from drt_engine.core.film import parts
-    from drt_engine.core.render import merge, report
-
     def part(start, end):
-        data = scene()
         settings = RenderSettings(samples=8, threads=1, max_depth=4, passes=("Combined", "DiffInd"),
                                   sample_start=start, sample_end=end)
-        renderer = Renderer(data, settings)
-        result = renderer.render()
-        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data),
-                  "report": report.report_dict(settings, result.stats, result.log, report.scene_summary(data))}
-        return parts.from_film(renderer.film, settings, header), result
+        return split_render.render_part(scene(), settings)
 
     _, whole = part(0, 0)
-    for i, (a, b) in enumerate(((0, 3), (3, 8))):
-        parts.write(tmp_path / f"{i}.exr", part(a, b)[0])
-    merged = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).images()
+    merged = split_render.merged([part(a, b)[0] for a, b in ((0, 3), (3, 8))], tmp_path).images()
     assert set(merged) == {"Combined", "DiffInd"}
     np.testing.assert_allclose(merged["DiffInd"], whole.passes["DiffInd"], rtol=1e-5, atol=1e-7)

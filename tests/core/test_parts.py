@@ -4,14 +4,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from drt_engine.core.render import merge, report
+from drt_engine.core.render import report
 from drt_engine.core.film import parts
 from drt_engine.core.render.adaptive import image_error
 from drt_engine.core.errors import SettingsError
 from drt_engine.core.film.ratio_sums import RATIO
-from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import PASSES, RenderSettings
 from test_determinism import scene
+from tests.support import split_render
 
 SAMPLES = 12
 RELATIVE = 1e-6
@@ -23,13 +23,7 @@ def result_settings(pattern, start=0, end=0, seed=3, estimator="MONTE_CARLO"):
 
 
 def render_part(pattern, start=0, end=0, seed=3, estimator="MONTE_CARLO"):
-    settings = result_settings(pattern, start, end, seed, estimator)
-    data = scene()
-    renderer = Renderer(data, settings)
-    result = renderer.render()
-    summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(data))
-    header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data), "report": summary}
-    return parts.from_film(renderer.film, settings, header), result
+    return split_render.render_part(scene(), result_settings(pattern, start, end, seed, estimator))
 
 
 def close(a, b, scale=None):
@@ -45,9 +39,7 @@ def test_merged_ranges_equal_the_whole_render(pattern, estimator, tmp_path):
     whole, result = render_part(pattern, estimator=estimator)
     assert (RATIO in whole.sums) == (estimator == "RATIO")  # the ratio estimator's sums travel too
     pieces = [render_part(pattern, a, b, estimator=estimator)[0] for a, b in ((5, 12), (0, 2), (2, 5))]
-    for i, piece in enumerate(pieces):  # through the file: the float64 sums are stored losslessly
-        parts.write(tmp_path / f"{i}.exr", piece)
-    merger = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(3)], ["A", "B", "C"])
+    merger = split_render.merged(pieces, tmp_path)  # through the files: float64 sums, losslessly
     film = merger.film
     assert np.array_equal(film.count, whole.count) and np.array_equal(film.count_a, whole.count_a)
     assert close(film.sum_a, whole.sum_a)

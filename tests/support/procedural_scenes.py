@@ -259,17 +259,19 @@ def smooth_sphere(name, x, material) -> None:
     bpy.ops.object.shade_smooth()
 
 
-def add_light(scene, name, kind, energy, location, size=0.0):
-    """A light of ``kind`` aimed at the origin from ``location``: an area light ``size`` across, any
-    other a point source (radius 0)."""
+def add_light(scene, name, kind, energy, location, size=0.0, color=(1.0, 1.0, 1.0), radius=0.0):
+    """A light of ``kind`` and ``color`` aimed at the origin from ``location``: an area light ``size``
+    across, any other of ``radius`` (0: a point source); the light's object."""
     light = bpy.data.objects.new(name, bpy.data.lights.new(name, kind))
     light.data.energy = energy
+    light.data.color = color
     if kind == "AREA":
         light.data.size = size
     else:
-        light.data.shadow_soft_size = 0.0
+        light.data.shadow_soft_size = radius
     aim(light, location)
     scene.collection.objects.link(light)
+    return light
 
 
 def assert_parity(scene, samples, out, name):

@@ -1,7 +1,9 @@
 """Small scenes written by hand for core tests (no Blender)."""
 import numpy as np
 
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Camera, Closure, Instance, Light, Material, Mesh, SceneData
+from drt_engine.core.settings import RenderSettings
 
 
 def translation(x=0.0, y=0.0, z=0.0):
@@ -110,3 +112,10 @@ def defocused_checker_scene(width=64):
     scene = SceneData(camera, [Mesh("checker", vertices, tris, shades)], [Instance(0, np.eye(4))], mats, [])
     scene.world.radiance = np.full(3, 1.0)
     return scene, dict(max_depth=4, filter_type="BLACKMAN_HARRIS", filter_size=1.5, threads=0)
+
+
+def render_passes(data, passes, **settings):
+    """The passes of ``data`` rendered with 8 samples on one thread to depth 4, unless ``settings`` say
+    otherwise."""
+    s = RenderSettings(**{"samples": 8, "threads": 1, "max_depth": 4, "passes": passes, **settings})
+    return Renderer(data, s).render().passes
