@@ -222,7 +222,8 @@ def test_farm_parts_merge_into_the_single_render(drt, tmp_path):
     scene.render.engine = "DRT"
     rh.configure_drt(scene, SAMPLES, 0)
     settings = scene.render.image_settings
-    settings.media_type = "MULTI_LAYER_IMAGE"
+    if hasattr(settings, "media_type"):  # Blender 5.0+
+        settings.media_type = "MULTI_LAYER_IMAGE"
     settings.file_format = "OPEN_EXR_MULTILAYER"
     scene.render.filepath, scene.render.use_file_extension = str(tmp_path / "frame_####"), True
     pieces = []

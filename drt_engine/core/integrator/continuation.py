@@ -93,22 +93,23 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
 @kernel(inline="always")
 def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, bits, sx, sy, sz, model, dx, dy,
                 dz, shares):
-    """``shares[j]``: the diffuse and glossy weights of a path continued toward local (x, y, z) (on
-    the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the diffuse lobes'
-    normal (dx, dy, dz)).
-    Rows 0-1, for what the path brings from further on (Indirect): the shares of the whole mixture's
+    """``shares[j]``: the diffuse, glossy and transmission weights of a path continued toward local
+    (x, y, z) (on the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the
+    diffuse lobes' normal (dx, dy, dz)).
+    Rows 0-2, for what the path brings from further on (Indirect): the shares of the whole mixture's
     BSDF there, the diffuse lobes no ray continues through (no diffuse bounce left) included, as
-    Cycles' bsdf_eval of a sampled direction sums every closure (closure MIS). Rows 2-3, for the
+    Cycles' bsdf_eval of a sampled direction sums every closure (closure MIS). Rows 3-5, for the
     emission this ray finds (Direct): the shares of the lobes it continues through, the BSDF its MIS
     weighs against light sampling (the other diffuse lobes' direct light is light sampling's alone,
-    core.integrator.direct): Cycles' Direct passes hold each kind's own direct light."""
-    for i in range(4):
+    core.integrator.direct): Cycles' Direct passes hold each kind's own direct light. Each share is
+    its own parts' evaluation, exactly 0 for a kind the BSDF has none of there (not what the others
+    leave of 1: that rounding would fill a pass nothing lights)."""
+    for i in range(6):
         for c in range(3):
             shares[j, i, c] = 0.0
     if delta:  # a mirror or glass's sharp reflection is glossy, its refraction transmission
-        if not crosses:
-            for c in range(3):
-                shares[j, 1, c] = shares[j, 3, c] = 1.0
+        for c in range(3):
+            shares[j, 2 if crosses else 1, c] = shares[j, 5 if crosses else 4, c] = 1.0
         return
     f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits, 0,
                    sx, sy, sz, model, dx, dy, dz)
@@ -116,13 +117,14 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
                     UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
     for c in range(3):
         shares[j, 0, c] = share(fd[c] + fd[3 + c], f[c] + f[3 + c])
-        shares[j, 2, c] = share(fd[3 + c], f[3 + c])
-    if above:
-        fg = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
-                        UNLIT_DIFFUSE | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
-        for c in range(3):
-            shares[j, 1, c] = share(fg[3 + c], f[c] + f[3 + c])
-            shares[j, 3, c] = share(fg[3 + c], f[3 + c])
+        shares[j, 3, c] = share(fd[3 + c], f[3 + c])
+    # the other lobes' reflection is glossy, their transmission transmission
+    kind = 1 if above else 2
+    fo = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+                    UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION), sx, sy, sz, model, dx, dy, dz)
+    for c in range(3):
+        shares[j, kind, c] = share(fo[3 + c], f[c] + f[3 + c])
+        shares[j, 3 + kind, c] = share(fo[3 + c], f[3 + c])
 
 
 @kernel(inline="always")

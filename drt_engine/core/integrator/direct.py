@@ -162,7 +162,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             c2 = throughput[j, 2] * v2 * (d2 + n2 * w)
             if not _positive(c0, c1, c2):
                 continue
-            e0 = e1 = e2 = h0 = h1 = h2 = 0.0  # the diffuse and glossy parts, at a first hit
+            e0 = e1 = e2 = h0 = h1 = h2 = 0.0  # the diffuse and the other parts, at a first hit
             if first:
                 unlit = unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS))
                 fd = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
@@ -171,12 +171,14 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
                 e0 = throughput[j, 0] * v0 * (fd[0] + fd[3] * w)
                 e1 = throughput[j, 1] * v1 * (fd[1] + fd[4] * w)
                 e2 = throughput[j, 2] * v2 * (fd[2] + fd[5] * w)
-                if above:  # the other lobes' reflection (glass's on its reflected side) is glossy
-                    fg = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                    inside[j], sel, bits, unlit | UNLIT_DIFFUSE | UNLIT_TRANSMISSION, sx, sy, sz,
-                                    model, dn[j, 0], dn[j, 1], dn[j, 2])
-                    h0, h1, h2 = throughput[j, 0] * v0 * fg[3] * w, throughput[j, 1] * v1 * fg[4] * w, \
-                        throughput[j, 2] * v2 * fg[5] * w
+                # the other lobes' reflection (glass's on its reflected side) is glossy, their transmission
+                # transmission: each its own evaluation, exactly 0 where the BSDF has none
+                fo = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
+                                inside[j], sel, bits,
+                                unlit | UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION), sx, sy,
+                                sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
+                h0, h1, h2 = throughput[j, 0] * v0 * fo[3] * w, throughput[j, 1] * v1 * fo[4] * w, \
+                    throughput[j, 2] * v2 * fo[5] * w
             ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, cd,
                                        hx, hy, hz, scale[j])
             tmax = math.inf
@@ -217,9 +219,12 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
                     grouped[path[j], g, 0] += c0
                     grouped[path[j], g, 1] += c1
                     grouped[path[j], g, 2] += c2
-                if first:
-                    add_split(split, path[j], c0, c1, c2, e0 * cut, e1 * cut, e2 * cut, h0 * cut, h1 * cut, h2 * cut,
-                              0)
+                if first and above:
+                    add_split(split, path[j], e0 * cut, e1 * cut, e2 * cut, h0 * cut, h1 * cut, h2 * cut, 0.0, 0.0,
+                              0.0, 0)
+                elif first:
+                    add_split(split, path[j], e0 * cut, e1 * cut, e2 * cut, 0.0, 0.0, 0.0, h0 * cut, h1 * cut,
+                              h2 * cut, 0)
                 elif splitting:
                     add_weighted(split, weights, path[j], c0, c1, c2)
         p = path[j]

@@ -679,7 +679,7 @@ class Integrator:
         bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
         next_bounces = np.empty_like(bounces)
         first = np.zeros(0, bool) if split is None else split.bounces[hits.path] == 0
-        shares = np.empty((n if split is not None else 0, 4, 3))
+        shares = np.empty((n if split is not None else 0, 6, 3))
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m), _smooth(hits), _c(hits.dn),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),

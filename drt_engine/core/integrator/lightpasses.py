@@ -11,8 +11,8 @@ everything later. What the camera sees itself (Emit, Env) is in none of them. Ea
 the clamp, as Combined; the film reads each out divided by its colour pass (core.film.film).
 
 The wave carries ``split`` (paths, 6, 3: kind x direct / indirect, ``COLUMNS``), per path its
-``weights`` (paths, 4, 3: diffuse and glossy share after the first bounce, of the whole mixture for
-Indirect, then of the lobes the ray continued through for the emission it finds, Direct:
+``weights`` (paths, 6, 3: diffuse, glossy and transmission share after the first bounce, of the whole
+mixture for Indirect, then of the lobes the ray continued through for the emission it finds, Direct:
 core.integrator.continuation.pass_shares) and ``bounces`` (its non-transparent bounces so far).
 A render with none of these passes carries nothing of this.
 """
@@ -32,7 +32,7 @@ RATIO_LEFT_OUT = "light passes: the Ratio shadow estimator's correction is in Co
 COLUMNS = ("DiffDir", "DiffInd", "GlossDir", "GlossInd", "TransDir", "TransInd")
 """The ``split`` columns: kind (diffuse, glossy, transmission) by direct (even) and indirect (odd)."""
 NO_SPLIT = np.zeros((0, 6, 3))
-NO_WEIGHTS = np.zeros((0, 4, 3))
+NO_WEIGHTS = np.zeros((0, 6, 3))
 NO_BOUNCES = np.zeros(0, np.int64)
 """The kernels' arrays when no light pass is asked for."""
 
@@ -47,7 +47,7 @@ class WaveSplit:
 
     def __init__(self, n: int):
         self.split = np.zeros((n, 6, 3))
-        self.weights = np.zeros((n, 4, 3))
+        self.weights = np.zeros((n, 6, 3))
         self.bounces = np.zeros(n, np.int64)
 
     def arrays(self) -> tuple:
@@ -63,10 +63,9 @@ class WaveSplit:
         if len(rows) == 0:
             return
         p, e, indirect = path[rows], e[rows], (b[rows] > 1).astype(np.int64)
-        w = self.weights[p[:, None], 2 * (1 - indirect)[:, None] + np.arange(2)]
-        rest = e * (1.0 - w[:, 0] - w[:, 1])
-        for kind, part in enumerate((e * w[:, 0], e * w[:, 1], rest)):
-            np.add.at(self.split, (p, 2 * kind + indirect), part)
+        w = self.weights[p[:, None], 3 * (1 - indirect)[:, None] + np.arange(3)]
+        for kind in range(3):
+            np.add.at(self.split, (p, 2 * kind + indirect), e * w[:, kind])
 
     def passes(self, aux: dict):
         """The asked light passes of ``aux`` filled from ``split``."""
@@ -76,25 +75,26 @@ class WaveSplit:
 
 
 @kernel(inline="always")
-def add_split(split, p, c0, c1, c2, d0, d1, d2, g0, g1, g2, indirect):
-    """Contribution (c0, c1, c2) of path p, of which (d*) is diffuse and (g*) glossy, the rest
-    transmission, into ``split``'s direct or ``indirect`` columns."""
+def add_split(split, p, d0, d1, d2, g0, g1, g2, t0, t1, t2, indirect):
+    """A contribution of path p, (d*) diffuse, (g*) glossy and (t*) transmission, into ``split``'s
+    direct or ``indirect`` columns."""
     split[p, indirect, 0] += d0
     split[p, indirect, 1] += d1
     split[p, indirect, 2] += d2
     split[p, 2 + indirect, 0] += g0
     split[p, 2 + indirect, 1] += g1
     split[p, 2 + indirect, 2] += g2
-    split[p, 4 + indirect, 0] += c0 - d0 - g0
-    split[p, 4 + indirect, 1] += c1 - d1 - g1
-    split[p, 4 + indirect, 2] += c2 - d2 - g2
+    split[p, 4 + indirect, 0] += t0
+    split[p, 4 + indirect, 1] += t1
+    split[p, 4 + indirect, 2] += t2
 
 
 @kernel(inline="always")
 def add_weighted(split, weights, p, c0, c1, c2):
     """Contribution (c0, c1, c2) of path p after its first bounce, split by its weights, Indirect."""
-    add_split(split, p, c0, c1, c2, c0 * weights[p, 0, 0], c1 * weights[p, 0, 1], c2 * weights[p, 0, 2],
-              c0 * weights[p, 1, 0], c1 * weights[p, 1, 1], c2 * weights[p, 1, 2], 1)
+    add_split(split, p, c0 * weights[p, 0, 0], c1 * weights[p, 0, 1], c2 * weights[p, 0, 2],
+              c0 * weights[p, 1, 0], c1 * weights[p, 1, 1], c2 * weights[p, 1, 2],
+              c0 * weights[p, 2, 0], c1 * weights[p, 2, 1], c2 * weights[p, 2, 2], 1)
 
 
 @kernel(inline="always")
