@@ -17,6 +17,7 @@ from drt_engine.core.render.denoise import DENOISED_SHARE, Schedule, denoised_er
 from drt_engine.core.render.driver import TARGET_MIN_SAMPLES
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import NOISY_IMAGE, RenderSettings
+from tests.support import split_render
 from tests.support.oidn import require_oidn
 from tests.support.scenes import defocused_checker_scene, soft_shadow_scene
 
@@ -208,18 +209,14 @@ def test_merged_parts_are_denoised_once_as_the_whole_render_is(oidn, monkeypatch
     however often its images are asked for) and gives the whole render's denoised image and estimate."""
     from drt_engine.core.film import parts
     from drt_engine.core.film.denoising import PASSES as FEATURE_PASSES
-    from drt_engine.core.render import merge, report
+    from drt_engine.core.render import merge
 
     scene, base = soft_shadow_scene(WIDTH)
 
     def run(start=0, end=0):
         settings = RenderSettings(**{**base, "samples": SPP, "seed": 1, "passes": ("Combined",),
                                      "use_denoising": True, "sample_start": start, "sample_end": end})
-        renderer = Renderer(scene, settings, denoiser=oidn)
-        result = renderer.render()
-        summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(scene))
-        header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(scene), "report": summary}
-        return parts.from_film(renderer.film, settings, header), result
+        return split_render.render_part(scene, settings, oidn)
 
     whole = run()[1]
     pieces = [run(a, b)[0] for a, b in ((3, SPP), (0, 3))]

@@ -5,9 +5,10 @@ from drt_engine.core.render import merge, report
 from drt_engine.core.render.render import Renderer
 
 
-def render_part(data, settings):
-    """(the part, the render's result) of ``data`` rendered with ``settings`` (its sample range)."""
-    renderer = Renderer(data, settings)
+def render_part(data, settings, denoiser=None):
+    """(the part, the render's result) of ``data`` rendered with ``settings`` (its sample range) and
+    ``denoiser``."""
+    renderer = Renderer(data, settings, denoiser=denoiser)
     result = renderer.render()
     summary = report.report_dict(settings, result.stats, result.log, report.scene_summary(data))
     header = {"frame": 1, "view_layer": "ViewLayer", "fingerprint": parts.fingerprint(data), "report": summary}
