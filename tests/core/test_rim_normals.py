@@ -60,12 +60,13 @@ def test_a_mixture_lights_its_diffuse_lobe_about_the_smooth_normal_wo_lies_below
     assert np.allclose(value, 0.5 * ALBEDO * SUN / np.pi * (NORMAL @ TO_SUN), rtol=1e-4)
 
 
-def _hits(dirs):
-    scene = _tilted_plane(Material("glossy", [Closure("GLOSSY", roughness=0.2)]))
+def _hits(dirs, correction=True):
+    scene = _tilted_plane(Material("glossy", [Closure("GLOSSY", roughness=0.2)], bump_correction=correction))
     geo = Geometry(scene, np.zeros(3))
     n = len(dirs)
     prim, u, v = np.zeros(n, np.int64), np.full(n, 0.25), np.full(n, 0.25)
-    return surface_records(geo, prim, u, v, None, np.arange(n), dirs, mat=np.zeros(n, np.int64),
+    raises = np.array([m.bump_correction for m in scene.materials] + [True])
+    return surface_records(geo, prim, u, v, None, np.arange(n), dirs, raises, mat=np.zeros(n, np.int64),
                            path=np.arange(n), throughput=np.ones((n, 3)), straight=np.ones(n, bool),
                            time=np.full(n, 0.5))
 
@@ -106,6 +107,17 @@ def test_wo_above_the_smooth_normal_whose_mirror_image_leaves_below_raises_it_to
     raised = valid_specular_reflection(np.tile([0.0, 0.0, 1.0], (2, 1)), np.tile(wo, (2, 1)), np.tile(NORMAL, (2, 1)))
     assert np.allclose(hits.frame.n, raised, atol=1e-12) and not np.allclose(raised, NORMAL, atol=1e-3)
     assert np.allclose(hits.ns, NORMAL, atol=1e-12) and np.allclose(hits.frame.to_world(hits.dn), NORMAL, atol=1e-12)
+
+
+def test_bump_map_correction_off_keeps_the_normal_for_every_lobe():
+    """A material whose Bump Map Correction is off: Cycles' maybe_ensure_valid_specular_reflection
+    returns the normal as it is, so the frame is the mesh's normal for every lobe, where wo's
+    mirror image about it leaves below the surface too (a Principled cylinder's cap: raised there
+    anyway, DRT was up to 0.05 off Cycles with the setting off, tests/blender/test_smooth_rims_cycles.py)."""
+    wo = np.array([0.0, 0.3, np.sqrt(1.0 - 0.09)])
+    hits = _hits(np.tile(-wo, (2, 1)), correction=False)
+    assert np.allclose(hits.frame.n, NORMAL, atol=1e-7)
+    assert np.array_equal(hits.ns, hits.frame.n) and np.array_equal(hits.dn, np.tile([0.0, 0.0, 1.0], (2, 1)))
 
 
 def test_raising_keeps_a_normal_whose_mirror_image_leaves_above():

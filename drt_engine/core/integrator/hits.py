@@ -13,24 +13,25 @@ from ..geometry.accel import hit_surface, offset_scale
 from .records import SurfaceHits
 
 
-def surface_records(geometry, prim, u, v, ray_times, rows, dirs, **carried) -> SurfaceHits:
+def surface_records(geometry, prim, u, v, ray_times, rows, dirs, raises, **carried) -> SurfaceHits:
     """The hits ``rows`` of a step's rays (``prim``, ``u``, ``v``, ``dirs`` per ray; ``ray_times``
     their shutter times, None when nothing moves) as a record (``surface_hits``), with the fields
-    the paths carry to them (path, mat, throughput, straight, time, bounces) as given."""
+    the paths carry to them (path, mat, throughput, straight, time, bounces) as given; ``raises``
+    per material: its Bump Map Correction is on (Cycles raises its specular normals only then)."""
     n = len(rows)
     pos, ng, wo_l, normal, ns, dn = (np.empty((n, 3)) for _ in range(6))
     frame, inside, scale = np.empty((n, 3, 3)), np.empty(n, bool), np.empty(n)
-    surface_hits(geometry.tables, prim, u, v, geometry.time_values(ray_times), rows, dirs, pos, ng, frame, wo_l,
-                 inside, scale, normal, ns, dn)
+    surface_hits(geometry.tables, prim, u, v, geometry.time_values(ray_times), rows, dirs, raises[carried["mat"]],
+                 pos, ng, frame, wo_l, inside, scale, normal, ns, dn)
     return SurfaceHits(row=rows, prim=prim[rows], pos=pos, ng=ng, frame=Frame(frame), ns=ns, dn=dn, wo=-dirs[rows],
                        wo_l=wo_l, inside=inside, scale=scale, normal=normal, **carried)
 
 
 @kernel
-def surface_hits(geo, prim, u, v, times, rows, dirs, pos, ng, frame, wo_l, inside, scale, normal, ns, dn):
+def surface_hits(geo, prim, u, v, times, rows, dirs, raises, pos, ng, frame, wo_l, inside, scale, normal, ns, dn):
     """For hits ``rows`` of the step's rays (each ray's triangle, barycentrics, shutter time (empty:
-    nothing moves) and direction): world position, geometric normal and the shading frame
-    (tangent, bitangent, normal rows) on the side the ray came from, wo in that frame, whether
+    nothing moves) and direction; per hit, whether its material raises normals): world position,
+    geometric normal and the shading frame (tangent, bitangent, normal rows) on the side the ray came from, wo in that frame, whether
     the ray came from the back, offset scale, the shading normal as the mesh has it, and facing
     the ray (``ns``, Cycles' sd->N), and that normal in the frame (``dn``).
 
@@ -39,7 +40,10 @@ def surface_hits(geo, prim, u, v, times, rows, dirs, pos, ng, frame, wo_l, insid
     image about it would leave below the surface, near a silhouette's rim, wo below the normal or
     not (core.bsdf.specular_normal). The frame is about the raised normal (the geometric normal
     where wo is still below it), and the diffuse lobes take theirs as ``dn``
-    (core.bsdf.diffuse_normal): (0, 0, 1) exactly where nothing was raised.
+    (core.bsdf.diffuse_normal): (0, 0, 1) exactly where nothing was raised. A material whose Bump
+    Map Correction is off keeps the mesh's normal for every lobe, wo below it or not, as Cycles'
+    maybe_ensure_valid_specular_reflection does (its specular lobes then reflect nothing where
+    wo lies below: Cycles' microfacet closures need cos(N, wi) > 0).
     """
     scratch = np.empty((2, 3, 4))
     for i in range(len(rows)):
@@ -50,8 +54,8 @@ def surface_hits(geo, prim, u, v, times, rows, dirs, pos, ng, frame, wo_l, insid
         back = ox * gx + oy * gy + oz * gz < 0
         flip = -1.0 if back else 1.0
         gx, gy, gz, kx, ky, kz = gx * flip, gy * flip, gz * flip, sx * flip, sy * flip, sz * flip
-        nx, ny, nz = raised(gx, gy, gz, ox, oy, oz, kx, ky, kz)
-        if ox * nx + oy * ny + oz * nz <= 1e-6:
+        nx, ny, nz = raised(gx, gy, gz, ox, oy, oz, kx, ky, kz) if raises[i] else (kx, ky, kz)
+        if raises[i] and ox * nx + oy * ny + oz * nz <= 1e-6:
             nx, ny, nz = gx, gy, gz
         turned = nx != kx or ny != ky or nz != kz
         tx, ty, tz, bx, by, bz = basis(nx, ny, nz)

@@ -175,7 +175,8 @@ class Integrator:
         self.shadows = None
         if plan.see_through:
             clear = self.geometry.of_triangles(np.array([see_through(m) for m in scene.materials]))
-            self.shadows = TransparentShadows(self.geometry, clear, self._bind_materials, self._count, self.clamp)
+            self.shadows = TransparentShadows(self.geometry, clear, self.prepared.raises, self._bind_materials, self._count,
+                                              self.clamp)
         # the glossy and transmission limits, where they can end paths before the Total does
         self.limited = binding(settings) and (plan.rays["reflection"] or plan.rays["refraction"]
                                               or plan.rays["diffuse"])
@@ -408,7 +409,7 @@ class Integrator:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame
         facing the ray (core.integrator.hits)."""
         return surface_records(self.geometry, hits.prim, hits.u, hits.v, ray_times, rows, state.dirs,
-                               path=state.path[rows], mat=mat,
+                               self.prepared.raises, path=state.path[rows], mat=mat,
                                throughput=state.throughput[rows],
                                straight=state.straight[rows], time=state.time[rows],
                                bounces=None if state.bounces is None else state.bounces[rows])
@@ -575,7 +576,7 @@ class Integrator:
                 n, kept, wo = group.frame.n, group.ns, group.wo
                 if normal is not None:
                     kept = np.where((vec.dot(normal, group.ng) * vec.dot(wo, group.ng) > 0)[:, None], normal, kept)
-                    n = _raised_above(kept, group.ng, wo)
+                    n = _raised_above(kept, group.ng, wo, shading.material.bump_correction)
                 frame = Frame.about(n) if tangent is None else Frame.along(n, tangent)
                 if smooth is not None:
                     smooth = _smooth_rows(smooth, shading.material)
@@ -742,13 +743,16 @@ def _smooth(hits) -> np.ndarray:
     return _NO_BUMP if hits.smooth is None else _c(hits.smooth)
 
 
-def _raised_above(ns, ng, wo):
+def _raised_above(ns, ng, wo, raises: bool):
     """Program normals ``ns`` raised as Cycles raises a specular closure's where wo's mirror image
     would leave below the surface (ensure_valid_specular_reflection, about ``ng`` facing wo), the
     geometric normal where wo is still below: the frame's normal, for the glossy, glass and coat
     lobes (the diffuse lobes keep ``ns``: Cycles keeps a diffuse closure's bumped normal facing away
     from the viewer; raising it for them lit the rim of a bumped sphere 0.12 brighter than Cycles
-    in its worst block)."""
+    in its worst block). ``ns`` as it is where the material does not ``raise`` (its Bump Map
+    Correction off: core.integrator.hits)."""
+    if not raises:
+        return ns
     ns = valid_specular_reflection(ng, wo, ns)
     return np.where((vec.dot(wo, ns) <= 1e-6)[:, None], ng, ns)
 

@@ -126,11 +126,13 @@ def stopped(qf, qi, m: int, bounces: np.ndarray) -> ShadowRays | None:
 
 class TransparentShadows:
     """Resolves the queued shadow rays of a wave (see the module's docstring): ``geometry`` and
-    ``clear`` (per mesh triangle row), ``bind`` the integrator's shaders per material group,
-    ``clamp`` the (direct, indirect) limits of a contribution (core.integrator.clamp)."""
+    ``clear`` (per mesh triangle row), ``raises`` (per material: Bump Map Correction), ``bind`` the
+    integrator's shaders per material group, ``clamp`` the (direct, indirect) limits of a
+    contribution (core.integrator.clamp)."""
 
-    def __init__(self, geometry, clear: np.ndarray, bind, count, clamp):
-        self.geometry, self.clear, self.bind, self.count, self.clamp = geometry, clear, bind, count, clamp
+    def __init__(self, geometry, clear: np.ndarray, raises: np.ndarray, bind, count, clamp):
+        self.geometry, self.clear, self.raises = geometry, clear, raises
+        self.bind, self.count, self.clamp = bind, count, clamp
 
     def resolve(self, rays: ShadowRays, radiance: np.ndarray, grouped: np.ndarray, timed: bool):
         """Every queued ray taken through its surfaces until it is blocked or gets through (what
@@ -147,7 +149,8 @@ class TransparentShadows:
             bounces = rays.bounces.copy()
             bounces[:, KIND] = 0
             bounces[:, TRANSPARENT_DEPTH] += i[:, 3]
-            surf = surface_records(geo, prim, u, v, f[:, 10] if timed else None, np.arange(n), dirs, path=i[:, 0],
+            surf = surface_records(geo, prim, u, v, f[:, 10] if timed else None, np.arange(n), dirs, self.raises,
+                                   path=i[:, 0],
                                    mat=mat, throughput=f[:, 0:3], straight=np.zeros(n, bool), time=f[:, 10],
                                    bounces=bounces)
             hits = Hits(t=f[:, 13], prim=prim, u=u, v=v)

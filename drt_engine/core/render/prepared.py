@@ -132,6 +132,8 @@ class PreparedScene:
         # per material (and one past the end for none): casts shadow rays, continues (a material
         # with varying inputs may, whatever its fallback)
         self.lit = np.array([bool(sh.lobes) or m.varying for sh, m in zip(self.shaders, self.shading)] + [False])
+        # per material (and one past the end): Cycles raises its specular normals at rims (Bump Map Correction)
+        self.raises = np.array([m.material.bump_correction for m in self.shading] + [True])
         self.continues = np.array([sh.can_continue or m.varying for sh, m in zip(self.shaders, self.shading)]
                                   + [False])
         # what shader programs read at hits: a varying material's, or the AOVs' of any with a program
