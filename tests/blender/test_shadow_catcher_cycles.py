@@ -1,10 +1,16 @@
-"""Shadow catchers against Cycles on a scene built for them: a red cube on a ground plane that is a
-shadow catcher, under an area light, a sun and a blue-grey world. Combined (RGBA) with Film
-Transparent on and off, and the view layer's Shadow Catcher pass, against Cycles' by
+"""Shadow catchers against Cycles on a scene built for them: a red diffuse cube floating over a ground
+plane that is a shadow catcher, under an area light, a sun and a blue-grey world (the cube floats so
+its shadows lie apart from its outline: on a pixel where the cube meets its own shadow the pass
+jumps between 1, no sample split, and the shadow, one sample deciding, in Cycles as in DRT).
+Combined (RGBA) with Film Transparent on and off, with and without the view layer's Shadow Catcher
+pass (without it Combined carries Cycles' approximate shadow), and that pass, against Cycles by
 procedural_scenes.parity's rule: DRT's worst 4x4-block difference from Cycles seed 0 within 1.5x
 Cycles' own seed-0-against-seed-1 worst plus 0.002. Each comparison also renders DRT with the
-catcher flag ignored (the ground then a plain object, the pass all 1) and asserts that image is
-far out. Figures measured: see each test's FIGURES."""
+catcher flag ignored (the ground then a plain object, the pass all 1) and asserts it is far out.
+Measured (64 x 48, 128 samples), worst block / limit (Cycles' seeds), flag ignored:
+Combined, Film Transparent on: 0.0103 / 0.0509 (0.0326), ignored 3.01; off: 0.0093 / 0.0490 (0.0313),
+ignored 2.60 (approximate shadow) and 3.01 (with the pass); the pass, Film Transparent on:
+0.0150 / 0.0244 (0.0149), off: 0.0312 / 0.0880 (0.0574), ignored 0.544."""
 from __future__ import annotations
 
 import bpy

@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 from drt_engine.core.film.shadow_catcher import catcher_ratio, combined_read
+from drt_engine.core.integrator.shadow_catcher import LEFT_OUT, NOT_DENOISED
+from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings
 from tests.support import split_render
@@ -88,3 +90,16 @@ def test_shadow_catcher_travels_through_parts_and_merge(tmp_path, transparent):
         assert set(merged) == set(whole.passes) == set(passes)
         for name in passes:
             np.testing.assert_allclose(merged[name], whole.passes[name], rtol=1e-5, atol=1e-6)
+
+
+def test_what_is_not_matched_is_named():
+    """Denoise on: the image stays as rendered (a denoised Combined would be the whole scene's, not
+    the matte), light passes still count the catcher paths' light: both named in the warnings."""
+    settings = RenderSettings(samples=4, threads=1, max_depth=2, passes=("Combined", "DiffDir"), use_denoising=True)
+    renderer = Renderer(scene(), settings)
+    result = renderer.render()
+    assert NOT_DENOISED in result.warnings and LEFT_OUT in result.warnings
+    assert "Noisy Image" not in result.passes
+    plain = Renderer(replace(scene(), instances=[replace(i, shadow_catcher=False) for i in scene().instances]),
+                     replace(settings, use_denoising=False))
+    assert not any("shadow catcher" in w for w in plain.warnings)

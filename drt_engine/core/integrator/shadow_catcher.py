@@ -26,6 +26,9 @@ LEFT_OUT = ("shadow catcher: the light passes and light groups still count the c
 RATIO_LEFT_OUT = ("shadow catcher: the catcher paths estimate lights' direct light by Monte Carlo, and the "
                   "matte leaves out the ratio estimator's share of what paths bring before a catcher")
 """The warning with shadow catchers and the ratio shadow estimator."""
+NOT_DENOISED = ("shadow catcher: the image is not denoised (DRT denoises the whole scene's Combined, not the "
+                "catchers' matte Cycles' Combined is with them)")
+"""The warning with shadow catchers and Denoise on (the render, and a farm's merge, leave it undenoised)."""
 
 
 def catchers_only(scene):
