@@ -57,6 +57,10 @@ DRT_PASS_TOGGLES = {
 }
 """DRT's own passes, toggled by ``view_layer.drt.<property>``."""
 
+CYCLES_PASS_TOGGLES = {"Shadow Catcher": "use_pass_shadow_catcher"}
+"""Passes whose toggle Cycles' add-on puts on the view layer (``view_layer.cycles``), as Cycles reads
+it; off when that add-on is not there."""
+
 RESULT_NAMES_5 = {"IndexOB": "Object Index", "IndexMA": "Material Index"}
 """Passes Blender 5.0+ names otherwise in its render result (the view-layer toggles create them so)."""
 
@@ -75,6 +79,8 @@ def pass_enabled(view_layer, name: str) -> bool:
         return True
     if name in BLENDER_PASS_TOGGLES:
         return bool(getattr(view_layer, BLENDER_PASS_TOGGLES[name], False))
+    if name in CYCLES_PASS_TOGGLES:
+        return bool(getattr(getattr(view_layer, "cycles", None), CYCLES_PASS_TOGGLES[name], False))
     return bool(getattr(view_layer.drt, DRT_PASS_TOGGLES[name]))
 
 

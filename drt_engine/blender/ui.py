@@ -314,6 +314,8 @@ class DRT_PT_passes(DRTButtonsPanel, bpy.types.Panel):
         col = layout.column(heading="Light", align=True)
         col.prop(view_layer, "use_pass_emit", text="Emission")
         col.prop(view_layer, "use_pass_environment")
+        if hasattr(view_layer, "cycles"):  # Cycles' add-on's toggle, as its Light panel shows it
+            col.prop(view_layer.cycles, "use_pass_shadow_catcher")
         col = layout.column(heading="Sampling", align=True)
         col.prop(view_layer.drt, "use_pass_sample_count")
         col.prop(view_layer.drt, "use_pass_noise")

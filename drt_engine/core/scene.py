@@ -251,6 +251,9 @@ class Instance:
     holdout: bool = False
     """The whole object is a holdout where the camera sees it (Cycles' object holdout); other
     rays see it as it is."""
+    shadow_catcher: bool = False
+    """Cycles' Shadow Catcher: where the camera sees it, its path splits into one through the whole
+    scene and one through the catchers alone (core.integrator.shadow_catcher)."""
     visible_camera: bool = True
     visible_shadow: bool = True
     visible_diffuse: bool = True

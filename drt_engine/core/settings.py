@@ -38,6 +38,7 @@ PASSES = (
     "CryptoObject",  # Cryptomatte of the objects' names, written as CryptoObject00, 01, ... (core.film.cryptomatte)
     "CryptoMaterial",  # of the materials' names
     "CryptoAsset",  # of the objects' top-level parents' names
+    "Shadow Catcher",  # Cycles' Shadow Catcher pass: the catchers' light with the other objects over without them
 )
 PASS_CHANNELS = {
     "Combined": "RGBA",
@@ -64,6 +65,11 @@ PASS_CHANNELS = {
     "TransCol": "RGB",
     "Vector": "XYZW",
     "Noisy Image": "RGBA",
+    "Shadow Catcher": "RGB",  # read from the sums below (core.film.shadow_catcher)
+    "Shadow Catcher Paths": "RGB",
+    "Shadow Catcher Matte": "RGBA",
+    "Shadow Catcher Sample Count": "X",
+    "Shadow Catcher Background": "RGB",
 }
 FIRST_SAMPLE_PASSES = ("IndexOB", "IndexMA")
 """Passes that hold their pixel's first sample (sample id 0, replicate 0) as it is, not a filtered
@@ -82,6 +88,13 @@ def read_over(passes) -> tuple[str, ...]:
     passes = tuple(passes)
     return tuple(dict.fromkeys(LIGHT_PASSES[name] for name in passes
                                if name in LIGHT_PASSES and LIGHT_PASSES[name] not in passes))
+
+
+CATCHER_SUMS = ("Shadow Catcher Paths", "Shadow Catcher Matte", "Shadow Catcher Sample Count",
+                "Shadow Catcher Background")
+"""The film sums a render with shadow catchers keeps beside Combined and Shadow Catcher and returns
+as no pass, as Cycles allocates its matte, sample count and background passes for itself
+(core.film.shadow_catcher)."""
 
 
 WEIGHTED_PASSES = ("Vector",)
@@ -232,7 +245,7 @@ class RenderSettings:
             raise ValueError("samples must be at least 1")
         self.aovs = tuple((str(name), str(kind)) for name, kind in self.aovs)
         self._check_aovs()
-        unknown = {name for name in set(self.passes) - set(PASSES) - {name for name, _ in self.aovs}
+        unknown = {name for name in set(self.passes) - set(PASSES) - set(CATCHER_SUMS) - {name for name, _ in self.aovs}
                    if not name.startswith(LIGHTGROUP_PREFIX)}
         if unknown:
             raise ValueError(f"unknown passes {sorted(unknown)}")

@@ -100,6 +100,7 @@ def test_all_passes_are_written_and_finite(bl, tmp_path):
     view_layer.drt.use_pass_sample_count = True
     view_layer.drt.use_pass_noise = True
     view_layer.drt.use_pass_denoising_data = True
+    view_layer.cycles.use_pass_shadow_catcher = True  # Cycles' own toggle (1 everywhere without catchers)
     channels = bl.render_exr(scene, tmp_path / "all.exr")
     ranks = [rank for name in CRYPTOMATTE_PASSES for rank in cryptomatte_passes(name, view_layer.pass_cryptomatte_depth)]
     assert bl.passes_in(channels, LAYER) == {result_pass_name(name) for name in PASSES

@@ -931,24 +931,25 @@ def test_object_types_drt_does_not_render_are_named_in_one_warning():
     assert len(data.instances) == 3  # the two cubes and the text
 
 
-def test_object_and_light_settings_drt_does_not_read_are_named_in_one_warning():
-    """Shadow catcher changes Cycles' image; until DRT reads it, a scene using it says so (objects
-    named, a long list cut short). Light groups and light linking are read: not named."""
+def test_shadow_catchers_are_exported_and_named_in_no_warning():
+    """Shadow Catcher is read (per instance, an instance taking its instancer's flag or its own, as
+    Cycles' sync_object): no warning names it; light groups and light linking are read too."""
     scene = empty_scene()
-    cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}")) for i in range(6)]
-    for cube in cubes[:5]:
-        cube.is_shadow_catcher = True
-        cube.lightgroup = "key"
-    cubes[3].light_linking.receiver_collection = bpy.data.collections.new("Lit")
+    cubes = [add_object(scene, f"Cube{i}", cube_mesh(f"Cube{i}"), location=(3.0 * i, 0.0, 0.0)) for i in range(3)]
+    cubes[0].is_shadow_catcher = True
+    cubes[0].lightgroup = "key"
+    cubes[1].light_linking.receiver_collection = bpy.data.collections.new("Lit")
+    hidden = bpy.data.collections.new("Instanced")
+    hidden.objects.link(cubes[2])
+    instancer = add_object(scene, "Instancer", None, location=(0.0, 4.0, 0.0))
+    instancer.instance_type, instancer.instance_collection = "COLLECTION", hidden
+    instancer.is_shadow_catcher = True
     data = render_export(scene)
-    (warning,) = data.warnings
-    assert "shadow catcher ('Cube0', 'Cube1', 'Cube2' and 2 more)" in warning, warning
-    assert "Cube5" not in warning and "visibility" not in warning and "holdout" not in warning
-    assert "light group" not in warning and "linking" not in warning
-    for cube in cubes[:5]:
-        cube.is_shadow_catcher = False
-    cubes[3].light_linking.receiver_collection = None
-    assert not render_export(scene).warnings
+    assert not data.warnings, data.warnings
+    caught = sorted((i.name, i.shadow_catcher) for i in data.instances)
+    # Cube2 itself, and its instance, which takes its instancer's flag
+    assert caught == [("Cube0", True), ("Cube1", False), ("Cube2", False), ("Cube2", True)], caught
+    cubes[1].light_linking.receiver_collection = None
 
 
 def test_light_and_shadow_linking_are_exported():

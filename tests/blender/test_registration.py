@@ -119,13 +119,15 @@ def test_scene_settings_defaults(drt):
 
 
 def test_every_pass_has_a_toggle(drt):
-    toggles = properties.BLENDER_PASS_TOGGLES | properties.DRT_PASS_TOGGLES
+    toggles = properties.BLENDER_PASS_TOGGLES | properties.DRT_PASS_TOGGLES | properties.CYCLES_PASS_TOGGLES
     assert set(toggles) == set(PASSES) - {"Combined"}
     view_layer_props = bpy.types.ViewLayer.bl_rna.properties
     for name, attr in properties.BLENDER_PASS_TOGGLES.items():
         assert attr in view_layer_props, f"ViewLayer.{attr} (pass {name}) missing"
     for attr in properties.DRT_PASS_TOGGLES.values():
         assert attr in properties.DRTViewLayerSettings.bl_rna.properties
+    for attr in properties.CYCLES_PASS_TOGGLES.values():
+        assert attr in bpy.context.scene.view_layers[0].cycles.bl_rna.properties
 
 
 def test_settings_from_scene(drt):

@@ -396,6 +396,7 @@ class GeometryExporter:
                                            attributes=self._instance_attributes(obj, parent, slot_materials),
                                            color=tuple(obj.color), pass_index=obj.pass_index, random=random,
                                            holdout=self._holdout(parent or obj),
+                                           shadow_catcher=_shadow_catcher(obj, parent),
                                            lightgroup=lightgroup_of(obj, self.light_groups),
                                            asset=asset_name(obj), **ray_visibility(obj, parent)))
             self.keys.append(key)
@@ -482,3 +483,8 @@ def ray_visibility(obj, parent=None) -> dict:
     both it and its instancer, as Cycles syncs it (object_ray_visibility of both)."""
     return {f"visible_{kind}": bool(getattr(obj, f"visible_{kind}", True))
             and (parent is None or bool(getattr(parent, f"visible_{kind}", True))) for kind in RAY_KINDS}
+
+
+def _shadow_catcher(obj, parent) -> bool:
+    """Whether Cycles makes the object a shadow catcher: its own flag or its instancer's (sync_object)."""
+    return bool(obj.is_shadow_catcher or (parent is not None and parent.is_shadow_catcher))

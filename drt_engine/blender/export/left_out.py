@@ -4,8 +4,9 @@ layer's passes it does not write (a third), so that a scene relying on them is n
 differently without a word.
 
 Each object is looked at once (its instances share its settings). Objects' and lights' ray
-visibility, lights' Cast Shadow, objects' Holdout and the world's ray visibility are read (export.geometry,
-export.lights, export.world) and so are light and shadow linking (export.linking): they are not listed here.
+visibility, lights' Cast Shadow, objects' Holdout and Shadow Catcher and the world's ray visibility are
+read (export.geometry, export.lights, export.world) and so are light and shadow linking
+(export.linking): they are not listed here.
 """
 from __future__ import annotations
 
@@ -25,9 +26,7 @@ PASSES = (  # view-layer toggle, the pass as Blender's Passes panel names it
 Indirect it does, core.integrator.lightpasses): a view layer that asks for them gets no such pass,
 so the warning names them."""
 
-OBJECT_SETTINGS = (  # attribute, the value DRT renders as, what the warning calls another value
-    ("is_shadow_catcher", False, "shadow catcher"),
-)
+OBJECT_SETTINGS = ()  # (attribute, the value DRT renders as, what the warning calls another value): none left
 
 
 class LeftOut:

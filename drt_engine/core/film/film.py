@@ -25,6 +25,7 @@ from ..settings import (CRYPTOMATTE_PASSES, FIRST_SAMPLE_PASSES, LIGHT_PASSES, W
                         pass_channels)
 from .cryptomatte import add_slots, ranks, slot_count
 from .ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO, resolve
+from . import shadow_catcher as catcher
 
 _TABLE = 1024
 _BUCKETS = 1 << 14  # uniform cells over u that locate a sample's segment of the filter table
@@ -204,7 +205,7 @@ class Film:
                          for name in passes}
         self.count = np.zeros(self.n)
         self.sums = {name: np.zeros((self.n, self.channels[name] + (name in WEIGHTED_PASSES)))
-                     for name in passes if name not in ("Sample Count", "Noise")}
+                     for name in passes if name not in ("Sample Count", "Noise", catcher.PASS)}
         if ratio:
             self.sums[RATIO] = np.zeros((self.n, FILM_CHANNELS))
         self.count_a = np.zeros(self.n)
@@ -324,6 +325,8 @@ class Film:
             unknown = ~np.isfinite(var)
             var[unknown] = mean[unknown] ** 2
             return np.sqrt(var)
+        if name == catcher.PASS:
+            return self._catcher_ratio(span)
         if name in FIRST_SAMPLE_PASSES:
             return self.sums[name][span]
         if name in WEIGHTED_PASSES:  # over the samples that wrote it (its last channel counts them)
@@ -332,9 +335,32 @@ class Film:
         mean = self.sums[name][span] / np.maximum(count, 1)[:, None]
         if name == "Combined" and self.ratio:
             mean[:, :3] = self.rgb(span)
+        if name == "Combined" and catcher.MATTE in self.sums:
+            return self._catcher_combined(span, mean)
         if name in LIGHT_PASSES:  # read out as Cycles: over its colour pass
             return divide_even_color(mean, self.sums[LIGHT_PASSES[name]][span] / np.maximum(count, 1)[:, None])
         return mean
+
+
+    def _means(self, name: str, span: slice) -> np.ndarray:
+        return self.sums[name][span] / np.maximum(self.count[span], 1)[:, None]
+
+    def _catcher_ratio(self, span: slice, combined=None) -> np.ndarray:
+        """The Shadow Catcher pass of the pixels ``span`` (1 without catchers, core.film.shadow_catcher)."""
+        if catcher.SPLITS not in self.sums:
+            return np.ones((len(self.count[span]), 3))
+        if combined is None:
+            combined = self._means("Combined", span)
+            if self.ratio:
+                combined[:, :3] = self.rgb(span)
+        return catcher.catcher_ratio(combined, self._means(catcher.MATTE, span), self._means(catcher.PATHS, span),
+                                     self.sums[catcher.SPLITS][span, 0])
+
+    def _catcher_combined(self, span: slice, combined: np.ndarray) -> np.ndarray:
+        """Combined of the pixels ``span`` as Cycles reads it with catchers in the scene (its matte)."""
+        ratio = None if catcher.PASS in self.passes else self._catcher_ratio(span, combined)
+        background = self._means(catcher.BACKGROUND, span) if catcher.BACKGROUND in self.sums else None
+        return catcher.combined_read(self._means(catcher.MATTE, span), ratio, background)
 
 
 def divide_even_color(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -54,6 +54,7 @@ from .masks import ray_masks
 from .mis import add_emitted
 from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
+from .shadow_catcher import Catchers, CatcherWave
 from .shadows import TransparentShadows, limits, new_queue, stopped
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
@@ -116,6 +117,8 @@ class WaveOutput:
     group_names: tuple = ()
     # with light passes: their per-path split and the paths' weights (core.integrator.lightpasses)
     split: WaveSplit | None = None
+    # with shadow catchers: the wave's splits (core.integrator.shadow_catcher)
+    catcher: CatcherWave | None = None
 
     def values(self) -> dict:
         radiance, ratio = self.radiance, None if self.ratio is None else self.ratio.ndu
@@ -198,9 +201,18 @@ class Integrator:
         self.light_passes = asked(settings.passes)  # Diffuse / Glossy / Transmission Direct and Indirect
         self.group_passes = [name for name in settings.passes if name.startswith(LIGHTGROUP_PREFIX)
                              and name not in dict(settings.aovs)]
+        self.catchers = None  # core.integrator.shadow_catcher.Catchers, when the renderer gives one (``catch``)
         self.rays = {"camera": 0, "shadow": 0, "reflection": 0, "refraction": 0, "transparent": 0, "diffuse": 0,
                      "occlusion": 0}
         self._rays_lock = threading.Lock()
+
+    def catch(self, scene, paths):
+        """Split camera paths at the scene's shadow catchers, ``paths`` the integrator of the catchers
+        alone (core.integrator.shadow_catcher); it counts its rays with this one's."""
+        paths.rays, paths._rays_lock = self.rays, self._rays_lock
+        held = np.array([i.holdout for i in scene.instances], bool)
+        self.catchers = Catchers(np.array([i.shadow_catcher for i in scene.instances], bool), held, self.geometry,
+                                 paths, "Shadow Catcher Background" in self.settings.passes)
 
     def _count(self, kind, n):
         with self._rays_lock:
@@ -226,6 +238,8 @@ class Integrator:
             out.grouped, out.group_names = self.groups.new(n), tuple(self.groups.names)
         if self.light_passes:
             out.split = WaveSplit(n)
+        if self.catchers is not None:
+            out.catcher = self.catchers.new(n)
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:
@@ -264,6 +278,9 @@ class Integrator:
                 order = np.argsort(mat, kind="stable")
                 rows, mat = rows[order], mat[order]
             surf = self._surface(state, hits, rows, mat, ray_times)
+            if out.catcher is not None:  # before the hits' light: from here on a split path's is not the matte's
+                self.catchers.split(surf, out.catcher, out.radiance, out.alpha,
+                                    lambda seen: self._world_seen(state.take(surf.row[seen])))
             occlusion = self._occlusion(surf, state, samples, sampler, depth)
             self._emission_seen(surf, state, hits, out, occlusion)
             if self.aovs is not None:
@@ -307,6 +324,8 @@ class Integrator:
             if not continued:
                 break
             state = PathState.concat(continued)
+        if out.catcher is not None:
+            self.catchers.write(out.catcher, samples, sampler, out.radiance, out.alpha, out.aux)
         return out.values()
 
     # -- camera ---------------------------------------------------------------------
@@ -375,9 +394,9 @@ class Integrator:
             return
         lights = self.lights
         st = rays.straight
-        path = None if rays.bounces is None else RayPath(st, rays.bounces, np.full(len(rays), BACKGROUND_LENGTH),
-                                                         emission=True)
-        world = lights.world_radiance(rays.dirs, st, rays.prev_normal, path)
+        world = self._world_seen(rays)
+        if out.catcher is not None and out.catcher.background is not None:  # Cycles' Background pass
+            out.catcher.background[rays.path[st]] += rays.throughput[st] * world[st]
         if self.aovs is not None and self.aovs.world:
             seen = np.flatnonzero(st & ~out.indexed[rays.path])
             self.aovs.write_world(rays.path[seen], rays.throughput[seen], out.aux, out.aov_reach[rays.path[seen]])
@@ -404,6 +423,12 @@ class Integrator:
                                 None if group is None else self._group(lambda: np.full(len(bounced), group)))
                 if out.split is not None:
                     out.split.add_found(bounced.path, e)
+
+    def _world_seen(self, rays: PathState) -> np.ndarray:
+        """The world's radiance along ``rays`` as they see it (its ray visibility)."""
+        path = None if rays.bounces is None else RayPath(rays.straight, rays.bounces,
+                                                         np.full(len(rays), BACKGROUND_LENGTH), emission=True)
+        return self.lights.world_radiance(rays.dirs, rays.straight, rays.prev_normal, path)
 
     def _surface(self, state: PathState, hits, rows, mat, ray_times) -> SurfaceHits:
         """The surface hits ``rows`` of this depth (materials ``mat``): position, normals and a frame

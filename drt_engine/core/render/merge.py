@@ -13,6 +13,7 @@ import numpy as np
 
 from ..film import parts as parts_mod
 from ..film.film import Film
+from ..film.shadow_catcher import MATTE
 from ..settings import pass_channels, pass_of
 from .denoise import denoise_film, denoised_passes, figures
 from .report import ErrorLog, report_dict
@@ -75,7 +76,8 @@ class Merger:
         given, its estimated error then in the last log entry; else the passes asked for as merged."""
         settings = self.first.settings()
         passes = self.film.images()
-        if not (self.denoising and denoiser is not None):
+        caught = MATTE in self.film.sums  # a scene with shadow catchers is not denoised (its parts said so)
+        if not (self.denoising and denoiser is not None) or caught:
             return {name: image for name, image in passes.items() if pass_of(name) in settings.passes}
         if self.denoised is None:
             with denoiser.filters() as filters:

@@ -17,12 +17,15 @@ from ..base import jit
 from ..errors import SceneError, SettingsError
 from ..film.denoising import PASSES as FEATURE_PASSES, with_features
 from ..film.film import Film
+from ..film.shadow_catcher import hidden_sums
 from ..integrator.aovs import AOV_TRANSPARENCY
 from ..integrator.bounces import LIMIT_TRANSPARENCY
 from ..integrator.integrator import Integrator
 from ..integrator.lightpasses import RATIO_LEFT_OUT, SHADOWS_LEFT_OUT
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
+from ..integrator.shadow_catcher import LEFT_OUT as CATCHER_LEFT_OUT, NOT_DENOISED as CATCHER_NOT_DENOISED, \
+    RATIO_LEFT_OUT as CATCHER_RATIO_LEFT_OUT, catcher_settings, catchers_only
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
 from ..settings import RenderSettings, pass_of, read_over
@@ -68,7 +71,9 @@ class Renderer:
         self.prepared = prepared
         self.scene, self.settings, self.camera = scene, settings, scene.camera
         self.denoiser = denoiser
-        self.denoising = settings.use_denoising and not settings.partial
+        catchers = catchers_only(scene)  # the scene of its shadow catchers alone, if it has any
+        # a denoised Combined would be the whole scene's, not the catchers' matte: not denoised, and said so
+        self.denoising = settings.use_denoising and not settings.partial and catchers is None
         self._denoised = None  # (samples in the film, core.render.denoise.Denoised) of the newest denoising
         self._denoise_seconds = 0.0
         self._filters = None  # core.film.denoiser.Filters while a denoising render runs
@@ -78,6 +83,8 @@ class Renderer:
         if settings.use_denoising:  # the features guide the denoiser (a part's, the merge's): traced even
             settings = with_features(settings)  # when not asked for as passes
         self._read_over = read_over(settings.passes)  # light passes' colours, summed (parts keep them), not returned
+        if catchers is not None:  # the sums Combined and the Shadow Catcher pass are read from
+            self._read_over += hidden_sums(settings.passes, scene.film_transparent)
         if self._read_over:
             settings = replace(settings, passes=tuple(settings.passes) + self._read_over)
         self.threads = settings.threads if settings.threads > 0 else (os.cpu_count() or 1)
@@ -86,6 +93,10 @@ class Renderer:
         self.plan = make_plan(scene, settings, self.geometry, self.lights, self.shaders)
         self.timed = self.plan.time
         self.integrator = Integrator(prepared, scene, settings, self.plan)
+        if catchers is not None:
+            only, only_settings = PreparedScene(catchers), catcher_settings(settings)
+            plan = make_plan(catchers, only_settings, only.geometry, only.lights, only.shaders)
+            self.integrator.catch(scene, Integrator(only, catchers, only_settings, plan))
         w, h = self.camera.window_size
         contrast = settings.use_adaptive_sampling and settings.adaptive_mode == "CONTRAST"
         self.film = Film(w, h, settings.passes, track_range=contrast, ratio=bool(self.plan.ratio),
@@ -114,6 +125,13 @@ class Renderer:
             warnings.append(SHADOWS_LEFT_OUT)
         if self.integrator.light_passes and self.integrator.ratio:
             warnings.append(RATIO_LEFT_OUT)
+        if self.integrator.catchers is not None:
+            if self.integrator.light_passes or self.integrator.groups is not None:
+                warnings.append(CATCHER_LEFT_OUT)
+            if self.integrator.ratio:
+                warnings.append(CATCHER_RATIO_LEFT_OUT)
+            if self.settings.use_denoising:
+                warnings.append(CATCHER_NOT_DENOISED)
         return warnings
 
     def render(self, progress=None) -> RenderResult:

@@ -1,0 +1,105 @@
+"""Shadow catchers in the core (core.integrator.shadow_catcher, core.film.shadow_catcher): a floor
+that is a catcher under an area light and a lit world, a sphere over it. The catcher paths start on
+the camera's own rays with the same sample values as the paths they split from (Cycles copies the
+state): with nothing shading the floor they bring exactly its light, so the Shadow Catcher pass
+reads 1; the sphere's shadow reads below 1; parts merged read as the whole render."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from drt_engine.core.film.shadow_catcher import catcher_ratio, combined_read
+from drt_engine.core.integrator.shadow_catcher import LEFT_OUT, NOT_DENOISED
+from drt_engine.core.render.render import Renderer
+from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
+from drt_engine.core.settings import RenderSettings
+from tests.support import split_render
+from tests.support.scenes import plane, render_passes, top_camera, translation, uv_sphere
+
+PASSES = ("Combined", "Shadow Catcher")
+
+
+def scene(sphere_z=0.5, transparent=True) -> SceneData:
+    floor = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.5, 0.4))])
+    ball = Material("ball", [Closure("DIFFUSE", color=(0.8, 0.2, 0.1))])
+    meshes = [plane(10.0), uv_sphere(0.3, (0.0, 0.0, sphere_z), 24, 12, material=1)]
+    instances = [Instance(0, np.eye(4), name="floor", shadow_catcher=True), Instance(1, np.eye(4), name="ball")]
+    lights = [Light("AREA", translation(0.3, 0.2, 2.0), radiance=np.array([4.0, 3.0, 2.0]), size_x=0.5, size_y=0.5)]
+    return SceneData(top_camera(3.0, 0.5, 16), meshes, instances, [floor, ball], lights,
+                     World(radiance=np.array([0.1, 0.15, 0.3])), film_transparent=transparent)
+
+
+def test_the_pass_reads_one_where_nothing_shades_the_catcher():
+    """The sphere far above the camera's view and the light (no shadow on the floor in view): the
+    catcher paths bring what the split paths bring, so the pass is 1 and Combined transparent there."""
+    passes = render_passes(scene(sphere_z=50.0), PASSES)
+    np.testing.assert_allclose(passes["Shadow Catcher"], 1.0, atol=1e-5)
+    assert passes["Combined"][..., 3].max() < 1e-5 and passes["Combined"][..., :3].max() == 0.0
+
+
+@pytest.mark.parametrize("transparent", [True, False])
+def test_the_shadow_reads_below_one_and_is_the_alpha_of_combined(transparent):
+    """With the sphere's shadow: the pass dark under it. With the pass, Combined is the matte (the
+    sphere over a transparent floor); without it, Cycles' approximate shadow: alpha
+    (1 - a) (1 - mean(pass)) + a over a transparent film (a the matte's alpha), and over an opaque
+    one the world darkened by the pass where the floor alone shows."""
+    data = scene(transparent=transparent)
+    with_pass = render_passes(data, PASSES)
+    shadow, matte = with_pass["Shadow Catcher"].mean(axis=2), with_pass["Combined"]
+    combined = render_passes(data, ("Combined",))["Combined"]
+    assert shadow.min() < 0.7 and with_pass["Shadow Catcher"].max() <= 1.0 + 1e-5
+    a = matte[..., 3]
+    assert a.min() == 0.0 and a.max() == 1.0  # the floor held out of the matte, the sphere in it
+    if transparent:
+        np.testing.assert_allclose(combined[..., 3], (1.0 - a) * (1.0 - shadow) + a, atol=1e-5)
+        np.testing.assert_allclose(combined[..., :3], matte[..., :3], atol=1e-6)
+    else:
+        assert np.all(combined[..., 3] == 1.0)
+        floor = a == 0.0
+        world = np.array([0.1, 0.15, 0.3])
+        np.testing.assert_allclose(combined[..., :3][floor], world * shadow[floor][:, None], rtol=1e-4, atol=1e-6)
+
+
+def test_film_reads_as_cycles():
+    """Cycles' film_calculate_shadow_catcher and matte-with-shadow on sums: no split reads 1, a 0
+    catcher light reads 1 in that channel, Combined's alpha lays the ratio over white."""
+    combined = np.array([[0.5, 0.2, 0.0, 1.0], [0.3, 0.3, 0.3, 0.5], [0.2, 0.2, 0.2, 1.0]])
+    matte = np.array([[0.1, 0.0, 0.0, 0.0], [0.1, 0.1, 0.1, 0.5], [0.2, 0.2, 0.2, 1.0]])
+    light = np.array([[0.8, 0.4, 0.0], [0.4, 0.4, 0.4], [0.0, 0.0, 0.0]])
+    ratio = catcher_ratio(combined, matte, light, np.array([4.0, 2.0, 0.0]))
+    np.testing.assert_allclose(ratio, [[0.5, 0.5, 1.0], [0.75, 0.75, 0.75], [1.0, 1.0, 1.0]])
+    np.testing.assert_allclose(combined_read(matte, ratio, None)[:, 3], [1 / 3, 0.625, 1.0])
+    opaque = combined_read(matte, ratio, np.array([[1.0, 1.0, 1.0]] * 3))
+    np.testing.assert_allclose(opaque[:, 3], 1.0)
+    np.testing.assert_allclose(opaque[0, :3], [0.1 + 2 / 3, 2 / 3, 2 / 3])
+
+
+@pytest.mark.parametrize("transparent", [True, False])
+def test_shadow_catcher_travels_through_parts_and_merge(tmp_path, transparent):
+    """A split render's parts carry the catcher sums; merged, Combined and the pass are the whole render's."""
+    def part(start, end, passes):
+        settings = RenderSettings(samples=8, threads=1, max_depth=4, passes=passes, sample_start=start,
+                                  sample_end=end)
+        return split_render.render_part(scene(transparent=transparent), settings)
+
+    for passes in (PASSES, ("Combined",)):
+        _, whole = part(0, 0, passes)
+        merged = split_render.merged([part(a, b, passes)[0] for a, b in ((0, 3), (3, 8))], tmp_path).images()
+        assert set(merged) == set(whole.passes) == set(passes)
+        for name in passes:
+            np.testing.assert_allclose(merged[name], whole.passes[name], rtol=1e-5, atol=1e-6)
+
+
+def test_what_is_not_matched_is_named():
+    """Denoise on: the image stays as rendered (a denoised Combined would be the whole scene's, not
+    the matte), light passes still count the catcher paths' light: both named in the warnings."""
+    settings = RenderSettings(samples=4, threads=1, max_depth=2, passes=("Combined", "DiffDir"), use_denoising=True)
+    renderer = Renderer(scene(), settings)
+    result = renderer.render()
+    assert NOT_DENOISED in result.warnings and LEFT_OUT in result.warnings
+    assert "Noisy Image" not in result.passes
+    plain = Renderer(replace(scene(), instances=[replace(i, shadow_catcher=False) for i in scene().instances]),
+                     replace(settings, use_denoising=False))
+    assert not any("shadow catcher" in w for w in plain.warnings)
