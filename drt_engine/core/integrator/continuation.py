@@ -21,7 +21,7 @@ from .lightpasses import eval_parts, share
 @kernel
 def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, inside, u_select, u2, throughput, pos, ng,
                    scale, bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf,
-                   passthrough, transmit, next_bounces, diffuse, first, shares):
+                   passthrough, transmit, next_bounces, diffuse, first, shares, chance):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
     world direction ``wi``, the path's new throughput ``weight``, the density that sampled the
     direction (``prev_pdf``, inf for a delta lobe), whether the transparent lobe was taken, whether
@@ -33,7 +33,11 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     their depths) sets reflection or transmission and diffuse, and counts a bounce and a diffuse
     (reflected) or transmission one; ``diffuse[j]``: a diffuse lobe was taken. With
     ``min_bounces`` (bounces, transparent bounces; -1: no roulette) a path past them goes on with
-    Cycles' probability min(sqrt(max throughput), 1) (``roulette``), decided by ``u_roulette[j]``.
+    Cycles' probability p = min(sqrt(max throughput), 1) (``roulette``), decided by ``u_roulette[j]``
+    and applied where Cycles applies it, at the next hit (integrator_intersect_terminate): the ray
+    still goes and what it finds (lights, world, emission) counts at the undivided ``weight``;
+    ``chance[j]`` is p for a path that survives (its hit divides the throughput by it before direct
+    light and the next bounce), 0 for one that ends at that hit; 1 without roulette.
     Where ``first[j]`` (empty: no light passes) and the path bounces (not through a transparent
     lobe), ``shares[j]`` its light passes' weights (core.integrator.lightpasses, ``pass_shares``): the
     diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
@@ -61,11 +65,10 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
         crosses = s[11]
         if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0) != crosses:
             continue
+        chance[j] = 1.0
         if min_bounces[0] >= 0 and len(bounces):
             p = roulette(bounces, j, s[9], peak, min_bounces)
-            if u_roulette[j] >= p:
-                continue
-            t0, t1, t2 = t0 / p, t1 / p, t2 / p
+            chance[j] = p if u_roulette[j] < p else 0.0
         go[j] = True
         origin[j, 0], origin[j, 1], origin[j, 2] = spawn_point(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1],
                                                                ng[j, 2], wx, wy, wz, scale[j])

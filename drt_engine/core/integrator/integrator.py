@@ -74,8 +74,7 @@ class StepSamples:
     per light strategy k the point on the light ``[:, k, 0]`` and the choice of light or
     triangle ``[:, k, 1, 0]``, valid where the material casts shadow rays; ``path`` (N, 2, 2),
     the lobe direction ``[:, 0]``, the lobe choice ``[:, 1, 0]`` and Russian roulette's
-    ``[:, 1, 1]`` (the second value of the lobe choice's pair, core.sampling.dims), valid where the
-    path continues."""
+    ``[:, 1, 1]`` (with diffuse bounces; core.sampling.dims), valid where the path continues."""
 
     light: np.ndarray
     path: np.ndarray
@@ -288,6 +287,14 @@ class Integrator:
             if self.limited:  # paths past a glossy or transmission limit end here, with what they saw
                 kept = np.flatnonzero(~ended(surf.bounces, s))
                 surf, occlusion = surf.take(kept), None if occlusion is None else occlusion.take(kept)
+                if len(surf) == 0:
+                    break
+            if state.continuation is not None:  # Russian roulette, as Cycles' integrate_surface_terminate:
+                # after the emission the ray found, a path ends or its throughput is divided by its chance
+                chance = state.continuation[surf.row]
+                kept = np.flatnonzero(chance > 0)
+                surf, occlusion = surf.take(kept), None if occlusion is None else occlusion.take(kept)
+                surf.throughput = surf.throughput / chance[kept, None]
                 if len(surf) == 0:
                     break
             u = self._draw(depth, samples.pixel[surf.path], samples.sample[surf.path], surf.mat, sampler,
@@ -579,6 +586,8 @@ class Integrator:
         go = np.flatnonzero(self.continues[mat]) if bounce else np.zeros(0, np.int64)
         if len(go):
             sampler.pairs(pixel, sample, [D.lobe(depth), D.lobe_choice(depth)], go, path)
+            if self.roulette[0] >= 0:  # its own dimension: not correlated with the lobe choice
+                path[:, 1, 1] = sampler.pairs(pixel, sample, [D.roulette(depth)], go)[:, 0, 0]
         return StepSamples(light, path)
 
     def _bind_materials(self, surf: SurfaceHits, hits, shadow: bool = False, occlusion: OcclusionRays | None = None):
@@ -701,7 +710,8 @@ class Integrator:
         the paths' weights set at their first bounce and their bounces counted."""
         n = len(hits)
         go, passthrough, transmit, diffuse = np.empty(n, bool), np.empty(n, bool), np.empty(n, bool), np.empty(n, bool)
-        origin, wi, weight, prev_pdf = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        origin, wi, weight, prev_pdf, chance = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), np.empty(n), \
+            np.empty(n)
         bounces = _NO_BOUNCES if hits.bounces is None else _c(hits.bounces)
         next_bounces = np.empty_like(bounces)
         first = np.zeros(0, bool) if split is None else split.bounces[hits.path] == 0
@@ -711,7 +721,7 @@ class Integrator:
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
                        _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, self.diffuse, _c(u.roulette),
                        self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse,
-                       first, shares)
+                       first, shares, chance)
         sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
@@ -744,7 +754,8 @@ class Integrator:
                          throughput=weight[sel], prev_pdf=prev_pdf, prev_normal=prev_normal,
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin,
-                         min_pdf=min_pdf, receiver=receiver)
+                         min_pdf=min_pdf, receiver=receiver,
+                         continuation=chance[sel] if self.roulette[0] >= 0 else None)
 
 
 def _material_slices(mat):

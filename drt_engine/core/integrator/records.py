@@ -65,7 +65,10 @@ class PathState(Rows):
     Filter Glossy) the least density of the path's non-transparent bounces so far (inf: none or
     only delta ones; core.bsdf.blur); ``receiver`` (with light linking) the receiver light set of
     the object the path last bounced off, not counting transparent pass-throughs (Cycles'
-    mis_ray_object; 0 for camera rays, which see every emitter)."""
+    mis_ray_object; 0 for camera rays, which see every emitter); ``continuation`` (with Russian
+    roulette) what the ray's hit divides the throughput by before it lights and bounces, 0 where the
+    path ends there after the ray saw what it found (Cycles' continuation_probability,
+    core.integrator.continuation)."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -81,6 +84,7 @@ class PathState(Rows):
     mis_origin: np.ndarray | None = None
     min_pdf: np.ndarray | None = None
     receiver: np.ndarray | None = None
+    continuation: np.ndarray | None = None
 
     def mis_ray(self, rows, t):
         """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs
