@@ -57,10 +57,10 @@ def row(name: str, f) -> str:
     return f"| {name} | {f['worst']:.4f} | {f['cycles_seeds']:.4f} | {'yes' if f['ok'] else '**no**'} |"
 
 
-def publish(figures: dict, json_path: Path, marks: tuple[str, str], page_table: str) -> None:
-    """Write the figures' JSON and the page's block, and say how many cases missed the limit."""
+def publish(figures: dict, json_path: Path, marks: tuple[str, str], page_table: str, page: Path = PAGE) -> None:
+    """Write the figures' JSON and the ``page``'s block, and say how many cases missed the limit."""
     json_path.write_text(json.dumps(figures, indent=1) + "\n")
-    replace_between(PAGE, *marks, page_table)
+    replace_between(page, *marks, page_table)
     failed = [name for name, f in figures["cases"].items() if not isinstance(f, str) and not f["ok"]]
     print(f"{len(figures['cases'])} cases, {len(failed)} outside the limit" + (f": {failed}" if failed else ""))
 

@@ -116,8 +116,8 @@ def _turn(scene, angle):
     scene.frame_set(1)
 
 
-@pytest.mark.parametrize("case", CASES)
-def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
+def case_scene(case: str):
+    """The box seen by the camera of ``case`` (CASES), with its depth of field and turn."""
     panorama, settings, dof, turn = CASES[case]
     scene = box_scene(panorama, **settings)
     if dof is not None:
@@ -125,6 +125,12 @@ def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
         scene.camera.data.dof.aperture_fstop, scene.camera.data.dof.focus_distance = dof
     if turn:
         _turn(scene, turn)
+    return scene
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_panoramic_camera_matches_cycles(drt, tmp_path, case):
+    scene = case_scene(case)
     drt_render, c0, c1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name=case) for engine, seed in ps.RUNS]
     rh.save_side_by_side(f"panorama-{case}", drt_render.rgb, c0.rgb)
     combined = [r.passes["Combined"] for r in (drt_render, c0, c1)]

@@ -43,7 +43,7 @@ def catcher_scene(transparent: bool, catcher_pass: bool):
     return scene
 
 
-def _render(scene, engine, seed, tmp_path, name, catcher_pass):
+def catcher_render(scene, engine, seed, tmp_path, name, catcher_pass):
     """Combined and, when asked, the Shadow Catcher pass of one render."""
     r = rh.render(scene, engine, SAMPLES, seed, tmp_path, name=name)
     images = [r.passes["Combined"]]
@@ -59,10 +59,10 @@ def test_shadow_catcher_matches_cycles(drt, tmp_path, transparent, catcher_pass)
     """Combined (RGBA) with Film Transparent on and off, Cycles' approximate shadow in it without the
     Shadow Catcher pass, and that pass, against Cycles; with the flag ignored each is far out."""
     scene = catcher_scene(transparent, catcher_pass)
-    drt_images, cycles0, cycles1 = (_render(scene, engine, seed, tmp_path, "catcher", catcher_pass)
+    drt_images, cycles0, cycles1 = (catcher_render(scene, engine, seed, tmp_path, "catcher", catcher_pass)
                                     for engine, seed in ps.RUNS)
     bpy.data.objects["Ground"].is_shadow_catcher = False
-    ignored = _render(scene, "DRT", 0, tmp_path, "ignored", catcher_pass)
+    ignored = catcher_render(scene, "DRT", 0, tmp_path, "ignored", catcher_pass)
     ignored[1:] = [np.ones_like(image) for image in ignored[1:]]  # no catcher: Cycles' pass reads 1
     for name, image, c0, c1, off in zip(("Combined", "Shadow Catcher"), drt_images, cycles0, cycles1, ignored):
         figures = ps.parity(image, c0, c1)
