@@ -341,7 +341,6 @@ class Film:
             return divide_even_color(mean, self.sums[LIGHT_PASSES[name]][span] / np.maximum(count, 1)[:, None])
         return mean
 
-
     def _means(self, name: str, span: slice) -> np.ndarray:
         return self.sums[name][span] / np.maximum(self.count[span], 1)[:, None]
 

@@ -12,12 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..settings import CATCHER_SUMS
+
 PASS = "Shadow Catcher"
 """The pass Blender shows, read from the sums below; the film keeps no sum of its own for it."""
-PATHS = "Shadow Catcher Paths"
-MATTE = "Shadow Catcher Matte"
-SPLITS = "Shadow Catcher Sample Count"
-BACKGROUND = "Shadow Catcher Background"
+PATHS, MATTE, SPLITS, BACKGROUND = CATCHER_SUMS
 
 
 def hidden_sums(passes, film_transparent: bool) -> tuple[str, ...]:

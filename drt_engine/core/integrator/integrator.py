@@ -32,6 +32,7 @@ from ..film.denoising import Features
 from ..film.film import PixelFilter
 from ..film.mist import Mist
 from ..film.ratio_sums import RATIO
+from ..film.shadow_catcher import BACKGROUND as CATCHER_BACKGROUND
 from ..geometry import camera as camera_rays
 from ..geometry.motion_vectors import MotionVectors
 from ..lights.strategies import LightSamples
@@ -211,7 +212,7 @@ class Integrator:
         paths.rays, paths._rays_lock = self.rays, self._rays_lock
         held = np.array([i.holdout for i in scene.instances], bool)
         self.catchers = Catchers(np.array([i.shadow_catcher for i in scene.instances], bool), held, self.geometry,
-                                 paths, "Shadow Catcher Background" in self.settings.passes)
+                                 paths, CATCHER_BACKGROUND in self.settings.passes)
 
     def _count(self, kind, n):
         with self._rays_lock:
