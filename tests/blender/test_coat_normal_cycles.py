@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import bpy
 
+from drt_engine.core.integrator import integrator
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 
@@ -86,3 +87,21 @@ def test_coat_normal_matches_cycles(drt, tmp_path):
     off = ps.parity(unlinked.rgb, cycles0.rgb, cycles1.rgb)
     print("coat normal unlinked", off)
     assert not off["ok"], f"the coat on the base's normal passes too: {off}"
+
+
+def test_coat_normal_without_bump_map_correction(drt, tmp_path, monkeypatch):
+    """With Bump Map Correction off Cycles takes the Coat Normal as it is, even where the view lies
+    below it (the coat then reflects nothing there); DRT raising it anyway must fail the limit."""
+    scene = coat_normal_scene()
+    for material in bpy.data.materials:
+        material.cycles.use_bump_map_correction = False
+    drt_img, cycles0, cycles1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, name="coat-uncorrected")
+                                 for engine, seed in ps.RUNS]
+    figures = ps.parity(drt_img.rgb, cycles0.rgb, cycles1.rgb)
+    print("coat normal uncorrected", figures)
+    assert figures["ok"], ps.message("coat normal uncorrected", figures)
+    coat_turned = integrator._coat_turned
+    monkeypatch.setattr(integrator, "_coat_turned", lambda shader, hits, raises: coat_turned(shader, hits, True))
+    raised = ps.parity(rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="coat-raised").rgb, cycles0.rgb, cycles1.rgb)
+    print("coat normal raised anyway", raised)
+    assert not raised["ok"], f"DRT passes raising the coat normal too: {raised}"

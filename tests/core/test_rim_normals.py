@@ -120,6 +120,18 @@ def test_bump_map_correction_off_keeps_the_normal_for_every_lobe():
     assert np.array_equal(hits.ns, hits.frame.n) and np.array_equal(hits.dn, np.tile([0.0, 0.0, 1.0], (2, 1)))
 
 
+def test_without_bump_map_correction_a_glossy_lobe_sees_nothing_from_below_the_normal():
+    """Bump Map Correction off and wo below the smooth normal: Cycles' microfacet closures need
+    cos(N, wi) > 0 and give nothing, the diffuse half its light about that normal. DRT evaluated
+    GGX there with wo's cosine floored at 1e-30: pixels of 1e25 (a coated Principled with a bumped
+    base, tests/blender/test_coat_normal_cycles.py)."""
+    closures = [Closure("DIFFUSE", weight=np.full(3, 0.5), color=(ALBEDO,) * 3),
+                Closure("GLOSSY", weight=np.full(3, 0.5), roughness=0.3)]
+    scene = _tilted_plane(Material("uncorrected", closures, bump_correction=False))
+    value = Renderer(scene, RenderSettings(samples=16, threads=1)).render().passes["Combined"][..., :3]
+    assert np.allclose(value, 0.5 * ALBEDO * SUN / np.pi * (NORMAL @ TO_SUN), rtol=1e-4)
+
+
 def test_raising_keeps_a_normal_whose_mirror_image_leaves_above():
     ng = np.array([[0.0, 0.0, 1.0]])
     n = np.array([[0.0, 0.1, 0.995]]) / np.linalg.norm([0.0, 0.1, 0.995])

@@ -3,7 +3,9 @@ toward a direction, and sampling one (with the pdf of the whole mixture).
 
 These scalar functions (``selection``, ``eval_lobes``, ``sample_lobes``) take one ray's numbers
 and are what a fused kernel calls; ``rows`` runs them over a wave's arrays. Directions are
-local (z the shading normal) with wo above, as in ``shader``.
+local (z the shading normal) with wo above, as in ``shader``, but where a material's Bump Map
+Correction is off: there the specular lobes (``needs_wo_above``) give nothing with wo below the
+shading normal, as Cycles' microfacet and toon glossy closures need cos(N, wi) > 0.
 
 The scalar functions of the lobe modules are inlined where they are called
 (``inline="always"``): a call between compiled functions increments and decrements the
@@ -79,6 +81,13 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
         sel[si, k] = sel[si, k] / max(total, TINY) if total > 0.0 else 1.0 / n
 
 
+@kernel(inline="always")
+def needs_wo_above(lp, l, woz):
+    """Lobe l (not diffuse) gives nothing toward or from wo (z its cosine to the shading normal): a
+    GGX reflection, glass or toon glossy lobe about the shading normal with wo not above it."""
+    kind = int(lp[l, P_KIND])
+    return woz <= 0.0 and kind != TRANSPARENT and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
+
 
 @kernel(inline="always")
 def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit,
@@ -148,6 +157,8 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd0 += d0
             fd1 += d1
             fd2 += d2
+            continue
+        if needs_wo_above(lp, l, woz):
             continue
         seen = lit
         if kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0:  # its hemisphere is its own normal's, as Cycles'
@@ -259,6 +270,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     else:
         wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
                                                     lobe_eta(lp, l, inside))
+        ok = ok and not needs_wo_above(lp, l, woz)
     s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
     ms = ms_factor(lp, lt, hp, r, j, t, l)
     p = max(p_choice, TINY)

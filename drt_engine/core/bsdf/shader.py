@@ -656,9 +656,10 @@ class MaterialShader:
         return self.hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3]
 
     def turn_coat(self, normal_l: np.ndarray, wo_l: np.ndarray) -> "MaterialShader":
-        """The bound shader with its coat normal per hit in the local shading frame (``normal_l``, unit,
-        wo above it) and, for the coat and the lobes under it, where wo's cosine to it falls in the
-        tables (``tables.locate``), whose albedos Cycles reads there."""
+        """The bound shader with its coat normal per hit in the local shading frame (``normal_l``, unit;
+        wo may be below it where Bump Map Correction is off) and, for the coat and the lobes under it,
+        where wo's cosine to it falls in the tables (``tables.locate``, clamped to them), whose albedos
+        Cycles reads there."""
         hp = self.hp.copy()
         mu = self.mu
         c = np.clip(np.einsum("ij,ij->i", normal_l, wo_l), mu[0], mu[-1])

@@ -619,7 +619,8 @@ class Integrator:
                                 dn=_diffuse_normal(frame, n, kept), smooth=smooth)
             for sub, shader in groups:
                 taken = group.take(sub)
-                yield g.start + sub, taken, _coat_turned(shader, taken) if shader.coat_normal else shader
+                yield g.start + sub, taken, (_coat_turned(shader, taken, shading.material.bump_correction)
+                                             if shader.coat_normal else shader)
 
     def _context(self, group: SurfaceHits, hits, shadow: bool = False,
                  occlusion: OcclusionRays | None = None) -> SurfaceContext:
@@ -805,17 +806,19 @@ def _diffuse_normal(frame: Frame, n, kept) -> np.ndarray:
     return dn
 
 
-def _coat_turned(shader, hits: SurfaceHits):
+def _coat_turned(shader, hits: SurfaceHits, raises: bool):
     """The bound shader with its coat normal (world, from the material's program) in each hit's
-    shading frame: unit (Cycles' safe_normalize_fallback to the frame's normal), raised toward the
-    geometric normal until wo's mirror image leaves above the surface (Cycles' coat takes its normal
-    through ensure_valid_specular_reflection; it may start below the surface), the frame's normal
-    where wo is still not above it."""
+    shading frame: unit (Cycles' safe_normalize_fallback to the frame's normal) and, where the material
+    ``raises`` (Bump Map Correction on), raised toward the geometric normal until wo's mirror image
+    leaves above the surface (Cycles' coat takes its normal through maybe_ensure_valid_specular_reflection;
+    it may start below the surface), the frame's normal where wo is still not above it. Unraised, the
+    coat reflects nothing where wo is below its normal (core.bsdf.reflection.own_reflect_eval)."""
     n = hits.frame.n
     nc = shader.coat_normals()
     length = vec.norm(nc)
     nc = np.where((length > 1e-20)[:, None], nc / np.maximum(length, 1e-20)[:, None], n)
-    ng = np.where((vec.dot(hits.wo, hits.ng) < 0)[:, None], -hits.ng, hits.ng)
-    nc = valid_specular_reflection(ng, hits.wo, nc)
-    nc = np.where((vec.dot(hits.wo, nc) <= 1e-6)[:, None], n, nc)
+    if raises:
+        ng = np.where((vec.dot(hits.wo, hits.ng) < 0)[:, None], -hits.ng, hits.ng)
+        nc = valid_specular_reflection(ng, hits.wo, nc)
+        nc = np.where((vec.dot(hits.wo, nc) <= 1e-6)[:, None], n, nc)
     return shader.turn_coat(hits.frame.to_local(nc), hits.wo_l)
