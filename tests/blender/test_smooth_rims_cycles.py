@@ -15,12 +15,13 @@ same cylinder measured 0.0088 against 0.027, and 0.34 with the geometric normal 
 below the smooth one (a first version of the change)."""
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import bpy
 import numpy as np
 
 from drt_engine.core.integrator import integrator
+from drt_engine.core.lights.strategies import LightSamples
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 
@@ -65,6 +66,31 @@ def test_smooth_rim_of_a_diffuse_cylinder(drt, tmp_path, monkeypatch):
     raised = ps.parity(rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="raised").rgb, cycles0.rgb, cycles1.rgb)
     print("raised", raised)
     assert not raised["ok"], f"DRT passes with the raised normal too: {raised}"
+
+
+def test_smooth_rim_of_a_diffuse_cylinder_under_a_white_world(drt, tmp_path, monkeypatch):
+    """Lit by the world alone, whose samples near the rim fall below the geometric surface: Cycles'
+    BSDF rays cannot go there, its light samples weigh against them all the same (core.integrator.direct);
+    each light sample there taking all its light must fail."""
+    scene = smooth_cylinder()
+    bpy.data.objects.remove(bpy.data.objects["High sun"])
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    drt_image, cycles0, cycles1 = [rh.render(scene, e, SAMPLES, s, tmp_path, name="world-rim") for e, s in ps.RUNS]
+    figures = ps.parity(drt_image.rgb, cycles0.rgb, cycles1.rgb)
+    print("diffuse rim under a white world", figures)
+    assert figures["ok"], ps.message("diffuse rim under a white world", figures)
+    arrays, at = LightSamples.arrays, [f.name for f in fields(LightSamples)].index("cycles_pdf")
+
+    def unweighed_arrays(samples):  # an infinite light density: every light sample unweighed
+        out = list(arrays(samples))
+        out[at] = np.full_like(out[at], np.inf)
+        return tuple(out)
+
+    monkeypatch.setattr(LightSamples, "arrays", unweighed_arrays)
+    unweighed = ps.parity(rh.render(scene, "DRT", 16, 0, tmp_path, name="unweighed").rgb, cycles0.rgb, cycles1.rgb)
+    print("unweighed", unweighed)
+    assert not unweighed["ok"], f"DRT passes without the weight too: {unweighed}"
 
 
 def test_a_glossy_rim_without_bump_map_correction(drt, tmp_path, monkeypatch):

@@ -335,7 +335,7 @@ class Lights:
         sample_strategies(self.table, self.light_slots, self.selecting, vertices, triangles, ng, area, self.emissive,
                           self.emissive_cdf, self.emissive_prob, emission, g.tables,
                           world, self._world_radiance, MAP_SHARE, *self._map, pos, normal, u, out.wi, out.dist,
-                          out.value, out.pdf, out.stop, pick, chosen, bary, lit)
+                          out.value, out.pdf, out.cycles_pdf, out.stop, pick, chosen, bary, lit)
         if time is not None and self.motions:
             self._moving_samples(out, pick, chosen, pos, u, time)
         e = self.light_slots

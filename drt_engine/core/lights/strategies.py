@@ -16,6 +16,7 @@ from ..geometry.accel import offset_scale
 from .choice import pick_light
 from .kinds import sample_light
 from .triangles import pick_triangle, sample_triangle
+from .environment import map_pdf
 from .world import cosine_direction, sample_world_direction
 
 UNRESTRICTED = -1
@@ -45,12 +46,17 @@ class LightSamples:
     (``exclude``: bsdf.mixture's ``UNLIT_*`` bits and ``NO_SHADOW``, from the ray visibility of
     the light or emissive object sampled; empty when no light leaves anything out) and each
     sample's light group (``group``, core.integrator.lightgroups; empty without light groups) and
-    each sample's shadow-ray Embree mask (``mask``, shadow linking; empty: the scene's)."""
+    each sample's shadow-ray Embree mask (``mask``, shadow linking; empty: the scene's). ``cycles_pdf``:
+    the density Cycles' light sampling has for the sample, where it differs from DRT's (a uniform
+    world's: 0, Cycles leaves a world that does not vary out of light sampling, scene/light.cpp's
+    "Background MIS has been disabled"; a map's: the map's alone), which weighs a sample that
+    Cycles' BSDF rays cannot reach (core.integrator.direct)."""
 
     wi: np.ndarray
     dist: np.ndarray
     value: np.ndarray
     pdf: np.ndarray
+    cycles_pdf: np.ndarray
     stop: np.ndarray
     restrict: np.ndarray
     exclude: np.ndarray = field(default_factory=lambda: _NOTHING_EXCLUDED)
@@ -60,7 +66,8 @@ class LightSamples:
     @classmethod
     def empty(cls, strategies: int, n: int) -> "LightSamples":
         return cls(np.zeros((strategies, n, 3)), np.zeros((strategies, n)), np.zeros((strategies, n, 3)),
-                   np.zeros((strategies, n)), np.zeros((strategies, n)), np.full((strategies, 3), UNRESTRICTED, np.int8))
+                   np.zeros((strategies, n)), np.zeros((strategies, n)), np.zeros((strategies, n)),
+                   np.full((strategies, 3), UNRESTRICTED, np.int8))
 
     @property
     def strategies(self) -> int:
@@ -68,12 +75,12 @@ class LightSamples:
 
     def put(self, k: int, rows, sample) -> None:
         """Strategy k's sample (a core.lights.collection.LightSample) at hits ``rows``."""
-        self.wi[k, rows], self.dist[k, rows], self.value[k, rows], self.pdf[k, rows] = \
-            sample.wi, sample.dist, sample.value, sample.pdf
+        self.wi[k, rows], self.dist[k, rows], self.value[k, rows], self.pdf[k, rows], self.cycles_pdf[k, rows] = \
+            sample.wi, sample.dist, sample.value, sample.pdf, sample.pdf
 
     def take(self, rows) -> "LightSamples":
         return LightSamples(self.wi[:, rows], self.dist[:, rows], self.value[:, rows], self.pdf[:, rows],
-                            self.stop[:, rows], self.restrict, self.exclude[:, rows] if self.exclude.size else
+                            self.cycles_pdf[:, rows], self.stop[:, rows], self.restrict, self.exclude[:, rows] if self.exclude.size else
                             self.exclude, self.group[:, rows] if self.group.size else self.group,
                             self.mask[:, rows] if self.mask.size else self.mask)
 
@@ -85,7 +92,7 @@ class LightSamples:
 @kernel
 def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, cdf, prob, emission,
                       geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, sun, pos, normal, u, wi, dist,
-                      value, pdf, stop, pick, chosen, bary, lit):
+                      value, pdf, cycles_pdf, stop, pick, chosen, bary, lit):
     """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
     hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
     expected picks of it), emissive triangles when there are (``emissive``: their global ids,
@@ -107,6 +114,7 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
             if selecting:
                 r, g, b, p = r / c, g / c, b / c, p * c
             value[k, j, 0], value[k, j, 1], value[k, j, 2], pdf[k, j] = r, g, b, p
+            cycles_pdf[k, j] = p
             pick[k, j], chosen[k, j] = i, c
         k = slots
         if len(emissive):
@@ -114,6 +122,7 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
             wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, prob, i, px, py, pz,
                                                               u[j, k, 0, 0], u[j, k, 0, 1])
             wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, d, p
+            cycles_pdf[k, j] = p
             pick[k, j], lit[k, j] = emissive[i], cos_l > 0
             bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
             if cos_l > 0:
@@ -127,6 +136,7 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
         if world == UNIFORM_WORLD:
             wx, wy, wz, z = cosine_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1])
             p = z / math.pi
+            cycles_pdf[k, j] = 0.0  # Cycles finds a world that does not vary by BSDF rays alone
             if p > 0:
                 s = 1.0 / max(p, TINY)
                 value[k, j, 0], value[k, j, 1], value[k, j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
@@ -134,4 +144,5 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
             wx, wy, wz, p = sample_world_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1], share, row_cdf, col_cdf,
                                                    cell, cell_area, sun)
             lit[k, j] = nx * wx + ny * wy + nz * wz > 0 and p > 0
+            cycles_pdf[k, j] = map_pdf(cell, cell_area, sun, wx, wy, wz)
         wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, math.inf, p
