@@ -62,14 +62,18 @@ def vector_scene(motion_blur=False):
     return scene
 
 
-def turning_scene():
+def turning_scene(lens="PERSP"):
     """A camera, its lens shifted, panning and tilting over a cube with most of the view on the
     background, faster between frames 2 and 3: the background's vectors are the camera's turning
-    alone (written from Blender 5.2 on, VECTOR_BACKGROUND_FROM)."""
+    alone (written from Blender 5.2 on, VECTOR_BACKGROUND_FROM). ``lens`` "EQUIRECTANGULAR": a
+    panoramic camera over half the turn (no seam, where a pixel's samples wrap round the image)."""
     scene = ps._scene(WIDTH, HEIGHT)
     camera = scene.camera
     ps.aim(camera, (0.0, -9.0, 1.0))
     camera.data.shift_x, camera.data.shift_y = 0.2, -0.1
+    if lens != "PERSP":
+        camera.data.type, camera.data.panorama_type = "PANO", lens
+        camera.data.longitude_min, camera.data.longitude_max = -math.pi / 2, math.pi / 2
     base = camera.rotation_euler.copy()
     for frame, (pan, tilt) in ((1, (-4.0, -1.0)), (2, (0.0, 0.0)), (3, (7.0, 3.0))):
         camera.rotation_euler = (base.x + math.radians(tilt), base.y, base.z + math.radians(pan))
@@ -206,16 +210,17 @@ def test_deforming_mesh_matches_cycles(drt, tmp_path):
     assert not still["ok"] and still["worst"] > 5 * still["limit"]
 
 
-def test_background_vector_matches_cycles(drt, tmp_path):
+@pytest.mark.parametrize("lens", ["PERSP", "EQUIRECTANGULAR"])
+def test_background_vector_matches_cycles(drt, tmp_path, lens):
     """Through a turning camera (``turning_scene``): from VECTOR_BACKGROUND_FROM on the background's
     samples carry the camera's turning and the cube's outline mixes both; before, they carry none."""
-    scene = turning_scene()
+    scene = turning_scene(lens)
     drt_v, c0, c1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, passes=("Vector",), name="turning")
                      .passes["Vector"] for engine, seed in ps.RUNS]
     figures, pixels = ps.parity(drt_v, c0, c1), per_pixel(drt_v, c0, c1)
     moving = float(np.mean(np.abs(c0).max(axis=-1) > 0.5))
-    print(f"Vector turning camera: blocks {figures}; per pixel {pixels}; moving pixels {moving:.3f}")
-    assert figures["ok"], ps.message("Vector turning camera", figures)
+    print(f"Vector turning camera ({lens}): blocks {figures}; per pixel {pixels}; moving pixels {moving:.3f}")
+    assert figures["ok"], ps.message(f"Vector turning camera ({lens})", figures)
     assert pixels["ok"], pixels
     assert (moving > 0.9) == (bpy.app.version >= VECTOR_BACKGROUND_FROM), moving
 
