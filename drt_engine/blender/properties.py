@@ -132,6 +132,12 @@ def pass_layout(name: str, aovs=()) -> tuple[int, str, str]:
     return len(chan_id), chan_id, _PASS_TYPES[chan_id]
 
 
+VECTOR_BACKGROUND_FROM = (5, 1, 0)
+"""The first Blender whose Cycles writes the Vector pass at camera rays that reach the background
+(film_write_data_passes_background: 5.2's kernel has it, 5.0's does not). 5.1's is not at hand: it is
+taken to be 5.2's, the first release after the 5.0 whose sources were read."""
+
+
 def settings_from_scene(scene, view_layer) -> RenderSettings:
     """The core's RenderSettings for one view layer of ``scene``."""
     drt = scene.drt
@@ -166,6 +172,7 @@ def settings_from_scene(scene, view_layer) -> RenderSettings:
         pass_alpha_threshold=view_layer.pass_alpha_threshold,
         cryptomatte_levels=view_layer.pass_cryptomatte_depth,
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),
+        vector_background=bpy.app.version >= VECTOR_BACKGROUND_FROM,
         use_denoising=drt.use_denoising,
         denoising_prefilter=drt.denoising_prefilter,
         denoising_quality=drt.denoising_quality,

@@ -211,6 +211,10 @@ class RenderSettings:
     # Cycles from Blender 5.2 on scales Denoising Normal by the feature walk's mean throughput
     # (measured: seen in a mirror of tint t, |n| = mean(t)); 5.0 and older write unit normals
     weighted_denoising_normal: bool = False
+    # Cycles from Blender 5.2 on writes the Vector pass at camera rays that reach the background
+    # too (the camera's own turning, weight 1, core.geometry.motion_vectors); 5.0 and older leave
+    # those samples out of the pass
+    vector_background: bool = False
     # OpenImageDenoise over the finished Combined image (core.render.denoise), guided by the
     # Denoising Albedo and Normal (traced for it even when not asked for as passes)
     use_denoising: bool = False

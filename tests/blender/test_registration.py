@@ -156,6 +156,7 @@ def test_settings_from_scene(drt):
         use_adaptive_sampling=True, adaptive_threshold=pytest.approx(0.05), adaptive_min_samples=16,
         adaptive_mode="CONTRAST", time_limit=12.0, target_error=pytest.approx(0.02),
         weighted_denoising_normal=bpy.app.version >= (5, 2, 0),  # as this Blender's Cycles writes it
+        vector_background=bpy.app.version >= properties.VECTOR_BACKGROUND_FROM,  # likewise
     )
     view_layer.use_pass_z = view_layer.use_pass_environment = view_layer.drt.use_pass_noise = False
     view_layer.use_pass_mist = view_layer.use_pass_object_index = view_layer.use_pass_material_index = False

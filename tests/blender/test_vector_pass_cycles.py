@@ -8,7 +8,12 @@ the floor mix in different proportions, and from the vector's change across a pi
 (a few thousandths of a pixel). DRT follows the node parity's rule (procedural_scenes.parity: worst
 4x4-block difference at most 1.5x Cycles' seed-to-seed worst plus 0.002, in pixels) and the same
 rule per pixel on the median and the 90th percentile of the pixels' differences. A pass of zeros,
-one with its halves swapped and one of the wrong sign each fail both by far."""
+one with its halves swapped and one of the wrong sign each fail both by far.
+
+From Blender 5.2 (DRT: VECTOR_BACKGROUND_FROM) Cycles' camera rays that reach the background write
+the camera's turning with weight 1, so an outline pixel's vector is a mean over all its samples, the
+background's included; before, over its surface hits only. Every comparison here runs under both.
+A turning camera (``turning_scene``) is the case where the background's vectors are not 0."""
 from __future__ import annotations
 
 import math
@@ -18,7 +23,7 @@ import numpy as np
 import pytest
 
 from drt_engine.blender.export import export_scene
-from drt_engine.blender.export.left_out import VECTOR_MATCHED_BEFORE
+from drt_engine.blender.properties import VECTOR_BACKGROUND_FROM
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support.datablocks import new_material
@@ -57,19 +62,40 @@ def vector_scene(motion_blur=False):
     return scene
 
 
+def turning_scene(lens="PERSP"):
+    """A camera, its lens shifted, panning and tilting over a cube with most of the view on the
+    background, faster between frames 2 and 3: the background's vectors are the camera's turning
+    alone (written from Blender 5.2 on, VECTOR_BACKGROUND_FROM). ``lens`` "EQUIRECTANGULAR": a
+    panoramic camera over half the turn (no seam, where a pixel's samples wrap round the image)."""
+    scene = ps._scene(WIDTH, HEIGHT)
+    camera = scene.camera
+    ps.aim(camera, (0.0, -9.0, 1.0))
+    camera.data.shift_x, camera.data.shift_y = 0.2, -0.1
+    if lens != "PERSP":
+        camera.data.type, camera.data.panorama_type = "PANO", lens
+        camera.data.longitude_min, camera.data.longitude_max = -math.pi / 2, math.pi / 2
+    base = camera.rotation_euler.copy()
+    for frame, (pan, tilt) in ((1, (-4.0, -1.0)), (2, (0.0, 0.0)), (3, (7.0, 3.0))):
+        camera.rotation_euler = (base.x + math.radians(tilt), base.y, base.z + math.radians(pan))
+        camera.keyframe_insert("rotation_euler", frame=frame)
+    for fcurve in _fcurves(camera):
+        for key in fcurve.keyframe_points:
+            key.interpolation = "LINEAR"
+    bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.0))
+    bpy.context.active_object.data.materials.append(new_material("Cube"))
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    scene.collection.objects.link(sun)
+    scene.frame_set(2)
+    return scene
+
+
 def _fcurves(obj):
     action = obj.animation_data.action
     if hasattr(action, "fcurves"):
         return list(action.fcurves)
     return [fc for layer in action.layers for strip in layer.strips for bag in strip.channelbags
             for fc in bag.fcurves]  # Blender 5's layered actions
-
-
-AFTER_5_0 = pytest.mark.skipif(
-    bpy.app.version >= VECTOR_MATCHED_BEFORE,
-    reason="Blender 5.2's Cycles writes the Vector pass otherwise at object edges (not matched yet): worst 4x4 "
-           "block 0.58 px against a limit of 0.22, per pixel 90th percentile 0.092 against Cycles' own 0.021; the "
-           "deforming grid 2.88 against 0.41 (5.1 not measured). Named in the render's warning there")
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +118,6 @@ def per_pixel(drt, c0, c1) -> dict:
     return {"ours": ours.tolist(), "cycles_seeds": own.tolist(), "ok": bool(np.all(ours <= 1.5 * own + 0.002))}
 
 
-@AFTER_5_0
 def test_vector_matches_cycles(renders):
     drt, c0, c1 = renders
     figures, pixels = ps.parity(drt, c0, c1), per_pixel(drt, c0, c1)
@@ -169,7 +194,6 @@ def deforming_scene():
     return scene
 
 
-@AFTER_5_0
 def test_deforming_mesh_matches_cycles(drt, tmp_path):
     scene = deforming_scene()
     scene.view_layers[0].use_pass_vector = True
@@ -186,9 +210,24 @@ def test_deforming_mesh_matches_cycles(drt, tmp_path):
     assert not still["ok"] and still["worst"] > 5 * still["limit"]
 
 
-def test_a_blender_whose_vector_pass_is_not_matched_says_so(drt):
-    """After 5.0 (see AFTER_5_0) the render's warning names the Vector pass; up to 5.0 it does not."""
+@pytest.mark.parametrize("lens", ["PERSP", "EQUIRECTANGULAR"])
+def test_background_vector_matches_cycles(drt, tmp_path, lens):
+    """Through a turning camera (``turning_scene``): from VECTOR_BACKGROUND_FROM on the background's
+    samples carry the camera's turning and the cube's outline mixes both; before, they carry none."""
+    scene = turning_scene(lens)
+    drt_v, c0, c1 = [rh.render(scene, engine, SAMPLES, seed, tmp_path, passes=("Vector",), name="turning")
+                     .passes["Vector"] for engine, seed in ps.RUNS]
+    figures, pixels = ps.parity(drt_v, c0, c1), per_pixel(drt_v, c0, c1)
+    moving = float(np.mean(np.abs(c0).max(axis=-1) > 0.5))
+    print(f"Vector turning camera ({lens}): blocks {figures}; per pixel {pixels}; moving pixels {moving:.3f}")
+    assert figures["ok"], ps.message(f"Vector turning camera ({lens})", figures)
+    assert pixels["ok"], pixels
+    assert (moving > 0.9) == (bpy.app.version >= VECTOR_BACKGROUND_FROM), moving
+
+
+def test_no_warning_names_the_vector_pass(drt):
+    """DRT writes the pass as this Blender's Cycles does (4.2 to 5.0, and 5.2's background vectors
+    from VECTOR_BACKGROUND_FROM on): no gap for the render's warning to name."""
     scene = vector_scene()
     scene.view_layers[0].use_pass_vector = True
-    named = any("Vector pass" in w for w in render_export(scene).warnings)
-    assert named == (bpy.app.version >= VECTOR_MATCHED_BEFORE)
+    assert not any("Vector" in w for w in render_export(scene).warnings)

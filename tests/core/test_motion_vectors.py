@@ -135,3 +135,43 @@ def test_parts_merge_into_the_whole_render(tmp_path):
     images = merge.merge_parts([parts.read(tmp_path / f"{i}.exr") for i in range(2)], ["A", "B"]).film.images()
     assert np.allclose(images["Vector"], whole.passes["Vector"], rtol=1e-6, atol=1e-12)
 
+
+
+def turned(angle, z=0.0):
+    """Camera-to-world: turned by ``angle`` about y, at height ``z``."""
+    c, s = np.cos(angle), np.sin(angle)
+    m = translation(0.0, 0.0, z)
+    m[:3, :3] = [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+    return m
+
+
+def test_background_directions_as_cycles_projects_them():
+    """A camera ray straight ahead, the camera turned by a at the previous frame: Cycles 5.2's
+    camera_motion_vector_direction takes the world-to-raster projection without its translation and
+    without dividing by depth, so x moves by 16 (sin a + cos a - 1) (the raster's origin at the
+    window's corner, x = -1 on z = -1), y by 8 (cos a - 1) (its corner at y = -0.5)."""
+    a = 0.1
+    cam = perspective(np.stack([turned(a), np.eye(4)]))
+    v = MotionVectors(cam, []).directions(np.array([[0.0, 0.0, -1.0]]))[0]
+    assert np.allclose(v, [16 * (np.sin(a) + np.cos(a) - 1), 8 * (np.cos(a) - 1), 0.0, 0.0], rtol=1e-12)
+
+
+def test_a_camera_that_only_moves_gives_the_background_zero():
+    cam = perspective(np.stack([translation(-PRE), translation(-POST)]))
+    dirs = np.random.default_rng(2).normal(size=(32, 3))
+    assert np.all(MotionVectors(cam, []).directions(dirs) == 0.0)
+
+
+@pytest.mark.parametrize("background", [False, True])
+def test_the_background_writes_the_cameras_turning_only_when_asked(background):
+    """The quads under an orthographic camera turned by -a and +a at the previous and next frame: with
+    ``vector_background`` (Cycles 5.2) the background's pixels read the turning, 8 sin a pixels per
+    half, else 0 (Cycles 5.0)."""
+    a = 0.05
+    data = quads()
+    data.camera.motion_pass = np.stack([turned(-a, 10.0), turned(a, 10.0)])
+    s = settings()
+    s.vector_background = background
+    v = render(data, s)[1].passes["Vector"][:, 3 * RES // 4 + 1:]
+    expected = [-8 * np.sin(a), 0.0, -8 * np.sin(a), 0.0] if background else [0.0] * 4
+    assert np.allclose(v, expected, rtol=1e-6, atol=1e-12)  # the film keeps float32

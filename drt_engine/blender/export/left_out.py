@@ -10,8 +10,6 @@ read (export.geometry, export.lights, export.world) and so are light and shadow 
 """
 from __future__ import annotations
 
-import bpy
-
 TYPES = {"CURVES": "hair curves", "POINTCLOUD": "point cloud", "VOLUME": "volume"}
 """Object types Cycles renders and DRT does not (text, curves and surfaces reach the export as
 meshes; empties, armatures, grease pencil and the like render in neither)."""
@@ -82,16 +80,7 @@ class LeftOut:
         return out + ["object and light settings DRT does not render yet, rendered as if unset: " + "; ".join(parts)]
 
 
-VECTOR_MATCHED_BEFORE = (5, 1, 0)
-"""The Vector pass matches Cycles 4.2 to 5.0; Blender 5.2's Cycles writes it otherwise at object edges
-(tests/blender/test_vector_pass_cycles.py), so from here on the warning says so (5.1 not measured)."""
-
-
 def passes_left_out(view_layer) -> list[str]:
     """One line naming the view layer's enabled passes DRT does not write (none: no line)."""
     names = [name for toggle, name in PASSES if getattr(view_layer, toggle, False)]
-    out = ["passes DRT does not write yet (not in the render result): " + ", ".join(names)] if names else []
-    if getattr(view_layer, "use_pass_vector", False) and bpy.app.version >= VECTOR_MATCHED_BEFORE:
-        out.append("the Vector pass is written as Cycles 4.2 to 5.0 write it: this Blender's Cycles differs at "
-                   "object edges (not matched yet)")
-    return out
+    return ["passes DRT does not write yet (not in the render result): " + ", ".join(names)] if names else []

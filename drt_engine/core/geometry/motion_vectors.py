@@ -10,6 +10,10 @@ barycentric place in its triangle, carried by the vertices there (Cycles' motion
 Panoramic cameras project through their own mapping scaled by the image size,
 as Cycles does. Without either motion the vector is exactly 0 (with motion blur on, Cycles' pass is
 0 everywhere: the export then gives no motion).
+
+A camera ray that reaches the background writes no vector up to Cycles 5.0; Cycles 5.2's
+camera_motion_vector_direction gives it one (``directions``), so edge pixels then average the
+surface's vectors with the background's rather than keep the surface's alone.
 """
 from __future__ import annotations
 
@@ -60,6 +64,30 @@ class MotionVectors:
                 carried[1][rows] = np.einsum("nk,nki->ni", weights, post[corners])
         pre, post = self.raster(carried[0], 1), self.raster(carried[1], 2)
         return np.concatenate([pre - center, center - post], axis=1)
+
+    def directions(self, dirs: np.ndarray) -> np.ndarray:
+        """(N, 4) motion vectors of camera rays of directions ``dirs`` (N, 3) that reach the
+        background, as Cycles 5.2's camera_motion_vector_direction: the direction through each
+        frame's camera, as the surface points are (only the camera's turning moves it)."""
+        center, pre, post = (self.direction_raster(dirs, k) for k in range(3))
+        return np.concatenate([pre - center, center - post], axis=1)
+
+    def direction_raster(self, dirs: np.ndarray, frame: int) -> np.ndarray:
+        """(N, 2) where world directions ``dirs`` fall through the camera of ``frame``, as Cycles has
+        it: a perspective or orthographic camera's world-to-raster projection without its
+        translation and without the division by depth (transform_perspective_direction), a
+        panoramic camera's mapping of the direction."""
+        w, h = self.camera.resolution
+        if self.camera.type == "PANO":
+            turned = self.placed[frame].copy()
+            turned[:3, 3] = 0.0
+            return panorama_window(self.camera, dirs, turned) * np.array([w, h])
+        local = dirs @ self.views[frame][:, :3].T
+        left, right, bottom, top = self.camera.frame
+        scale = np.array([w / (right - left), h / (top - bottom)])
+        if self.camera.type == "PERSP":  # the raster's origin at the frame's corner, times the depth
+            return (local[:, :2] + local[:, 2:3] * np.array([left, bottom])) * scale
+        return local[:, :2] * scale
 
     def raster(self, points: np.ndarray, frame: int) -> np.ndarray:
         """(N, 2) pixel coordinates of world ``points`` seen by the camera of ``frame`` (0 this

@@ -397,7 +397,8 @@ class Integrator:
             out.split.add_found(rays.path, e)
 
     def _escaped(self, rays: PathState, out: WaveOutput):
-        """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs."""
+        """Escaped rays see the world (and, after a bounce, the suns); camera rays take its AOVs and,
+        when the settings ask (Cycles 5.2), the background's Vector."""
         if len(rays) == 0:
             return
         lights = self.lights
@@ -408,6 +409,10 @@ class Integrator:
         if self.aovs is not None and self.aovs.world:
             seen = np.flatnonzero(st & ~out.indexed[rays.path])
             self.aovs.write_world(rays.path[seen], rays.throughput[seen], out.aux, out.aov_reach[rays.path[seen]])
+        if self.motion_vectors is not None and self.settings.vector_background:
+            seen = np.flatnonzero(st & ~out.indexed[rays.path])
+            out.aux["Vector"][rays.path[seen], :4] = self.motion_vectors.directions(rays.dirs[seen])
+            out.aux["Vector"][rays.path[seen], 4] = 1.0
         if "Env" in out.aux:
             out.aux["Env"][rays.path[st]] += rays.throughput[st] * world[st]
         if self.film_transparent:
