@@ -93,6 +93,16 @@ def test_light_passes_and_groups_leave_out_what_paths_bring_after_a_catcher(tran
                                atol=1e-6)
 
 
+def test_emit_counts_an_emissive_catcher_twice_as_cycles():
+    """Cycles writes a catcher's own emission to Emit from the path that split there and from the one
+    split off (neither is a light-pass bounce: film_write_emission_or_background_pass): twice."""
+    data = scene(sphere_z=50.0)
+    data.materials[0] = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.5, 0.4)),
+                                           Closure("EMISSION", emission=(0.5, 0.25, 0.125))])
+    emit = render_passes(data, PASSES + ("Emit",))["Emit"]
+    np.testing.assert_allclose(emit, np.broadcast_to([1.0, 0.5, 0.25], emit.shape), rtol=1e-5)
+
+
 def test_film_reads_as_cycles():
     """Cycles' film_calculate_shadow_catcher and matte-with-shadow on sums: no split reads 1, a 0
     catcher light reads 1 in that channel, Combined's alpha lays the ratio over white."""

@@ -41,10 +41,16 @@ def catchers_only(scene):
     return replace(scene, instances=kept) if kept else None
 
 
+SEEN = ("Emit", "Env")
+"""The passes the split-off paths write too, as Cycles' (what their camera ray sees: a catcher's own
+emission, the world through a transparent one), so those count twice there, as in Cycles."""
+
+
 def catcher_settings(settings):
-    """The settings the catcher paths are traced with: Combined alone, Monte Carlo direct light."""
-    return replace(settings, passes=("Combined",), aovs=(), shadow_estimator="MONTE_CARLO",
-                   use_denoising=False, use_adaptive_sampling=False)
+    """The settings the catcher paths are traced with: Combined (and of ``SEEN`` those asked for),
+    Monte Carlo direct light."""
+    return replace(settings, passes=("Combined",) + tuple(name for name in SEEN if name in settings.passes), aovs=(),
+                   shadow_estimator="MONTE_CARLO", use_denoising=False, use_adaptive_sampling=False)
 
 
 @dataclass
@@ -113,10 +119,13 @@ class Catchers:
         aux[SPLITS] = split[:, None].astype(float)
         aux[PATHS] = np.zeros((len(split), 3))
         rows = np.flatnonzero(split)
+        traced = self.paths.trace(samples.take(rows), sampler) if len(rows) else {}
         if len(rows):
-            light = self.paths.trace(samples.take(rows), sampler)["Combined"][:, :3]
-            aux[PATHS][rows] = wave.throughput[rows] * light
+            aux[PATHS][rows] = wave.throughput[rows] * traced["Combined"][:, :3]
         if self.background:
             aux[BACKGROUND] = wave.background
         if self.env:  # Cycles' Background pass is its Env
             aux["Env"][:] = wave.background
+        for name in SEEN:
+            if name in traced:
+                aux[name][rows] += wave.throughput[rows] * traced[name]
