@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from drt_engine.core.film.shadow_catcher import catcher_ratio, combined_read
-from drt_engine.core.integrator.shadow_catcher import LEFT_OUT, NOT_DENOISED
+from drt_engine.core.integrator.shadow_catcher import NOT_DENOISED
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
-from drt_engine.core.settings import RenderSettings
+from drt_engine.core.settings import RenderSettings, lightgroup_pass
 from tests.support import split_render
 from tests.support.scenes import plane, render_passes, top_camera, translation, uv_sphere
 
@@ -62,6 +62,47 @@ def test_the_shadow_reads_below_one_and_is_the_alpha_of_combined(transparent):
         np.testing.assert_allclose(combined[..., :3][floor], world * shadow[floor][:, None], rtol=1e-4, atol=1e-6)
 
 
+def grouped_scene(transparent) -> SceneData:
+    """The scene with its light in group ``key`` and its world in ``sky``."""
+    data = scene(transparent=transparent)
+    data.lights = [replace(light, lightgroup=0) for light in data.lights]
+    data.world = replace(data.world, lightgroup=1)
+    data.light_groups = ["key", "sky"]
+    return data
+
+
+@pytest.mark.parametrize("transparent", [True, False])
+def test_light_passes_and_groups_leave_out_what_paths_bring_after_a_catcher(transparent):
+    """As Cycles' film (nothing for a path that met a catcher): the floor's pixels, every sample split
+    there, hold no direct diffuse light nor any group's light; the sphere's hold its light; the groups
+    sum to the matte with the world the camera sees (Combined over an opaque film with the pass),
+    whatever the film. Env takes, over an opaque film, the world behind the floor (Cycles' split-off
+    path shades its Background pass there)."""
+    data = grouped_scene(transparent)
+    groups = [lightgroup_pass("key"), lightgroup_pass("sky")]
+    passes = render_passes(data, PASSES + ("DiffDir", "Env", *groups))
+    opaque = render_passes(grouped_scene(False), PASSES)["Combined"]
+    floor = opaque[..., 3] == 0.0  # the matte: the floor held out
+    ball = opaque[..., 3] == 1.0  # the sphere, every sample on it
+    assert floor.mean() > 0.5 and ball.any()
+    assert passes["DiffDir"][floor].max() == 0.0 and passes["DiffDir"][ball].min() > 0.0
+    assert passes[groups[0]][floor].max() == 0.0
+    np.testing.assert_allclose(passes[groups[0]] + passes[groups[1]], opaque[..., :3], rtol=1e-5, atol=1e-6)
+    world = np.array([0.1, 0.15, 0.3])
+    np.testing.assert_allclose(passes["Env"][floor], 0.0 if transparent else np.broadcast_to(world, (floor.sum(), 3)),
+                               atol=1e-6)
+
+
+def test_emit_counts_an_emissive_catcher_twice_as_cycles():
+    """Cycles writes a catcher's own emission to Emit from the path that split there and from the one
+    split off (neither is a light-pass bounce: film_write_emission_or_background_pass): twice."""
+    data = scene(sphere_z=50.0)
+    data.materials[0] = Material("floor", [Closure("DIFFUSE", color=(0.6, 0.5, 0.4)),
+                                           Closure("EMISSION", emission=(0.5, 0.25, 0.125))])
+    emit = render_passes(data, PASSES + ("Emit",))["Emit"]
+    np.testing.assert_allclose(emit, np.broadcast_to([1.0, 0.5, 0.25], emit.shape), rtol=1e-5)
+
+
 def test_film_reads_as_cycles():
     """Cycles' film_calculate_shadow_catcher and matte-with-shadow on sums: no split reads 1, a 0
     catcher light reads 1 in that channel, Combined's alpha lays the ratio over white."""
@@ -94,11 +135,11 @@ def test_shadow_catcher_travels_through_parts_and_merge(tmp_path, transparent):
 
 def test_what_is_not_matched_is_named():
     """Denoise on: the image stays as rendered (a denoised Combined would be the whole scene's, not
-    the matte), light passes still count the catcher paths' light: both named in the warnings."""
+    the matte), named in the warnings; the light passes, as Cycles', need no warning."""
     settings = RenderSettings(samples=4, threads=1, max_depth=2, passes=("Combined", "DiffDir"), use_denoising=True)
     renderer = Renderer(scene(), settings)
     result = renderer.render()
-    assert NOT_DENOISED in result.warnings and LEFT_OUT in result.warnings
+    assert [w for w in result.warnings if "shadow catcher" in w] == [NOT_DENOISED]
     assert "Noisy Image" not in result.passes
     plain = Renderer(replace(scene(), instances=[replace(i, shadow_catcher=False) for i in scene().instances]),
                      replace(settings, use_denoising=False))

@@ -212,7 +212,8 @@ class Integrator:
         paths.rays, paths._rays_lock = self.rays, self._rays_lock
         held = np.array([i.holdout for i in scene.instances], bool)
         self.catchers = Catchers(np.array([i.shadow_catcher for i in scene.instances], bool), held, self.geometry,
-                                 paths, CATCHER_BACKGROUND in self.settings.passes)
+                                 paths, CATCHER_BACKGROUND in self.settings.passes,
+                                 "Env" in self.settings.passes and not scene.film_transparent)
 
     def _count(self, kind, n):
         with self._rays_lock:
@@ -238,8 +239,9 @@ class Integrator:
             out.grouped, out.group_names = self.groups.new(n), tuple(self.groups.names)
         if self.light_passes:
             out.split = WaveSplit(n)
-        if self.catchers is not None:
-            out.catcher = self.catchers.new(n)
+        if self.catchers is not None:  # the light passes and groups a split path stops adding to
+            counted = (out.grouped, None if out.split is None else out.split.split)
+            out.catcher = self.catchers.new(n, tuple(sums for sums in counted if sums is not None))
         if "Depth" in out.aux:
             out.aux["Depth"][:] = _MISS_DEPTH
         if "Mist" in out.aux:

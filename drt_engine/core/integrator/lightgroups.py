@@ -3,7 +3,9 @@ the world may be in one, and a pass ``Combined_<group>`` (RGB) holds what that g
 give to Combined, contribution by contribution as Cycles' film writes it (light_passes.h:
 film_write_direct_light for light samples, film_write_surface_emission and film_write_background
 for emission a ray finds, after the clamp, MIS-weighted as in Combined). The groups of a scene
-whose every emitter is in one sum to Combined. Light no group owns is in Combined alone.
+whose every emitter is in one sum to Combined (with shadow catchers, to the matte: a path adds
+nothing to a group once it met a catcher, core.integrator.shadow_catcher). Light no group owns is in
+Combined alone.
 
 Each contribution goes to its emitter's group where it goes to the wave's radiance: the emission
 rays find (core.integrator.mis.add_emitted, ``rows``' group), light samples in the direct-light

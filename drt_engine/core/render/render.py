@@ -24,7 +24,7 @@ from ..integrator.integrator import Integrator
 from ..integrator.lightpasses import RATIO_LEFT_OUT, SHADOWS_LEFT_OUT
 from ..integrator.plan import make_plan
 from ..integrator.records import Samples
-from ..integrator.shadow_catcher import LEFT_OUT as CATCHER_LEFT_OUT, NOT_DENOISED as CATCHER_NOT_DENOISED, \
+from ..integrator.shadow_catcher import NOT_DENOISED as CATCHER_NOT_DENOISED, \
     RATIO_LEFT_OUT as CATCHER_RATIO_LEFT_OUT, catcher_settings, catchers_only
 from ..sampling.sampler import Sampler
 from ..scene import SceneData
@@ -126,8 +126,6 @@ class Renderer:
         if self.integrator.light_passes and self.integrator.ratio:
             warnings.append(RATIO_LEFT_OUT)
         if self.integrator.catchers is not None:
-            if self.integrator.light_passes or self.integrator.groups is not None:
-                warnings.append(CATCHER_LEFT_OUT)
             if self.integrator.ratio:
                 warnings.append(CATCHER_RATIO_LEFT_OUT)
             if self.settings.use_denoising:
