@@ -408,11 +408,13 @@ class Integrator:
         world = self._world_seen(rays)
         if out.catcher is not None and out.catcher.background is not None:  # Cycles' Background pass
             out.catcher.background[rays.path[st]] += rays.throughput[st] * world[st]
-        if self.aovs is not None and self.aovs.world:
+        aovs = self.aovs is not None and self.aovs.world
+        vectors = self.motion_vectors is not None and self.settings.vector_background
+        if aovs or vectors:  # the camera rays whose data passes no surface took yet
             seen = np.flatnonzero(st & ~out.indexed[rays.path])
+        if aovs:
             self.aovs.write_world(rays.path[seen], rays.throughput[seen], out.aux, out.aov_reach[rays.path[seen]])
-        if self.motion_vectors is not None and self.settings.vector_background:
-            seen = np.flatnonzero(st & ~out.indexed[rays.path])
+        if vectors:
             out.aux["Vector"][rays.path[seen], :4] = self.motion_vectors.directions(rays.dirs[seen])
             out.aux["Vector"][rays.path[seen], 4] = 1.0
         if "Env" in out.aux:
