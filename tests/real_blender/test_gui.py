@@ -138,7 +138,7 @@ def wall_share(image: np.ndarray, channel: int) -> float:
 
 
 def test_f12_render_finished(gui):
-    assert "complete" in gui["f12"] and "cancel" not in gui["f12"], gui["f12"]
+    assert "complete" in gui["f12"] and "cancel" not in gui["f12"] and gui["f12"]["job_ended"], gui["f12"]
     result = read(gui["dir"] / "f12_result.png")
     assert result.shape == (F12_SIZE, F12_SIZE, 3)
     assert wall_share(result, 0) > 0.05 and wall_share(result, 1) > 0.05

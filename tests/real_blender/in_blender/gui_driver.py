@@ -227,7 +227,12 @@ def steps():
         bpy.ops.render.render("INVOKE_DEFAULT")
     while not finished and time.monotonic() - started < RENDER_TIMEOUT:
         yield 0.5
+    # render_complete runs in the render job's thread before the job hands its result to the Render Result
+    # image; saving before the job has ended raced it ("does not have any image data" on a loaded machine)
+    while bpy.app.is_job_running("RENDER") and time.monotonic() - started < RENDER_TIMEOUT:
+        yield 0.25
     state["f12"] = {k: round(v - started, 2) for k, v in finished.items()}
+    state["f12"]["job_ended"] = not bpy.app.is_job_running("RENDER")
     result = bpy.data.images.get("Render Result")
     if result is not None:  # the image editor's Render Result, written out for the host to check
         result.save_render(str(OUT / "f12_result.png"), scene=scene)
