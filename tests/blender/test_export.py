@@ -974,6 +974,28 @@ def test_light_and_shadow_linking_are_exported():
     assert excluded.light_set_membership == (1 << 64) - 1 and not data.warnings
 
 
+def test_instances_take_their_instancers_linking_sets():
+    """A collection instance whose instancer a receiver collection excludes and a blocker collection
+    includes: its instances take the instancer's receiver and blocker sets (Cycles' BlenderLightLink
+    reads the parent's where it is not the default), the instanced object itself keeps its own."""
+    scene = empty_scene()
+    emitter = add_object(scene, "Emitter", cube_mesh("Emitter"))
+    source = bpy.data.collections.new("Source")
+    source.objects.link(add_object(scene, "Inner", cube_mesh("Inner"), location=(3.0, 0.0, 0.0)))
+    instancer = add_object(scene, "Instancer", None, location=(0.0, 4.0, 0.0))
+    instancer.instance_type, instancer.instance_collection = "COLLECTION", source
+    receivers, blockers = bpy.data.collections.new("Receivers"), bpy.data.collections.new("Blockers")
+    receivers.objects.link(instancer)
+    receivers.collection_objects[0].light_linking.link_state = "EXCLUDE"
+    blockers.objects.link(instancer)
+    emitter.light_linking.receiver_collection = receivers
+    emitter.light_linking.blocker_collection = blockers
+    data = render_export(scene)
+    inner = sorted((i.receiver_light_set, i.blocker_shadow_set) for i in data.instances if i.name == "Inner")
+    assert inner == [(0, 0), (1, 1)], inner  # the object itself, then its instance
+    assert not data.warnings, data.warnings
+
+
 def test_more_blocker_sets_than_drt_tells_apart_are_named():
     """Each of 28 emitters' blocker collection includes a cube of its own: 28 blocker sets, past the
     26 DRT's shadow masks tell apart (the 27th and 28th cubes cast every shadow): one warning."""

@@ -77,7 +77,7 @@ def export_scene(
             geometry.add(obj, matrix, instance_key(instance), instance.parent if instance.is_instance else None,
                          instance.random_id if instance.is_instance else None)
     geometry.finish()
-    links.apply(lights, geometry.instances, warnings)
+    links.apply(lights, geometry.instances, [key[1] for key in geometry.keys], warnings)
     world = getattr(depsgraph.view_layer, "world_override", None) or scene.world
     warnings.extend(left_out.warnings())
     if depsgraph.mode == "RENDER":  # the viewport writes no passes

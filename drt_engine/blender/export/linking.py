@@ -43,17 +43,20 @@ class LightLinks:
         if linking is not None and linking.blocker_collection is not None:
             self._blockers[obj.name] = linking.blocker_collection
 
-    def apply(self, lights, instances, warnings: list[str]) -> None:
+    def apply(self, lights, instances, instancers, warnings: list[str]) -> None:
         """Sets each light's and instance's memberships and each instance's receiver and blocker
         sets (nothing without such collections: the defaults light everything, every object
-        casting every shadow). DRT tells core.geometry.visibility.BLOCKER_SETS blocker sets apart,
-        Blender MAX_SET: a scene that needs more is named in ``warnings``."""
+        casting every shadow). An instance takes its instancer's (``instancers``: a name per
+        instance, "" for none) receiver and blocker set where that is not the default, else its
+        own, its own memberships always (Cycles' BlenderLightLink). DRT tells
+        core.geometry.visibility.BLOCKER_SETS blocker sets apart, Blender MAX_SET: a scene that
+        needs more is named in ``warnings``."""
         if self._receivers:
             receiver, member = _sets(self._receivers, MAX_SET)
             for emitter in (*lights, *instances):
                 emitter.light_set_membership = member.get(emitter.name, LIGHT_SETS_ALL)
-            for instance in instances:
-                instance.receiver_light_set = receiver.get(instance.name, 0)
+            for instance, instancer in zip(instances, instancers):
+                instance.receiver_light_set = receiver.get(instancer, 0) or receiver.get(instance.name, 0)
         if self._blockers:
             blocker, member = _sets(self._blockers, BLOCKER_SETS)
             needed = max(_sets(self._blockers, MAX_SET)[0].values(), default=0)
@@ -63,5 +66,5 @@ class LightLinks:
                                 "emitter's shadows")
             for emitter in (*lights, *instances):
                 emitter.shadow_set_membership = member.get(emitter.name, LIGHT_SETS_ALL)
-            for instance in instances:
-                instance.blocker_shadow_set = blocker.get(instance.name, 0)
+            for instance, instancer in zip(instances, instancers):
+                instance.blocker_shadow_set = blocker.get(instancer, 0) or blocker.get(instance.name, 0)
