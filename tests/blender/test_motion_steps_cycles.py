@@ -11,6 +11,7 @@ shutter curve's table, export.camera).
 """
 from __future__ import annotations
 
+import bpy
 import numpy as np
 import pytest
 from conftest import emission_material
@@ -58,10 +59,11 @@ def test_steps_switch_and_deformation_reach_the_export(drt):
     assert len(render_export(scene, motion=True).instances[0].matrices) == 1  # still: its motion blur is off
 
 
-def test_deformation_switch_keeps_vertices_still(drt):
-    scene, edge = eased_edge_scene(1)
+def _deforming_edge(steps: int = 1):
+    """The eased edge's scene with the half-plane still and its vertices keyed to slide instead."""
+    scene, edge = eased_edge_scene(steps)
     edge.animation_data_clear()
-    key = edge.shape_key_add(name="Basis")
+    edge.shape_key_add(name="Basis")
     moved = edge.shape_key_add(name="moved")
     for point in moved.data:
         point.co.x += 1.0
@@ -69,6 +71,32 @@ def test_deformation_switch_keeps_vertices_still(drt):
         moved.value = value
         moved.keyframe_insert("value", frame=frame)
     scene.frame_set(1)
+    return scene, edge
+
+
+def test_deformation_switch_keeps_vertices_still(drt):
+    scene, edge = _deforming_edge()
+    key = edge.data.shape_keys
     assert render_export(scene, motion=True).meshes[0].motion_vertices is not None and key is not None
     edge.cycles.use_deform_motion = False
     assert render_export(scene, motion=True).meshes[0].motion_vertices is None
+
+
+def test_instances_of_a_deforming_mesh_deform_with_it(drt):
+    """The deforming half-plane and two collection instances of it share one mesh: its vertices'
+    motion is read once for all of them, over the shutter and for the Vector pass (Cycles syncs a
+    shared geometry's motion once; DRT read it only for a mesh one object used)."""
+    scene, edge = _deforming_edge()
+    source = bpy.data.collections.new("Source")
+    source.objects.link(edge)
+    for i in range(2):
+        instancer = bpy.data.objects.new(f"Instancer{i}", None)
+        instancer.instance_type, instancer.instance_collection = "COLLECTION", source
+        instancer.location.y = 3.0 * (i + 1)
+        scene.collection.objects.link(instancer)
+    data = render_export(scene, motion=True)
+    assert len(data.meshes) == 1 and len(data.instances) == 3
+    assert data.meshes[0].motion_vertices is not None and np.ptp(data.meshes[0].motion_vertices[:, :, 0]) > 0.5
+    scene.render.use_motion_blur = False
+    scene.view_layers[0].use_pass_vector = True
+    assert render_export(scene, motion=True).meshes[0].motion_pass_vertices is not None

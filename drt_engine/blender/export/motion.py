@@ -119,6 +119,15 @@ def _kept_vertices(obj, mesh) -> np.ndarray | None:
     return v if v is not None and len(v) == len(mesh.vertices) else None
 
 
+def _read_once(vertices: dict, mesh_index: int, mesh, obj, k: int, count: int) -> None:
+    """The vertices of ``mesh`` at the ``k``-th of ``count`` times, read from the first object found
+    using it: the objects and instances sharing a mesh share its evaluated vertices, and Cycles syncs
+    a shared geometry's motion once, for all of them."""
+    per_time = vertices.setdefault(mesh_index, [None] * count)
+    if per_time[k] is None:
+        per_time[k] = _kept_vertices(obj, mesh)
+
+
 def _steps_of(depsgraph, wanted: dict, light_index: dict, camera_name: str):
     """Each wanted instance's, light's and the camera's motion steps (``motion_steps``, at least
     ``long_shutter_steps``) and whether each instance's mesh may deform (its Deformation switch),
@@ -157,7 +166,10 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
     times = shutter_times(scene, max([camera_steps, *inst_steps, *light_steps]))
     if times is None:
         return
-    users = np.bincount([inst.mesh for inst in scene_data.instances], minlength=len(scene_data.meshes))
+    mesh_steps: dict[int, int] = {}  # per mesh that may deform, the most steps an object using it takes
+    for i, inst in enumerate(scene_data.instances):
+        if deform[i] and inst_steps[i]:
+            mesh_steps[inst.mesh] = max(mesh_steps.get(inst.mesh, 0), int(inst_steps[i]))
     steps = len(times)
     matrices = np.repeat(np.stack([inst.matrices[0] for inst in scene_data.instances])[:, None], steps, 1) \
         if scene_data.instances else np.zeros((0, steps, 4, 4))
@@ -165,7 +177,7 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
     light_matrices = np.repeat(np.stack([light.matrix for light in scene_data.lights])[:, None], steps, 1) \
         if scene_data.lights else np.zeros((0, steps, 4, 4))
     light_seen = np.zeros((len(light_keys), steps), bool)
-    vertices: dict[int, tuple[int, list]] = {}  # mesh -> (its instance, its vertices per time)
+    vertices: dict[int, list] = {}  # mesh -> its vertices per time
     camera = np.repeat(scene_data.camera.matrices[:1], steps, 0)
     frame, subframe = scene.frame_current, scene.frame_subframe
     try:
@@ -185,10 +197,8 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
                 matrices[i, k] = np.array(instance.matrix_world, dtype=np.float64)
                 seen[i, k] = True
                 mesh_index = scene_data.instances[i].mesh
-                if users[mesh_index] == 1 and deform[i] and inst_steps[i]:
-                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
-                    if v is not None:
-                        vertices.setdefault(mesh_index, (i, [None] * steps))[1][k] = v
+                if mesh_index in mesh_steps:
+                    _read_once(vertices, mesh_index, scene_data.meshes[mesh_index], instance.object, k, steps)
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:
                 camera[k] = without_scale(cam.matrix_world)
@@ -202,11 +212,12 @@ def add_motion(scene_data, depsgraph, frame_set: Callable[[int, float], None], i
     for j, light in enumerate(scene_data.lights):
         if light_seen[j].all() and light_steps[j] and not np.allclose(light_matrices[j], light_matrices[j][:1]):
             light.matrices = own_steps(light_matrices[j], light_steps[j], _matrices_between)
-    for mesh_index, (i, per_step) in vertices.items():
+    for mesh_index, per_step in vertices.items():
         if all(v is not None for v in per_step):
             stack = np.stack(per_step)
             if not np.allclose(stack, stack[:1]):
-                scene_data.meshes[mesh_index].motion_vertices = own_steps(stack, inst_steps[i], _vertices_between)
+                scene_data.meshes[mesh_index].motion_vertices = own_steps(stack, mesh_steps[mesh_index],
+                                                                          _vertices_between)
 
 
 def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], None], instance_keys: list,
@@ -214,13 +225,12 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
     """For the Vector pass, each instance's and the camera's transforms at the previous and the next
     frame, and the vertices there of meshes that deform (Cycles' motion for passes: frame -1 and +1
     when motion blur is off; with it on Cycles' pass is 0, and so is DRT's without them). As for
-    motion blur, a mesh's vertices are read when one object uses it, its Deformation switch is on and
-    its vertex count stays (Cycles keeps no vertex motion otherwise)."""
+    motion blur, a mesh's vertices are read where an object using it has its Deformation switch on
+    and its vertex count stays (Cycles keeps no vertex motion otherwise)."""
     scene = depsgraph.scene
     if not depsgraph.view_layer.use_pass_vector or scene.render.use_motion_blur:
         return
     wanted = {key: i for i, key in enumerate(instance_keys)}
-    users = np.bincount([inst.mesh for inst in scene_data.instances], minlength=len(scene_data.meshes))
     matrices = np.zeros((len(instance_keys), 2, 4, 4))
     seen = np.zeros((len(instance_keys), 2), bool)
     camera = np.repeat(scene_data.camera.matrix[None], 2, 0)
@@ -236,10 +246,8 @@ def add_motion_pass(scene_data, depsgraph, frame_set: Callable[[int, float], Non
                 matrices[i, k] = np.array(instance.matrix_world, dtype=np.float64)
                 seen[i, k] = True
                 mesh_index = scene_data.instances[i].mesh
-                if users[mesh_index] == 1 and deforms_in_motion(instance.object.original):
-                    v = _kept_vertices(instance.object, scene_data.meshes[mesh_index])
-                    if v is not None:
-                        vertices.setdefault(mesh_index, [None, None])[k] = v
+                if deforms_in_motion(instance.object.original):
+                    _read_once(vertices, mesh_index, scene_data.meshes[mesh_index], instance.object, k, 2)
             cam = depsgraph.objects.get(camera_name)
             if cam is not None:
                 camera[k] = without_scale(cam.matrix_world)
