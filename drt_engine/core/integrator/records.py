@@ -5,10 +5,18 @@ argument lists and tuples. A stage takes records and returns new ones; ``take`` 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from functools import cache
 
 import numpy as np
 
 from ..base.vectors import Frame
+
+
+@cache
+def _names(kind: type) -> tuple[str, ...]:
+    """A record type's field names, found once: ``dataclasses.fields`` walks every field per call,
+    and records are cut and joined many times per wave (a third of a glossy render's Python calls)."""
+    return tuple(f.name for f in fields(kind))
 
 
 class Rows:
@@ -16,14 +24,14 @@ class Rows:
     rows (an index array, a mask or a slice) field by field, a field nobody asked for (None) staying None."""
 
     def __len__(self):
-        return len(getattr(self, fields(self)[0].name))
+        return len(getattr(self, _names(type(self))[0]))
 
     def take(self, rows):
         def rows_of(name):
             value = getattr(self, name)
             return None if value is None else value[rows]
 
-        return type(self)(**{f.name: rows_of(f.name) for f in fields(self)})
+        return type(self)(**{name: rows_of(name) for name in _names(type(self))})
 
     @staticmethod
     def concat(records: list):
@@ -33,7 +41,7 @@ class Rows:
             parts = [getattr(r, name) for r in records]
             return None if parts[0] is None else np.concatenate(parts)
 
-        return type(records[0])(**{f.name: joined(f.name) for f in fields(records[0])})
+        return type(records[0])(**{name: joined(name) for name in _names(type(records[0]))})
 
 
 @dataclass
