@@ -55,18 +55,38 @@ def test_nothing_moves_gives_exactly_zero():
     assert np.all(MotionVectors(perspective(), [Instance(0, np.eye(4))]).vectors(points, np.zeros(64, int)) == 0)
 
 
+TRI = np.array([[-1.0, -1.0, -DEPTH], [1.0, -1.0, -DEPTH], [0.0, 1.0, -DEPTH]])
+SHIFT = np.array([[[0.1, 0, 0], [0.3, 0.2, 0], [0, 0, 0]], [[-0.4, 0, 0], [0, 0.5, 0], [0.2, 0, 0]]])
+"""A triangle at DEPTH whose corners move differently at the previous and the next frame."""
+WEIGHTS = np.array([0.2, 0.3, 0.5])
+
+
+def _expected(pre, post):
+    """The vector of a point moved by ``pre`` and ``post`` (world, at DEPTH) between the frames."""
+    scale = 16.0 / DEPTH
+    return [pre[0] * scale, pre[1] * scale, -post[0] * scale, -post[1] * scale]
+
+
 def test_a_deforming_mesh_carries_its_points_with_its_vertices():
     """A point at barycentric (0.2, 0.3, 0.5) of a triangle whose corners move differently lands at
     the same place among the moved corners (the object moved too: its transform there applies)."""
-    tri = np.array([[-1.0, -1.0, -DEPTH], [1.0, -1.0, -DEPTH], [0.0, 1.0, -DEPTH]])
-    shift = np.array([[[0.1, 0, 0], [0.3, 0.2, 0], [0, 0, 0]], [[-0.4, 0, 0], [0, 0.5, 0], [0.2, 0, 0]]])
-    mesh = Mesh("tri", tri, [[0, 1, 2]], [0], motion_pass_vertices=tri + shift)
-    weights = np.array([0.2, 0.3, 0.5])
-    point = (weights @ tri)[None]
+    mesh = Mesh("tri", TRI, [[0, 1, 2]], [0], motion_pass_vertices=TRI + SHIFT)
+    point = (WEIGHTS @ TRI)[None]
     v = MotionVectors(perspective(), [moving(0.25, 0.0)], [mesh]).vectors(point, np.array([0]), np.array([0]))[0]
-    pre, post = weights @ shift[0] + [0.25, 0, 0], weights @ shift[1]
-    scale = 16.0 / DEPTH
-    assert np.allclose(v, [pre[0] * scale, pre[1] * scale, -post[0] * scale, -post[1] * scale], rtol=1e-9)
+    assert np.allclose(v, _expected(WEIGHTS @ SHIFT[0] + [0.25, 0, 0], WEIGHTS @ SHIFT[1]), rtol=1e-9)
+
+
+def test_instances_of_one_deforming_mesh_carry_their_own_points():
+    """Two instances of the deforming triangle, the second placed 0.3 up and moving its own way:
+    each point is carried by the shared vertices and its own instance's placements."""
+    mesh = Mesh("tri", TRI, [[0, 1, 2]], [0], motion_pass_vertices=TRI + SHIFT)
+    up = Instance(0, translation(0.0, 0.3), motion_pass=np.stack([translation(-0.2, 0.3), translation(0.1, 0.3)]))
+    points = np.stack([WEIGHTS @ TRI, WEIGHTS @ TRI + [0.0, 0.3, 0.0]])
+    v = MotionVectors(perspective(), [moving(0.25, 0.0), up], [mesh]).vectors(points, np.array([0, 1]),
+                                                                               np.array([0, 0]))
+    assert np.allclose(v[0], _expected(WEIGHTS @ SHIFT[0] + [0.25, 0, 0], WEIGHTS @ SHIFT[1]), rtol=1e-9)
+    assert np.allclose(v[1], _expected(WEIGHTS @ SHIFT[0] + [-0.2, 0, 0], WEIGHTS @ SHIFT[1] + [0.1, 0, 0]),
+                       rtol=1e-9)
 
 
 def test_orthographic_scale():

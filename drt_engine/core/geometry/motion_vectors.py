@@ -38,16 +38,20 @@ class MotionVectors:
             if instance.motion_pass is not None:
                 to_object = np.linalg.inv(instance.matrix)
                 self.moves[:, i] = instance.motion_pass @ to_object
-        # per instance of a mesh whose vertices move: (its triangles, its world vertices now, at the
-        # previous and the next frame)
+        # per mesh whose vertices move: its triangles and object-space vertices now, at the previous
+        # and the next frame; per instance the mesh of it that moves (-1: none) and its placement at
+        # the three frames. A hit's corners are placed when it is found: the instances of one mesh
+        # (a crowd of one character) share its arrays rather than each holding world copies
         self.deformed = {}
+        self.deforming = np.full(len(instances), -1, np.int64)
         for i, instance in enumerate(instances):
             mesh = meshes[instance.mesh] if instance.mesh < len(meshes) else None
-            if mesh is None or mesh.motion_pass_vertices is None:
-                continue
-            placed = instance.motion_pass if instance.motion_pass is not None else (instance.matrix,) * 2
-            self.deformed[i] = (mesh.triangles, _world(instance.matrix, mesh.vertices),
-                                *(_world(m, v) for m, v in zip(placed, mesh.motion_pass_vertices)))
+            if mesh is not None and mesh.motion_pass_vertices is not None:
+                self.deformed[instance.mesh] = (mesh.triangles, mesh.vertices, *mesh.motion_pass_vertices)
+                self.deforming[i] = instance.mesh
+        self.placements = np.stack([
+            (inst.matrix, *(inst.motion_pass if inst.motion_pass is not None else (inst.matrix,) * 2))
+            for inst in instances]) if self.deformed else None
 
     def vectors(self, points: np.ndarray, instance: np.ndarray, triangle: np.ndarray | None = None) -> np.ndarray:
         """(N, 4) motion vectors of world ``points`` (N, 3) on the instances ``instance`` (N,), in
@@ -55,13 +59,15 @@ class MotionVectors:
         center = self.raster(points, 0)
         moves = self.moves[:, instance]
         carried = [np.einsum("nij,nj->ni", moves[k, :, :3, :3], points) + moves[k, :, :3, 3] for k in (0, 1)]
-        for i, (triangles, now, pre, post) in self.deformed.items():
-            rows = np.flatnonzero(instance == i)
+        meshes = self.deforming[instance]
+        for mesh, (triangles, now, pre, post) in self.deformed.items():
+            rows = np.flatnonzero(meshes == mesh)
             if len(rows):
                 corners = triangles[triangle[rows]]
-                weights = _barycentric(points[rows], now[corners])
-                carried[0][rows] = np.einsum("nk,nki->ni", weights, pre[corners])
-                carried[1][rows] = np.einsum("nk,nki->ni", weights, post[corners])
+                placed = self.placements[instance[rows]]
+                weights = _barycentric(points[rows], _placed(placed[:, 0], now[corners]))
+                for k, vertices in enumerate((pre, post)):  # the point's place, then where that frame put it
+                    carried[k][rows] = _placed(placed[:, k + 1], np.einsum("nk,nki->ni", weights, vertices[corners]))
         pre, post = self.raster(carried[0], 1), self.raster(carried[1], 2)
         return np.concatenate([pre - center, center - post], axis=1)
 
@@ -105,8 +111,10 @@ class MotionVectors:
         return plane * np.array([w / (right - left), h / (top - bottom)])
 
 
-def _world(matrix: np.ndarray, vertices: np.ndarray) -> np.ndarray:
-    return vertices @ matrix[:3, :3].T + matrix[:3, 3]
+def _placed(matrices: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points (N, ..., 3) placed by one matrix (N, 4, 4) each."""
+    offset = matrices[:, :3, 3].reshape((len(matrices),) + (1,) * (points.ndim - 2) + (3,))
+    return np.einsum("nij,n...j->n...i", matrices[:, :3, :3], points) + offset
 
 
 def _barycentric(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
