@@ -58,7 +58,7 @@ class MotionVectors:
         their meshes' triangles ``triangle`` (N,; needed where a mesh's vertices move)."""
         center = self.raster(points, 0)
         moves = self.moves[:, instance]
-        carried = [np.einsum("nij,nj->ni", moves[k, :, :3, :3], points) + moves[k, :, :3, 3] for k in (0, 1)]
+        carried = [_placed(moves[k], points) for k in (0, 1)]
         meshes = self.deforming[instance]
         for mesh, (triangles, now, pre, post) in self.deformed.items():
             rows = np.flatnonzero(meshes == mesh)
