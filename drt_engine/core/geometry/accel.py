@@ -150,7 +150,7 @@ class Geometry:
     """
 
     def __init__(self, scene: SceneData, center: np.ndarray, previous: "Geometry | None" = None):
-        self.center = np.asarray(center, dtype=np.float64)
+        self.center = np.ascontiguousarray(center, dtype=np.float64)  # one layout: one compiled kernel
         self.warnings: list[str] = []
         known = previous._meshes if previous is not None else {}
         analysed: dict[int, _MeshScene] = {}  # by mesh index in the scene
@@ -200,11 +200,12 @@ class Geometry:
         for j, (_, _, matrices) in enumerate(kept):
             if moves(matrices):
                 quat, upper = embree.quaternion_decomposition(matrices[:, :3])
-                for table, step in zip(motion, (matrices[:, :3, 3], quat, upper)):
+                translation = np.ascontiguousarray(matrices[:, :3, 3])  # frame_at's one compiled layout
+                for table, step in zip(motion, (translation, quat, upper)):
                     table.append(step)
                 self._steps[j] = rows, len(matrices)
                 rows += len(matrices)
-                frame_at(matrices[:, :3, 3], quat, upper, 0.5, self._frames[j])
+                frame_at(translation, quat, upper, 0.5, self._frames[j])
             else:
                 self._frames[j] = matrices[0, :3]
         self._motion = [np.concatenate(table) for table in motion]

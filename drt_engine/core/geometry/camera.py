@@ -269,8 +269,9 @@ def panorama_ray(lens, m, u, v, u0, u1, use_lens):
 
 
 @kernel
-def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens, time, out, valid):
-    """Camera rays into out (N, 9) and valid (N,); a moving camera's frame at each ray's time, its scale dropped."""
+def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens, time, rays, depths, valid):
+    """Camera rays into rays (2, N, 3: origins, directions), depths (3, N: tmax, t_start, depth per t)
+    and valid (N,); a moving camera's frame at each ray's time, its scale dropped."""
     m = matrix.copy()
     for i in range(len(px)):
         if moving:
@@ -280,8 +281,8 @@ def _rays(lens, matrix, translation, quat, stretch, moving, px, py, u, use_lens,
                 for r in range(3):
                     m[r, c] /= length
         u0, u1 = (u[i, 0], u[i, 1]) if use_lens else (0.0, 0.0)
-        (out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4], out[i, 5], out[i, 6], out[i, 7], out[i, 8],
-         valid[i]) = camera_ray(lens, m, px[i], py[i], u0, u1, use_lens)
+        (rays[0, i, 0], rays[0, i, 1], rays[0, i, 2], rays[1, i, 0], rays[1, i, 1], rays[1, i, 2], depths[0, i],
+         depths[1, i], depths[2, i], valid[i]) = camera_ray(lens, m, px[i], py[i], u0, u1, use_lens)
 
 
 @kernel
@@ -315,13 +316,13 @@ def generate(camera: Camera, px: np.ndarray, py: np.ndarray, lens: np.ndarray | 
     motion = Motion(camera.matrices)
     moving = time is not None and motion.moving
     use_lens = lens is not None and camera.aperture_radius > 0
-    out = np.empty((n, 9))
-    valid = np.empty(n, bool)
+    # each quantity its own C-contiguous block: what later kernels take compiles for one layout
+    rays, depths, valid = np.empty((2, n, 3)), np.empty((3, n)), np.empty(n, bool)
     _rays(lens_table(camera), np.ascontiguousarray(camera.matrix[:3]), *motion.table, moving,
           np.asarray(px, np.float64), np.asarray(py, np.float64),
           np.asarray(lens, np.float64) if use_lens else np.zeros((0, 2)), use_lens,
-          np.asarray(time, np.float64) if moving else np.zeros(0), out, valid)
-    return CameraRays(out[:, :3], out[:, 3:6], out[:, 6], out[:, 7], out[:, 8], valid)
+          np.asarray(time, np.float64) if moving else np.zeros(0), rays, depths, valid)
+    return CameraRays(rays[0], rays[1], depths[0], depths[1], depths[2], valid)
 
 
 def pixel_spread(camera: Camera) -> tuple[float, float]:

@@ -75,7 +75,7 @@ class Motion:
     def __init__(self, matrices: np.ndarray):
         matrices = np.asarray(matrices, dtype=np.float64).reshape(-1, 4, 4)
         self.steps = len(matrices)
-        self.translation = matrices[:, :3, 3]
+        self.translation = np.ascontiguousarray(matrices[:, :3, 3])  # the kernels' one layout
         self.linear = matrices[:, :3, :3]
         rotation, self.stretch = _polar(self.linear)
         self.quat = quaternions(rotation)

@@ -114,8 +114,9 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
         for c in range(3):
             shares[j, 2 if crosses else 1, c] = shares[j, 5 if crosses else 4, c] = 1.0
         return
-    f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits, 0,
-                   sx, sy, sz, model, dx, dy, dz)
+    # np.int64(0), not the literal 0: a literal argument would compile eval_parts a second time
+    f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+                   np.int64(0), sx, sy, sz, model, dx, dy, dz)
     fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
                     UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
     for c in range(3):
