@@ -234,7 +234,7 @@ def steps():
     state["f12"] = {k: round(v - started, 2) for k, v in finished.items()}
     state["f12"]["job_ended"] = not bpy.app.is_job_running("RENDER")
     result = bpy.data.images.get("Render Result")
-    if result is not None:  # the image editor's Render Result, written out for the host to check
+    if result is not None and state["f12"]["job_ended"]:  # the image editor's Render Result, for the host to check
         result.save_render(str(OUT / "f12_result.png"), scene=scene)
     yield 1.0
     shot("f12_render")
