@@ -9,7 +9,6 @@ border, an adaptive round's last pixels) compiled the largest kernels (direct_li
 again, and a GUI render compiled for minutes what a headless one of the same scene had compiled.
 """
 import json
-import os
 import re
 import subprocess
 import sys
@@ -60,8 +59,10 @@ def _layout_free(signature: str) -> str:
 def test_no_kernel_compiles_twice_for_a_layout(tmp_path, sample_scene):
     done = subprocess.run([sys.executable, "-c", RENDER_AND_LIST, str(ROOT), str(tmp_path / "frame"),
                            *(str(sample_scene(name)) for name in SCENES)],
-                          capture_output=True, text=True, timeout=1800, env=os.environ.copy())
+                          capture_output=True, text=True, timeout=1800)
     assert done.returncode == 0, done.stderr[-3000:]
+    traced = [line for line in done.stdout.splitlines() if line.startswith("DRT: rays traced:")]
+    assert len(traced) == len(SCENES) + 1 and traced[-1].startswith("DRT: rays traced: camera 1,"), traced
     line = next(line for line in done.stdout.splitlines() if line.startswith("SIGNATURES "))
     signatures = json.loads(line.removeprefix("SIGNATURES "))
     direct = signatures["drt_engine.core.integrator.direct.direct_light"]
