@@ -4,7 +4,8 @@
 #                    it, TEST_JOBS= for one process)
 #   make test-versions tests/core and tests/blender under each bpy of BPY_VERSIONS (4.2 5.0 5.2 LTS),
 #                    each in its own venv (.venv-X.Y from requirements-X.Y.txt; 5.0 is .venv)
-#   make extension   download the embreex wheels, validate, build the extension zips into dist/
+#   make extension   download the embreex wheels, validate, build the extension zips into dist/, the Linux
+#                    one with compiled kernels (tools/ship_kernels.py; KERNELS= leaves them out)
 #   make scenes      rebuild the sample .blend files from their scripts
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
 #                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
@@ -54,6 +55,8 @@ TEST_JOBS ?= -n auto --dist loadfile
 # The wheels listed in the manifest are the single source of truth for what gets downloaded.
 WHEELS := $(shell sed -n 's|^ *"\./\(wheels/[^"]*\.whl\)".*|\1|p' blender_manifest.toml)
 STAGE := $(DIST)/.stage
+# "ship": the Linux zip carries kernels compiled for it (Python 3.11, and 3.13 where BLENDER_ENV exists).
+KERNELS ?= ship
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
@@ -113,6 +116,7 @@ extension: $(WHEELS) | $(STAMP)
 	$(BLENDER_EXT) validate $(STAGE)
 	$(BLENDER_EXT) build --source-dir $(STAGE) --output-dir $(DIST) --split-platforms
 	@rm -rf $(STAGE)
+	$(if $(KERNELS),$(PY) tools/ship_kernels.py build $(DIST)/drt_engine-*-linux_x64.zip $(DIST)/.kernels $(BLENDER_ENV))
 	@for zip in $(DIST)/drt_engine-*.zip; do $(BLENDER_EXT) validate "$$zip" || exit 1; done
 	$(PY) bench/zip_sizes.py --dist $(DIST)
 
