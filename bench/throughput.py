@@ -11,11 +11,12 @@ For each sample scene, in one run:
 (c) b / a per CPU second on 1 thread (target: at least 0.5), and DRT's wall-time speed-up on
     every core against 1 thread (target: at least 1.8 on 2 cores), raw Embree's own beside it;
 (d) time to relMSE 1e-3, DRT (best of its curves) against Cycles with adaptive sampling,
-    taken from bench/run.py's per-scene results (bench/results/<scene>.json) when they exist;
+    taken from bench/run.py's per-scene results (bench/results/<scene>.json) when they exist,
+    and from the same curves the time per sample, DRT against Cycles (target: at most 1.5x);
 (e) peak memory (VmHWM, the process's own: tests/support/memory.py) of a 1920x1080 render in a
     fresh process, and of the same process before the renderer is made (bpy, the scene, the export);
-(f) cold and warm start (bench/startup.py): the first render with an empty kernel cache and
-    with the cache filled, each in a fresh process.
+(f) cold and warm start (bench/startup.py): the first render with an empty kernel cache, with
+    the cache filled, and with only the kernels the Linux zip ships, each in a fresh process.
 The scene is prepared once (core.render.prepared) and shared by the raw rays and both DRT renders.
 Writes bench/THROUGHPUT.md and its section of bench/RESULTS.md.
 """
@@ -50,6 +51,7 @@ TARGET_SPEEDUP = 1.8  # DRT's wall time on 1 thread over every core's, on 2 core
 TARGET_WARM = 1.0  # seconds to load the cached kernels
 TARGET_COLD = 15.0  # seconds of the first render with nothing cached
 TARGET_MEMORY = 300  # MB the 1920x1080 render adds to the process's peak
+TARGET_PER_SAMPLE = 1.5  # DRT's time per sample over Cycles'
 MARK_BEGIN, MARK_END = RESULTS_THROUGHPUT
 
 
@@ -101,15 +103,20 @@ def drt_rate(data, prepared, scene, threads, samples):
     return total / stats["elapsed"], total / cpu, stats["elapsed"], stats["rays"], stats["plan_summary"]
 
 
+def _results(name) -> dict | None:
+    """bench/run.py's results for scene ``name`` (bench/results/<scene>.json), None before a run."""
+    path = ROOT / "bench" / "results" / f"{name}.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
 def time_to_error(name, level=1e-3):
     """(DRT's best seconds, its curve, Cycles' best seconds, its curve, bench/run.py's settings) from
     bench/run.py's results."""
-    path = ROOT / "bench" / "results" / f"{name}.json"
-    if not path.exists():
+    found = _results(name)
+    if found is None:
         return None
     from bench.run import time_to
 
-    found = json.loads(path.read_text())
     curves = found["curves"]
     times = {k: time_to(v, level) for k, v in curves.items()}
 
@@ -120,6 +127,20 @@ def time_to_error(name, level=1e-3):
 
     w, h = found["resolution"]
     return best(False) + best(True) + (f"{w}x{h}, cap {found['cap']} spp, references {found['reference_samples']} spp",)
+
+
+def time_per_sample(name, drt="SOBOL", cycles="Cycles"):
+    """(DRT's seconds per sample, Cycles', the sample count) of bench/run.py's uniform curves at the
+    largest count both rendered (each point a render of its own, so fixed costs spread the most)."""
+    found = _results(name)
+    if found is None:
+        return None
+    curves = found["curves"]
+    if drt not in curves or cycles not in curves:
+        return None
+    points = [{p[4]: p[0] for p in curves[k]} for k in (drt, cycles)]
+    spp = max(set(points[0]) & set(points[1]), default=None)
+    return None if spp is None else (points[0][spp] / spp, points[1][spp] / spp, spp)
 
 
 MEMORY_SCRIPT = """
@@ -183,6 +204,15 @@ def table(rows, memory, startup, width, samples, cores, memory_scene, memory_sam
         ratio = f"{d / c:.1f}" if d and c else "—"
         lines.append(f"| {r['name']} | {fmt(d)}{f' ({dk})' if dk else ''} | {fmt(c)}{f' ({ck})' if ck else ''} "
                      f"| {ratio} | {where} |")
+    lines += ["", f"Time per sample from the same curves (DRT's uniform SOBOL against Cycles without adaptive sampling, "
+              f"seconds over samples at the largest count both rendered; target {TARGET_PER_SAMPLE}x):", "",
+              "| scene | DRT ms / sample | Cycles ms / sample | DRT / Cycles | at |", "|---|---|---|---|---|"]
+    for r in rows:
+        if r["per_sample"] is None:
+            lines.append(f"| {r['name']} | — | — | — | no bench/run.py results |")
+            continue
+        d, c, spp = r["per_sample"]
+        lines.append(f"| {r['name']} | {1e3 * d:.1f} | {1e3 * c:.1f} | {d / c:.2f} | {spp} spp |")
     lines += ["", "Rays traced per kind (all threads) and the render plan:", ""]
     for r in rows:
         kinds = ", ".join(f"{k} {v}" for k, v in r["rays"].items())
@@ -194,8 +224,9 @@ def table(rows, memory, startup, width, samples, cores, memory_scene, memory_sam
                   f"render {seconds:.1f} s, image {shape}): the render's own {after - before:.0f} MB. Target: the "
                   f"render's own under {TARGET_MEMORY} MB."]
     lines += ["", f"Start-up (bench/startup.py, {startup['where']}; each line a fresh process; start-up = first render "
-              f"minus a second one in the same process; targets: cold first render under {TARGET_COLD:.0f} s wall, "
-              f"warm under {TARGET_WARM:.0f} s):", ""]
+              f"minus a second one in the same process; cold: nothing cached or shipped; shipped: the kernels "
+              f"the Linux zip ships, what an installed extension's first render loads; targets: the first render "
+              f"after an install under {TARGET_COLD:.0f} s wall, warm under {TARGET_WARM:.0f} s):", ""]
     lines += [f"- {line}" for line in describe(startup).splitlines()] + [""]
     return "\n".join(lines) + "\n"
 
@@ -234,7 +265,8 @@ def main(argv=None):
         drt, _, seconds, rays, plan = drt_rate(data, prepared, scene, 0, args.samples)
         found = time_to_error(name) or (None, None, None, None, "no bench/run.py results")
         rows.append(dict(name=name, raw1=raw1, raw=raw, raw_cpu=raw_cpu, drt1=drt1, drt=drt, drt_cpu=drt_cpu,
-                         seconds1=seconds1, seconds=seconds, rays=rays, plan=plan, to_error=found))
+                         seconds1=seconds1, seconds=seconds, rays=rays, plan=plan, to_error=found,
+                         per_sample=time_per_sample(name)))
         print(f"{name}: raw {raw1 / 1e6:.2f} / {raw / 1e6:.2f} Mrays/s, DRT {drt1 / 1e6:.2f} / {drt / 1e6:.2f} "
               f"Mrays/s ({seconds1:.1f} s / {seconds:.1f} s), ratio {drt / raw:.3f}; per CPU s "
               f"{drt_cpu / raw_cpu:.3f}; to 1e-3: DRT {fmt(found[0])} Cycles {fmt(found[2])}", flush=True)

@@ -17,16 +17,18 @@ NOTES = {"macos_arm64": " (PyPI has no embreex 4.4 wheel for Intel Macs)"}
 
 
 def table(dist: Path) -> str:
-    rows = ["| zip | size | of which numba + llvmlite, both Pythons |", "|---|---|---|"]
+    rows = ["| zip | size | of which numba + llvmlite, both Pythons | of which compiled kernels, compressed (tools/ship_kernels.py) |",
+            "|---|---|---|---|"]
     zips = sorted(dist.glob("drt_engine-*.zip"))
     if not zips:
         sys.exit(f"error: no extension zips in {dist}: run make extension first")
     for path in zips:
         with zipfile.ZipFile(path) as z:
             compiled = sum(i.file_size for i in z.infolist() if re.search(r"/(numba|llvmlite)-", i.filename))
+            kernels = sum(i.compress_size for i in z.infolist() if i.filename.startswith("kernels/"))
         platform = path.stem.rsplit("-", 1)[1]
         rows.append(f"| `dist/{path.name}`{NOTES.get(platform, '')} | {path.stat().st_size / 1e6:.0f} MB "
-                    f"| {compiled / 1e6:.0f} MB |")
+                    f"| {compiled / 1e6:.0f} MB | {f'{kernels / 1e6:.0f} MB' if kernels else 'none'} |")
     return "\n".join(rows)
 
 
