@@ -3,13 +3,15 @@ them instead of compiling for minutes (core.base.jit: shipped kernels).
 
     python tools/ship_kernels.py build ZIP WORK [BLENDER_ROOT]   # what `make extension` runs
 
-``build`` exports the sample scenes as the core's input (``export``, with bpy), renders them under
-each Python the zip bundles Numba for (``compile``: this venv's 3.11 and, where ``make blender-env``
-made it, the Blender root's 3.13, side by side) and adds the kernels to the Linux zip (``add``).
+``build`` exports the sample scenes and the parity tests' shading scenes (textures, nodes, skies) as
+the core's input (``export``, with bpy), renders them under each Python the zip bundles Numba for
+(``compile``: this venv's 3.11 and, where ``make blender-env`` made it, the Blender root's 3.13, side
+by side) and adds the kernels to the Linux zip (``add``).
 Kernels compile for Numba's ``generic`` CPU, so they run on any CPU of the platform. The scenes
 render as F12 would (their own settings and passes, small and few samples) and once more with every
-pass DRT writes (Cryptomatte, the data passes: some have kernels of their own): kernels a scene needs
-beyond those still compile on first use. Windows and macOS zips ship none (no such machine here).
+pass DRT writes (Cryptomatte, the data passes: some have kernels of their own); the shading scenes
+reach the kernels of procedural textures and skies. Kernels a scene needs beyond those still
+compile on first use. Windows and macOS zips ship none (no such machine here).
 """
 from __future__ import annotations
 
@@ -26,25 +28,45 @@ ROOT = Path(__file__).resolve().parents[1]
 WIDTH, SAMPLES = 48, 4
 
 
+def _shading_scenes():
+    """(name, scene builder) of the parity tests' scenes whose shading has kernels of its own (the
+    procedural textures, the other shader nodes, each sky model this Blender offers): without
+    them a first render with a Noise or Voronoi texture compiled for about 18 s of CPU."""
+    from tests.support import node_scenes, procedural_scenes, sky_scenes
+
+    yield "textures", procedural_scenes.grid_scene
+    yield "nodes", node_scenes.grid_scene
+    for sky_type in sorted({props["sky_type"] for props in sky_scenes.CASES.values()}):
+        if sky_scenes.offered(sky_type):
+            yield f"sky_{sky_type.lower()}", lambda t=sky_type: sky_scenes.sky_scene({"sky_type": t}, WIDTH, WIDTH * 3 // 4)
+
+
 def export(out: Path) -> None:
     """The sample scenes as F12 would render them (SceneData, RenderSettings), and with every pass,
-    pickled into ``out``."""
+    then the shading scenes (``_shading_scenes``), pickled into ``out``."""
     import bpy
 
     sys.path.insert(0, str(ROOT))
     import drt_engine
     from bench.scenes import SCENES, load
+    from drt_engine.blender.export import export_scene
     from drt_engine.blender.properties import settings_from_scene
     from drt_engine.core.settings import PASSES
 
     drt_engine.register()
     out.mkdir(parents=True, exist_ok=True)
+
+    def write(name, scene, data, **changes):
+        settings = dataclasses.replace(settings_from_scene(scene, bpy.context.view_layer), samples=SAMPLES, **changes)
+        (out / f"{name}.pickle").write_bytes(pickle.dumps((data, settings)))
+
     for name in SCENES:
         scene, data = load(name, WIDTH)
-        settings = dataclasses.replace(settings_from_scene(scene, bpy.context.view_layer), samples=SAMPLES)
-        (out / f"{name}.pickle").write_bytes(pickle.dumps((data, settings)))
-        every = dataclasses.replace(settings, passes=PASSES)
-        (out / f"{name}_every_pass.pickle").write_bytes(pickle.dumps((data, every)))
+        write(name, scene, data)
+        write(f"{name}_every_pass", scene, data, passes=PASSES)
+    for name, build in _shading_scenes():
+        scene = build()
+        write(name, scene, export_scene(bpy.context.evaluated_depsgraph_get()))
 
 
 def compile_(out: Path, scenes: Path) -> None:
