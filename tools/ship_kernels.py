@@ -30,12 +30,15 @@ WIDTH, SAMPLES = 48, 4
 
 def _shading_scenes():
     """(name, scene builder) of the parity tests' scenes whose shading has kernels of its own (the
-    procedural textures, the other shader nodes, each sky model this Blender offers): without
-    them a first render with a Noise or Voronoi texture compiled for about 18 s of CPU."""
+    procedural textures, the other shader nodes, Ambient Occlusion and Bevel, each sky model this
+    Blender offers): without them a first render with a Noise or Voronoi texture compiled for
+    about 18 s of CPU."""
     from tests.support import node_scenes, procedural_scenes, sky_scenes
 
     yield "textures", procedural_scenes.grid_scene
     yield "nodes", node_scenes.grid_scene
+    yield "ambient_occlusion", node_scenes.ambient_occlusion_scene  # they trace rays of their own
+    yield "bevel", node_scenes.bevel_scene
     for sky_type in sorted({props["sky_type"] for props in sky_scenes.CASES.values()}):
         if sky_scenes.offered(sky_type):
             yield f"sky_{sky_type.lower()}", lambda t=sky_type: sky_scenes.sky_scene({"sky_type": t}, WIDTH, WIDTH * 3 // 4)
