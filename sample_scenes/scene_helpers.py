@@ -174,9 +174,18 @@ def box_mesh(name, size, material):
 
 
 def sphere_mesh(name, radius, material, segments=48, rings=24):
-    """A smooth UV sphere; 48 x 24 gives 2208 triangles."""
+    """A smooth UV sphere; 48 x 24 gives 2208 triangles. Its faces are put in one order: bmesh's
+    create_uvsphere lists them in an order that changes from run to run (measured in Blender 4.2
+    and 5.0), and a renderer's samples follow the order of an emitter's triangles, so each build
+    rendered a little differently."""
     bm = bmesh.new()
     bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=rings, radius=radius)
+    bm.verts.index_update()
+    bm.faces.index_update()
+    order = sorted(bm.faces, key=lambda face: sorted(v.index for v in face.verts))
+    rank = {face.index: i for i, face in enumerate(order)}
+    bm.faces.sort(key=lambda face: rank[face.index])
+    bm.faces.index_update()
     return mesh_from_bmesh(name, bm, [material], smooth=True)
 
 
