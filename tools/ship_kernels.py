@@ -30,13 +30,17 @@ WIDTH, SAMPLES = 48, 4
 
 def _shading_scenes():
     """(name, scene builder) of the parity tests' scenes whose shading has kernels of its own (the
-    procedural textures, the other shader nodes, Ambient Occlusion and Bevel, each sky model this
-    Blender offers): without them a first render with a Noise or Voronoi texture compiled for
-    about 18 s of CPU."""
+    procedural textures, the other shader nodes, the closures the sample scenes lack, as far as this
+    Blender has them, Ambient Occlusion and Bevel, each sky model this Blender offers): without them
+    a first render with a Noise or Voronoi texture compiled for about 18 s of CPU."""
+    import bpy
     from tests.support import node_scenes, procedural_scenes, sky_scenes
 
     yield "textures", procedural_scenes.grid_scene
     yield "nodes", node_scenes.grid_scene
+    closures = [case for case in node_scenes.CLOSURES if bpy.app.version >= case.since]
+    yield "closures", lambda: node_scenes.closure_scene(closures)  # Toon, Metallic, thin films, ...
+    yield "facing", node_scenes.facing_scene  # Fresnel and Layer Weight
     yield "ambient_occlusion", node_scenes.ambient_occlusion_scene  # they trace rays of their own
     yield "bevel", node_scenes.bevel_scene
     for sky_type in sorted({props["sky_type"] for props in sky_scenes.CASES.values()}):
