@@ -3,15 +3,15 @@ them instead of compiling for minutes (core.base.jit: shipped kernels).
 
     python tools/ship_kernels.py build ZIP WORK [BLENDER_ROOT]   # what `make extension` runs
 
-``build`` exports the sample scenes and the parity tests' shading scenes (textures, nodes, skies) as
+``build`` exports the sample scenes and the parity tests' shading scenes (``_shading_scenes``) as
 the core's input (``export``, with bpy), renders them under each Python the zip bundles Numba for
 (``compile``: this venv's 3.11 and, where ``make blender-env`` made it, the Blender root's 3.13, side
-by side) and adds the kernels to the Linux zip (``add``).
-Kernels compile for Numba's ``generic`` CPU, so they run on any CPU of the platform. The scenes
-render as F12 would (their own settings and passes, small and few samples) and once more with every
-pass DRT writes (Cryptomatte, the data passes: some have kernels of their own); the shading scenes
-reach the kernels of procedural textures and skies. Kernels a scene needs beyond those still
-compile on first use. Windows and macOS zips ship none (no such machine here).
+by side) and adds the kernels to the Linux zip (``add``). Kernels compile for Numba's ``generic``
+CPU, so they run on any CPU of the platform. The sample scenes render as F12 would (their own
+settings and passes, small and few samples) and once more with every pass DRT writes (Cryptomatte,
+the data passes: some have kernels of their own); the shading scenes reach the kernels of
+procedural textures, other nodes and closures, Ambient Occlusion, Bevel and skies. Kernels a scene
+needs beyond those still compile on first use. Windows and macOS zips ship none (no such machine here).
 """
 from __future__ import annotations
 
