@@ -1,7 +1,9 @@
 """Small textured scenes and images written in code for the texture and IBL tests."""
+from dataclasses import replace
+
 import numpy as np
 
-from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, Program, SceneData, World
+from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, Program, SceneData, TextureImage, World
 from tests.support.scenes import translation
 
 
@@ -48,6 +50,12 @@ def constant_world_scene(mesh, material, camera, radiance=1.0, images=()):
     """One mesh under a uniform world of the given radiance (which a diffuse surface reflects exactly)."""
     return SceneData(camera=camera, meshes=[mesh], instances=[Instance(0, np.eye(4))], materials=[material],
                      world=World(radiance=np.full(3, radiance)), images=list(images))
+
+
+def with_image_world(scene: SceneData) -> SceneData:
+    """``scene`` under an image world (a random 16x8 map), which lights.environment tabulates."""
+    sky = TextureImage("sky", pixels=np.random.default_rng(5).random((8, 16, 4)) * 3, colorspace="Non-Color")
+    return replace(scene, world=environment_world(image=0), images=[sky])
 
 
 def environment_world(image=0, strength=1.0, rotation=None, interpolation="Linear"):

@@ -90,7 +90,10 @@ _NO_KINDS = np.zeros(0, np.int32)  # rays that carry no kind: the world's visibi
 class Lights:
     """All next-event strategies of a scene."""
 
-    def __init__(self, scene: SceneData, geometry, shaders, textures=()):
+    def __init__(self, scene: SceneData, geometry, shaders, textures=(), environment=None):
+        """``environment``: the Environment of this scene's world and images made for an earlier
+        Lights (core.render.prepared passes it when an edit left both alone), so the world is not
+        tabulated again: its table is most of the lights' cost under an image world."""
         for light in scene.lights:
             validate_light(light)
         self.lights = [light for light in scene.lights if not light_power_zero(light)]
@@ -117,7 +120,10 @@ class Lights:
         world = scene.world
         self.world_visibility = (world.visible_camera, world.visible_diffuse, world.visible_glossy,
                                  world.visible_transmission)
-        self.environment = Environment(world, list(textures)) if world.program is not None else None
+        if world.program is None:
+            self.environment = None
+        else:
+            self.environment = environment if environment is not None else Environment(world, list(textures))
         env = self.environment
         self._map = (env.row_cdf, env.col_cdf, env.cell, env.cell_area, env.sun) if env is not None else _NO_MAP
         self._map_share = MAP_SHARE if env is not None else 0.0

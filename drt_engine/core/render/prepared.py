@@ -55,7 +55,8 @@ class PreparedScene:
         whose source changed: the geometry when a mesh or an instance did, each material that
         changed (all of them with the images), the lights after any of these or a light or
         world edit. Meshes are compared by identity (an export that keeps unchanged meshes as
-        the same objects spares their Embree scenes), everything else by content."""
+        the same objects spares their Embree scenes), everything else by content. The world's
+        table is kept while the world and the images are unchanged."""
         if scene.camera is None:
             raise SceneError("the scene has no camera")
         validate_scene(scene)
@@ -67,30 +68,32 @@ class PreparedScene:
         else:
             changed = [i for i, (a, b) in enumerate(zip(keys.materials, old.materials)) if a != b]
         geometry = keys.meshes != old.meshes or keys.instances != old.instances
+        world = self.lights.environment if (keys.world, keys.images) == (old.world, old.images) else None
         new = self
         if geometry:
-            new = new.update_geometry(scene)
+            new = new.update_geometry(scene, world)
         if changed:
-            new = new.update_materials(scene, changed)
+            new = new.update_materials(scene, changed, world)
         if not geometry and not changed and keys.lights != old.lights:
-            new = new.update_lights(scene)
+            new = new.update_lights(scene, world)
         if new is self:  # nothing to rebuild: the same parts for the new scene's objects
             new = self._copy(scene)
         new._keys = keys
         return new
 
-    def update_geometry(self, scene: SceneData) -> "PreparedScene":
+    def update_geometry(self, scene: SceneData, world=None) -> "PreparedScene":
         """New meshes or instance transforms: a new top-level Embree scene and triangle tables
         (around the same centre) over the Embree scenes of the meshes left as they were (only an
         edited mesh's is built again), then the lights (emissive triangles); materials and
-        textures are kept."""
+        textures are kept. ``world``, here and in the other updates: the world's table
+        (lights.environment.Environment) when the world and the images are this scene's."""
         new = self._copy(scene)
         new.geometry = new._geometry(scene, self.geometry.center, self.geometry)
         new._shading_done()
-        new._lights_done()
+        new._lights_done(world)
         return new
 
-    def update_materials(self, scene: SceneData, indices) -> "PreparedScene":
+    def update_materials(self, scene: SceneData, indices, world=None) -> "PreparedScene":
         """Materials ``indices`` compiled again (with the images when every one is), then the
         lights (emissive materials); the geometry is kept."""
         new = self._copy(scene)
@@ -104,13 +107,13 @@ class PreparedScene:
         for i in indices:
             new.shading[i] = MaterialShading(scene.materials[i], new.textures, [])
         new._shading_done()
-        new._lights_done()
+        new._lights_done(world)
         return new
 
-    def update_lights(self, scene: SceneData) -> "PreparedScene":
+    def update_lights(self, scene: SceneData, world=None) -> "PreparedScene":
         """Lights or the world edited: the light tables again, everything else kept."""
         new = self._copy(scene)
-        new._lights_done()
+        new._lights_done(world)
         return new
 
     def _copy(self, scene: SceneData) -> "PreparedScene":
@@ -140,8 +143,8 @@ class PreparedScene:
         programs = any(s.material.program is not None for s in self.shading)
         self.attributes = SurfaceAttributes(self.scene, self.geometry) if programs else None
 
-    def _lights_done(self) -> None:
-        self.lights = Lights(self.scene, self.geometry, self.shading, self.textures)
+    def _lights_done(self, world=None) -> None:
+        self.lights = Lights(self.scene, self.geometry, self.shading, self.textures, world)
 
     @property
     def warnings(self) -> list[str]:
@@ -182,7 +185,8 @@ class _Keys:
         known = {} if previous is None else dict(zip(map(id, previous.scene.materials), previous._keys.materials))
         self.materials = [known.get(id(m)) or _digest(m) for m in scene.materials]
         self.images = _digest(scene.images)
-        self.lights = _digest([scene.lights, scene.world])
+        self.world = _digest(scene.world)
+        self.lights = (_digest(scene.lights), self.world)
 
 
 def _digest(value) -> str | object:
