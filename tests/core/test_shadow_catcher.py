@@ -12,11 +12,13 @@ import pytest
 
 from drt_engine.core.film.shadow_catcher import catcher_ratio, combined_read
 from drt_engine.core.integrator.shadow_catcher import NOT_DENOISED
+from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Light, Material, SceneData, World
 from drt_engine.core.settings import RenderSettings, lightgroup_pass
 from tests.support import split_render
 from tests.support.scenes import plane, render_passes, top_camera, translation, uv_sphere
+from tests.support.textured_scenes import with_image_world
 
 PASSES = ("Combined", "Shadow Catcher")
 
@@ -144,3 +146,22 @@ def test_what_is_not_matched_is_named():
     plain = Renderer(replace(scene(), instances=[replace(i, shadow_catcher=False) for i in scene().instances]),
                      replace(settings, use_denoising=False))
     assert not any("shadow catcher" in w for w in plain.warnings)
+
+
+def test_renders_of_one_prepared_scene_share_the_catchers_preparation():
+    """The viewport renders a view as three coarse images and a full one, each a Renderer on one
+    prepared scene: the catchers' own preparation (lights, world table, top-level Embree scene) is
+    made once for them all, shares the scene's world table, and renders what a fresh one does."""
+    data = with_image_world(scene())
+    prepared = PreparedScene(data)
+    settings = RenderSettings(samples=4, threads=1, max_depth=4, passes=PASSES)
+    zoomed = replace(data, camera=top_camera(2.0, 0.5, 8))
+    first, second = Renderer(data, settings, prepared), Renderer(zoomed, settings, prepared)
+    only = prepared.catchers
+    assert first.integrator.catchers.paths.prepared is only and second.integrator.catchers.paths.prepared is only
+    assert only.lights.environment is prepared.lights.environment is not None
+    assert [i.name for i in only.scene.instances] == ["floor"]
+    ours, fresh = first.render().passes, Renderer(data, settings).render().passes
+    for name in PASSES:
+        assert np.array_equal(ours[name], fresh[name]), name
+    assert prepared.update(replace(data, instances=data.instances[:1])).catchers is not only

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import SceneError
 from ..geometry.accel import Geometry
+from ..integrator.shadow_catcher import catchers_only
 from ..lights.collection import Lights
 from ..scene import SceneData
 from ..shading.surface import MaterialShading, SurfaceAttributes, load_textures
@@ -42,6 +43,7 @@ class PreparedScene:
         validate_scene(scene)
         self.scene = scene
         self._keys = None  # what update() compares, made at the first update
+        self._catchers = _UNMADE  # the shadow catchers' own prepared scene (``catchers``), made when asked
         self.geometry = self._geometry(scene, scene.camera.matrix[:3, 3] if center is None else center)
         self.texture_warnings: list[str] = []
         self.textures = load_textures(scene, self.texture_warnings)
@@ -119,7 +121,19 @@ class PreparedScene:
     def _copy(self, scene: SceneData) -> "PreparedScene":
         new = copy.copy(self)
         new.scene = scene
+        new._catchers = _UNMADE
         return new
+
+    @property
+    def catchers(self) -> "PreparedScene | None":
+        """The scene of the shadow catchers alone (core.integrator.shadow_catcher), prepared at the
+        first render that asks and shared by every later one (the viewport's coarse and full images,
+        its orbits, an animation's frames): this scene's materials, images, world table and mesh
+        Embree scenes, a top level and lights of its own. None when no object is a catcher."""
+        if self._catchers is _UNMADE:
+            only = catchers_only(self.scene)
+            self._catchers = None if only is None else self.update_geometry(only, self.lights.environment)
+        return self._catchers
 
     # -- the steps of a preparation -------------------------------------------------------
     def _geometry(self, scene: SceneData, center, previous: Geometry | None = None) -> Geometry:
@@ -173,6 +187,7 @@ class PreparedScene:
 
 
 _PREPARED_FIELDS = ("meshes", "instances", "materials", "lights", "world", "images")
+_UNMADE = object()  # PreparedScene.catchers not asked for yet
 
 
 class _Keys:

@@ -94,7 +94,7 @@ class Renderer:
         self.timed = self.plan.time
         self.integrator = Integrator(prepared, scene, settings, self.plan)
         if catchers is not None:
-            only, only_settings = PreparedScene(catchers), catcher_settings(settings)
+            only, only_settings = prepared.catchers, catcher_settings(settings)
             plan = make_plan(catchers, only_settings, only.geometry, only.lights, only.shaders)
             self.integrator.catch(scene, Integrator(only, catchers, only_settings, plan))
         w, h = self.camera.window_size
