@@ -87,6 +87,46 @@ def test_extension_modes():
     assert np.all(clip == 0.0)
 
 
+def _bilinear_in_numpy(img, uv, extension):
+    """The bilinear lookup as NumPy computes it, over all points at once (the compiled kernel's
+    yardstick)."""
+    def index(i, n):
+        if extension == "REPEAT":
+            return np.mod(i, n)
+        if extension == "MIRROR":
+            period = np.mod(i, 2 * n)
+            return np.where(period < n, period, 2 * n - 1 - period)
+        return np.clip(i, 0, n - 1)
+
+    h, w = img.shape[:2]
+    x, y = uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+    with np.errstate(invalid="ignore"):
+        x0, y0 = x0.astype(np.int64), y0.astype(np.int64)
+    xa, xb, ya, yb = index(x0, w), index(x0 + 1, w), index(y0, h), index(y0 + 1, h)
+    top = img[ya, xa] * (1 - fx) + img[ya, xb] * fx
+    bottom = img[yb, xa] * (1 - fx) + img[yb, xb] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+@pytest.mark.parametrize("extension", ["REPEAT", "EXTEND", "CLIP", "MIRROR"])
+def test_bilinear_lookups_are_numpys_bit_for_bit_and_stay_inside_the_image(extension):
+    """The compiled bilinear taps give NumPy's values exactly, across the image's edges and at
+    coordinates no sane uv has (NaN, inf, past int64's range: a texel read, never memory past the
+    image), on an odd-sized image and on its mip levels."""
+    rng = np.random.default_rng(2)
+    tex = Texture(TextureImage("t", pixels=rng.random((37, 53, 4)).astype(np.float32), colorspace="Non-Color"))
+    uv = rng.random((4000, 2)) * 5 - 2
+    uv[:8] = [[np.nan, 0.5], [0.5, np.inf], [-np.inf, 0.1], [1e300, 0.5], [-1e300, 0.3], [0.5, 1e19],
+              [0.3, -5e18], [1.0, 1.0]]
+    for level in range(len(tex.levels)):
+        ours = tex._bilinear(level, uv, extension)
+        with np.errstate(invalid="ignore"):
+            assert np.array_equal(ours, _bilinear_in_numpy(tex.levels[level], uv, extension), equal_nan=True), level
+        assert np.isfinite(ours[3:]).all() and np.isnan(ours[:3]).all()
+
+
 def checker_pixels(n=256, square=2):
     i = np.arange(n) // square
     c = ((i[:, None] + i[None, :]) % 2).astype(np.float32)
