@@ -2,6 +2,7 @@
 mesh edit re-reads that mesh alone, and the prepared scene updated from the exports renders what
 a fresh preparation of the edited scene renders."""
 import dataclasses
+from pathlib import Path
 
 import bpy
 import numpy as np
@@ -78,3 +79,25 @@ def test_the_updated_prepared_scene_renders_the_edited_scene(viewport):
     ours = Renderer(moved, settings, updated).render().passes["Combined"]
     fresh = PreparedScene(moved, center=prepared.geometry.center)
     assert np.array_equal(ours, Renderer(moved, settings, fresh).render().passes["Combined"])
+
+
+def test_an_image_world_is_tabulated_again_only_when_the_world_changes(viewport):
+    """Every edit exports the world anew; the update compares its digest (and the images'), so the
+    world's sampling table (lights.environment, most of the lights' cost under an image world) stays
+    through a light edit and a move and is made again when the world is edited."""
+    world = bpy.context.scene.world
+    tree = world.node_tree
+    texture = tree.nodes.new("ShaderNodeTexEnvironment")
+    texture.image = bpy.data.images.load(str(Path(__file__).parents[1] / "data" / "grid_weight.png"))
+    background = next(node for node in tree.nodes if node.type == "BACKGROUND")
+    tree.links.new(texture.outputs["Color"], background.inputs["Color"])
+    prepared = PreparedScene(viewport()[0])
+    table = prepared.lights.environment
+    assert table is not None
+    light = next(o for o in bpy.data.objects if o.type == "LIGHT")
+    for edit in (lambda: setattr(light.data, "energy", light.data.energy * 2),
+                 lambda: setattr(bpy.data.objects["TallBox"], "location", (0.1, 0.2, 0.0))):
+        prepared = prepared.update(viewport(edit)[0])
+        assert prepared.lights.environment is table
+    prepared = prepared.update(viewport(lambda: setattr(background.inputs["Strength"], "default_value", 2.0))[0])
+    assert prepared.lights.environment is not table
