@@ -101,3 +101,19 @@ def test_an_image_world_is_tabulated_again_only_when_the_world_changes(viewport)
         assert prepared.lights.environment is table
     prepared = prepared.update(viewport(lambda: setattr(background.inputs["Strength"], "default_value", 2.0))[0])
     assert prepared.lights.environment is not table
+
+
+def test_the_viewport_traces_with_the_scenes_light_paths(viewport):
+    """Rendered shading takes the scene's Light Paths as F12 does (diffuse bounces included): only
+    the samples, the passes and the stop rules are the viewport's own."""
+    from drt_engine.blender.properties import settings_from_scene
+    from drt_engine.blender.viewport import viewport_settings
+
+    drt = bpy.context.scene.drt
+    drt.diffuse_bounces, drt.glossy_bounces, drt.transmission_bounces, drt.max_depth = 3, 5, 2, 6
+    final = settings_from_scene(bpy.context.scene, bpy.context.view_layer)
+    shown = viewport_settings(final, drt.preview_samples)
+    light_paths = ("diffuse_bounces", "glossy_bounces", "transmission_bounces", "max_depth", "min_light_bounces",
+                   "max_transparent_bounces", "sample_clamp_direct", "sample_clamp_indirect", "filter_glossy")
+    assert [getattr(shown, name) for name in light_paths] == [getattr(final, name) for name in light_paths]
+    assert (shown.diffuse_bounces, shown.samples) == (3, drt.preview_samples)
