@@ -7,6 +7,7 @@ import numpy as np
 
 from drt_engine.blender import engine as engine_module
 from drt_engine.core.render import prepared as prepared_module
+from tests.support.procedural_scenes import worst_block
 
 
 def _render_previews(materials):
@@ -51,11 +52,6 @@ def _large_preview(material, engine) -> np.ndarray:
     return np.asarray(preview.image_pixels_float[:], np.float64).reshape(height, width, 4)[..., :3]
 
 
-def _worst_block(a, b) -> float:
-    h, w = a.shape[:2]
-    return float(np.abs((a - b).reshape(h // 4, 4, w // 4, 4, 3).mean(axis=(1, 3))).max())
-
-
 def test_a_preview_is_what_cycles_shows_there_with_direct_light(drt, sample_scene, monkeypatch):
     """Previews keep diffuse surfaces to direct light (the preview scene's Light Paths, DRT's default):
     that is what Cycles' own previews show. Measured (glossy_spheres' Plastic0.05 large preview,
@@ -73,6 +69,6 @@ def test_a_preview_is_what_cycles_shows_there_with_direct_light(drt, sample_scen
     bounced = _large_preview(material, "DRT")
     for image, ok in ((drt_preview, True), (bounced, False)):
         mean_off = abs(image.mean() / cycles.mean() - 1.0)
-        worst = _worst_block(image, cycles)
+        worst = worst_block(image, cycles)
         print("diffuse bounces", 0 if ok else 4, "mean off", mean_off, "worst block", worst)
         assert (mean_off < 0.005 and worst < 0.08) == ok

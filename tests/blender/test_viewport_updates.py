@@ -2,7 +2,6 @@
 mesh edit re-reads that mesh alone, and the prepared scene updated from the exports renders what
 a fresh preparation of the edited scene renders."""
 import dataclasses
-from pathlib import Path
 
 import bpy
 import numpy as np
@@ -14,6 +13,7 @@ from drt_engine.blender.export.viewport import edited_geometry
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.settings import RenderSettings
+from tests.support import render_helpers as rh
 
 
 @pytest.fixture
@@ -88,7 +88,7 @@ def test_an_image_world_is_tabulated_again_only_when_the_world_changes(viewport)
     world = bpy.context.scene.world
     tree = world.node_tree
     texture = tree.nodes.new("ShaderNodeTexEnvironment")
-    texture.image = bpy.data.images.load(str(Path(__file__).parents[1] / "data" / "grid_weight.png"))
+    texture.image = bpy.data.images.load(str(rh.ROOT / "tests" / "data" / "grid_weight.png"))
     background = next(node for node in tree.nodes if node.type == "BACKGROUND")
     tree.links.new(texture.outputs["Color"], background.inputs["Color"])
     prepared = PreparedScene(viewport()[0])
