@@ -88,10 +88,15 @@ def test_extension_modes():
 
 
 def _bilinear_in_numpy(tex, level, uv, extension):
-    """The bilinear lookup as NumPy computes it, over all points at once, with the texel indices of
-    the NumPy lookups (Closest, Cubic): the compiled kernel's yardstick."""
+    """The bilinear lookup as NumPy computes it, over all points at once: the compiled kernels'
+    yardstick (their texel indices too)."""
     def index(i, n):
-        return tex._index(i, n, extension)
+        if extension == "REPEAT":
+            return np.mod(i, n)
+        if extension == "MIRROR":
+            period = np.mod(i, 2 * n)
+            return np.where(period < n, period, 2 * n - 1 - period)
+        return np.clip(i, 0, n - 1)
 
     img = tex.levels[level]
     h, w = img.shape[:2]

@@ -121,7 +121,7 @@ class PreparedScene:
     def _copy(self, scene: SceneData) -> "PreparedScene":
         new = copy.copy(self)
         new.scene = scene
-        new._catchers = _UNMADE
+        new._keys, new._catchers = None, _UNMADE  # of the scene it was copied from
         return new
 
     @property

@@ -1,9 +1,9 @@
 """Images as mipmapped textures: loading through OpenImageIO, filtered lookups over all hits
-of a wave, their bilinear taps in a compiled kernel.
+of a wave, their bilinear taps and texel indices in compiled kernels.
 
-OpenImageIO reads every format Blender reads. OpenImageIO's TextureSystem filters the same way, but its Python binding
-answers one point per call, a per-hit Python loop; so the pyramid (2x2 box reduction,
-as maketx's default) and the anisotropic trilinear lookup over a footprint live here.
+OpenImageIO reads every format Blender reads. Its TextureSystem filters the same way, but its
+Python binding answers one point per call, a per-hit Python loop; so the pyramid (2x2 box
+reduction, as maketx's default) and the anisotropic trilinear lookup over a footprint live here.
 
 Texel centres sit at (i + 0.5) / width as in Cycles; v = 0 is the bottom row.
 A missing or unreadable image is Blender's magenta (1, 0, 1, 1).
@@ -156,12 +156,9 @@ class Texture:
         return out
 
     def _index(self, i: np.ndarray, n: int, extension: str) -> np.ndarray:
-        if extension == "REPEAT":
-            return np.mod(i, n)
-        if extension == "MIRROR":
-            period = np.mod(i, 2 * n)
-            return np.where(period < n, period, 2 * n - 1 - period)
-        return np.clip(i, 0, n - 1)
+        out = np.empty(i.shape, np.int64)
+        wrap_indices(np.ascontiguousarray(i, np.int64).reshape(-1), n, _WRAPS.get(extension, CLAMP), out.reshape(-1))
+        return out
 
     def _closest(self, level, uv, extension):
         img = self.levels[level]
@@ -197,19 +194,28 @@ CUBIC = ("Cubic", "Smart")
 
 REPEAT, MIRROR, CLAMP = 0, 1, 2
 _WRAPS = {"REPEAT": REPEAT, "MIRROR": MIRROR}
-"""Extensions as ``bilinear`` reads them; Extend and Clip clamp to the edge texels (``lookup``
+"""Extensions as the kernels read them; Extend and Clip clamp to the edge texels (``lookup``
 blacks out what lies outside for Clip)."""
+_CAST_LIMIT, _INT64_MIN = 9.2e18, -(1 << 63)
+"""Past the limit a float's cast to int64 is undefined in compiled code; NumPy's gives int64's minimum."""
 
 
 @kernel(inline="always")
 def _wrap(i, n, mode):
-    """Texel index ``i`` of a row or column of ``n``, as ``Texture._index``."""
+    """Texel index ``i`` of a row or column of ``n`` under extension ``mode``."""
     if mode == REPEAT:
         return i % n
     if mode == MIRROR:
         period = i % (2 * n)
         return period if period < n else 2 * n - 1 - period
     return min(max(i, 0), n - 1)
+
+
+@kernel
+def wrap_indices(i, n, mode, out):
+    """``out[k]``: texel index ``i[k]`` wrapped (``_wrap``), for the Closest and Cubic lookups."""
+    for k in range(i.shape[0]):
+        out[k] = _wrap(i[k], n, mode)
 
 
 @kernel
@@ -226,8 +232,8 @@ def bilinear(img, uv, mode, out):
         y = uv[k, 1] * h - 0.5
         x0, y0 = np.floor(x), np.floor(y)
         fx, fy = x - x0, y - y0
-        ix = int(x0) if abs(x0) < 9.2e18 else -9223372036854775808
-        iy = int(y0) if abs(y0) < 9.2e18 else -9223372036854775808
+        ix = int(x0) if abs(x0) < _CAST_LIMIT else _INT64_MIN
+        iy = int(y0) if abs(y0) < _CAST_LIMIT else _INT64_MIN
         xa, xb = _wrap(ix, w, mode), _wrap(ix + 1, w, mode)
         ya, yb = _wrap(iy, h, mode), _wrap(iy + 1, h, mode)
         for c in range(img.shape[2]):
