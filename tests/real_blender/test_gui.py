@@ -31,9 +31,11 @@ SHARED = {  # Blender's own panels DRT relies on, by the Properties tab they sit
 GUI_TIMEOUT = 1200
 """Seconds the whole GUI session may take (about 60 s seen on 2 loaded cores before the timed
 viewport steps, which add 50 orbit steps and 20 edits)."""
-MEMORY_DRIFT_MB = 30.0
-"""Resident anonymous memory (RssAnon, what a leak grows; see gui_driver.resident_mb): the mean of
-the last ten timed viewport steps within this of the first ten's."""
+MEMORY_DRIFT_MB = 15.0
+"""Memory held by Blender with the viewport's render finished (RssAnon, what a leak grows, with
+jemalloc's freed pages purged; gui_driver.settled_mb): after the last two timed viewport steps
+within this of after the fifth and tenth (the 60 steps between: a leak of a third of a MB per
+step fails it by 20 MB). Read mid-render instead, RssAnon swings by about 100 MB within one run."""
 
 
 @pytest.fixture(scope="module")
@@ -86,6 +88,7 @@ def viewport_summary(times) -> dict | None:
         values = [s[key] for s in steps]
         out[f"{key}_first_ten"], out[f"{key}_last_ten"] = (round(float(np.mean(values[:10])), 1),
                                                            round(float(np.mean(values[-10:])), 1))
+    out["settled_mb"] = [s["settled_mb"] for s in steps if "settled_mb" in s]
     out["window_redraw_s"] = times["window_redraw_s"]
     return out
 
@@ -173,8 +176,8 @@ def test_viewport_renders_in_rendered_shading(gui):
 
 def test_viewport_full_resolution_after_orbits_and_edits(gui):
     """Maximised, the viewport reaches an image of the region's size after every orbit step
-    and edit, the orbit changes the picture, and memory stays flat over the 70 steps (the
-    timings are measured, written to out/ui/viewport_times.json, not asserted here)."""
+    and edit, the orbit changes the picture, and the memory held stays flat over the 70 steps
+    (the timings are measured, written to out/ui/viewport_times.json, not asserted here)."""
     times = gui["viewport_times"]
     width, height = times["region"]
     assert times["region"] == [1280, 720]
@@ -185,8 +188,9 @@ def test_viewport_full_resolution_after_orbits_and_edits(gui):
     before, after = screenshot(gui, "viewport_full_resolution"), screenshot(gui, "viewport_orbit")
     assert float(np.abs(after - before).mean()) > 0.005
     assert wall_share(after, 0) > 0.01  # the red wall, rendered
-    anon = [s["anon_mb"] for s in steps]
-    assert abs(np.mean(anon[-10:]) - np.mean(anon[:10])) <= MEMORY_DRIFT_MB, anon
+    settled = [s["settled_mb"] for s in steps if "settled_mb" in s]
+    assert len(settled) == 4
+    assert abs(np.mean(settled[2:]) - np.mean(settled[:2])) <= MEMORY_DRIFT_MB, settled
 
 
 def test_viewport_stops_with_rendered_shading(gui):

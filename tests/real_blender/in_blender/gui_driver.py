@@ -13,6 +13,7 @@ status line), with times. Screenshots of the whole X screen (``import -window ro
 to OUTDIR/NN_name.png and what Blender says to OUTDIR/state.json, which the test on the
 host checks. Blender quits at the end, also after an error (recorded in the state).
 """
+import ctypes
 import importlib
 import json
 import math
@@ -319,6 +320,25 @@ def resident_mb(field: str = "VmRSS") -> float:
         return next(int(line.split()[1]) / 1024.0 for line in status if line.startswith(field + ":"))
 
 
+def settled_mb():
+    """RssAnon with nothing in flight: yields until the viewport's worker has finished its render,
+    then purges the freed pages jemalloc (this Blender's allocator) keeps for reuse, so what stays
+    resident is what is held. Read right after a step's first full-resolution image, RssAnon
+    also counts the running render's buffers and the freed pages jemalloc returns over about ten
+    seconds: 670-775 MB within one run; settled, 533-543 MB over the same run's 70 steps."""
+    since = time.monotonic()
+    while viewport_threads():
+        if time.monotonic() - since > RENDER_TIMEOUT:
+            raise RuntimeError("the viewport's render did not finish")
+        yield 0.05
+    purged = ctypes.CDLL(None).mallctl(b"arena.4096.purge", None, None, None, ctypes.c_size_t(0))  # 4096: every arena
+    if purged != 0:
+        raise RuntimeError(f"jemalloc's mallctl arena.4096.purge failed ({purged})")
+    return round(resident_mb("RssAnon"), 1)
+
+
+SETTLED_AFTER = {"orbits": (4, 9), "edits": (14, 19)}
+"""Steps after which the memory held is measured (settled_mb): two near the start, two at the end."""
 STEP_TIMEOUT = 30.0
 """Seconds one timed orbit step or edit may take to reach its full-resolution image."""
 
@@ -348,7 +368,9 @@ def measure_viewport(window, view3d, scene):
     """The 3D view maximised: ORBITS orbit steps (the view matrix turned as a user's drag
     turns it), then EDITS edits (a light's colour, an object moved, in turn), each timed from
     the change to the first new image drawn and to the first full-resolution one, with the
-    resident memory after each; written to OUTDIR/viewport_times.json."""
+    resident memory after each and, after the steps SETTLED_AFTER names, the memory held once
+    the render has finished (the next step then starts from a finished render); written to
+    OUTDIR/viewport_times.json."""
     with bpy.context.temp_override(window=window, area=view3d):
         bpy.ops.screen.screen_full_area(use_hide_panels=True)
     yield 2.0
@@ -367,6 +389,8 @@ def measure_viewport(window, view3d, scene):
         first, done, seen = yield from wait_for_image(since, full)
         times["orbits"].append({"first_image_s": first, "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
                                 "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
+        if step in SETTLED_AFTER["orbits"]:
+            times["orbits"][-1]["settled_mb"] = yield from settled_mb()
         if step == 0:
             shot("viewport_orbit")
     light = next(o for o in scene.objects if o.type == "LIGHT")
@@ -381,6 +405,8 @@ def measure_viewport(window, view3d, scene):
         times["edits"].append({"kind": "transform" if step % 2 else "light", "first_image_s": first,
                                "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
                                "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
+        if step in SETTLED_AFTER["edits"]:
+            times["edits"][-1]["settled_mb"] = yield from settled_mb()
     with bpy.context.temp_override(window=window, area=view3d, region=region):
         started = time.monotonic()
         bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=REDRAWS)
