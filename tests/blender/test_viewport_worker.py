@@ -1,11 +1,11 @@
 """The viewport's worker: a new view of the same scene reuses its prepared scene, a new scene
-prepares again, each view shows its coarse levels first and ends with what a render of that
+prepares again, each view shows its coarse image first and ends with what a render of that
 camera gives."""
 import dataclasses
 
 import numpy as np
 
-from drt_engine.blender.export.viewport import level_cameras
+from drt_engine.blender.export.viewport import coarse_divisor, level_cameras
 from drt_engine.blender.viewport import ViewportRender
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.render.render import Renderer
@@ -42,10 +42,10 @@ def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
     for eye in ((0, -5, 2), (3, -4, 1.5)):
         camera = Camera(look_at(eye, (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (24, 16))
         shapes.seen.clear()
-        viewport.start(base, level_cameras(camera), settings)
+        viewport.start(base, level_cameras(camera, 8), settings)
         images.append(finish(viewport))
-        # one sample at 1/8, 1/4, 1/2 of the size, then the full size (once per round and at the end)
-        assert shapes.seen[:3] == [(2, 3), (4, 6), (8, 12)] and set(shapes.seen[3:]) == {(16, 24)}, shapes.seen
+        # one sample at 1/8 of the size, then the full size (once per round and at the end)
+        assert shapes.seen[0] == (2, 3) and set(shapes.seen[1:]) == {(16, 24)} and len(shapes.seen) > 1, shapes.seen
         prepared.append(viewport._prepared[1])
         moved = dataclasses.replace(base, camera=camera)  # prepared anew around the first view's centre
         expected = Renderer(moved, settings, PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes["Combined"]
@@ -56,6 +56,19 @@ def test_a_new_view_reuses_the_prepared_scene_and_renders_its_camera():
     viewport.start(other, [other.camera], settings)
     finish(viewport)
     assert viewport._prepared[1] is not prepared[0]
+
+
+def test_the_coarse_image_is_an_eighth_with_its_long_side_128_pixels_or_more():
+    """As Cycles' viewport starts a view: 1/8 of a large region, less where that would leave the
+    long side under 128 pixels, none for a region under 256."""
+    assert [coarse_divisor(size) for size in ((1280, 720), (720, 1280), (3840, 2160), (600, 400), (300, 40),
+                                              (255, 255), (24, 16))] == [8, 8, 8, 4, 2, 1, 1]
+    camera = Camera(look_at((0, -5, 2), (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (1280, 720), window=(0, 0, 640, 720))
+    coarse, full = level_cameras(camera)
+    assert coarse.resolution == (160, 90) and coarse.window == (0, 0, 160, 90) and coarse.frame == camera.frame
+    assert full is camera
+    small = dataclasses.replace(camera, resolution=(200, 120), window=None)
+    assert level_cameras(small) == [small]
 
 
 def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_render():

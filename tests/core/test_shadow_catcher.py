@@ -149,7 +149,7 @@ def test_what_is_not_matched_is_named():
 
 
 def test_renders_of_one_prepared_scene_share_the_catchers_preparation():
-    """The viewport renders a view as three coarse images and a full one, each a Renderer on one
+    """The viewport renders a view as a coarse image and a full one, each a Renderer on one
     prepared scene: the catchers' own preparation (lights, world table, top-level Embree scene) is
     made once for them all, shares the scene's world table, and renders what a fresh one does."""
     data = with_image_world(scene())

@@ -7,7 +7,7 @@ window and the clipping range are read off the region's projection
 (``window_matrix``) and the camera placement off the inverse ``view_matrix``, so the
 image lines up with the overlays drawn on top of it. The viewport renders with a
 pinhole (no depth of field), at the region's size in pixels (HiDPI included: Blender gives
-the region in pixels), after coarse images at fractions of it.
+the region in pixels), after one coarse image at a fraction of it.
 """
 from __future__ import annotations
 
@@ -17,18 +17,32 @@ import numpy as np
 
 from ...core.scene import Camera
 
-COARSE_LEVELS = (8, 4, 2)
-"""Divisors of the region's size for the coarse images drawn (stretched) before the full one:
-each one sample, so a new view shows within a fraction of the full image's first sample."""
+COARSE_DIVISOR = 8
+"""A new view first shows one sample at this fraction of the region's size, drawn stretched, then
+the full size, as Cycles' viewport does (render_scheduler.cpp: its start resolution divider is 8
+times the pixel size, and once the view holds still it goes to the full resolution at once).
+Halving steps between the two (1/4, 1/2, as DRT drew before) delayed the Cornell box's first
+full-resolution image in a 1280x720 region by about 0.4 s (the GUI test's worker events, in
+out/ui/viewport_times.json)."""
+COARSE_MIN_AXIS = 128
+"""The coarse image's long side keeps at least this many pixels (Cycles' preferred minimum); a
+region too small for that has no coarse image."""
 
 
-def level_cameras(camera: Camera, divisors=COARSE_LEVELS) -> list[Camera]:
-    """``camera`` at its resolution divided by each of ``divisors`` (at least one pixel a side),
-    then itself: the same window of the scene at coarser pixel grids."""
+def coarse_divisor(resolution: tuple[int, int]) -> int:
+    """The divisor of the coarse image for a region of ``resolution`` pixels; 1: none."""
+    return max(1, min(COARSE_DIVISOR, max(resolution) // COARSE_MIN_AXIS))
+
+
+def level_cameras(camera: Camera, divisor: int | None = None) -> list[Camera]:
+    """``camera`` at its resolution divided by ``divisor`` (default: coarse_divisor's; at least
+    one pixel a side), then itself: the same window of the scene at a coarser pixel grid first."""
     width, height = camera.resolution
-    coarse = [dataclasses.replace(camera, resolution=(max(1, width // d), max(1, height // d)), window=None)
-              for d in divisors]
-    return coarse + [camera]
+    divisor = coarse_divisor(camera.resolution) if divisor is None else divisor
+    if divisor <= 1:
+        return [camera]
+    return [dataclasses.replace(camera, resolution=(max(1, width // divisor), max(1, height // divisor)), window=None),
+            camera]
 
 
 def edited_geometry(updates) -> set[str]:
