@@ -192,6 +192,30 @@ def _update_scene_passes(self, context):
         view_layer.update_render_passes()
 
 
+_PREFILTERS = (
+    ("NONE", "None", "No prefiltering: the albedo and normal are taken as noise-free (sharpest "
+     "where they are, e.g. without depth of field or motion blur)"),
+    ("FAST", "Fast", "The denoiser allows for noise in the albedo and normal itself"),
+    ("ACCURATE", "Accurate", "The albedo and normal are denoised first, each on its own, then "
+     "guide the image's denoising (slowest, best detail)"),
+)
+"""Cycles' denoising prefilters, for final renders and the viewport alike."""
+_QUALITIES = (
+    ("HIGH", "High", "Best quality (for final frames)"),
+    ("BALANCED", "Balanced", "Faster, somewhat lower quality"),
+    ("FAST", "Fast", "Fastest, lowest quality (for previews)"),
+)
+"""OpenImageDenoise's quality modes, as Cycles names them."""
+
+
+def _denoising_option(name: str, default: str, where: str = "") -> dict:
+    """The arguments of a denoiser's Prefilter or Quality, as Cycles' options."""
+    what = ("How the albedo and normal that guide the denoiser are cleaned" if name == "Prefilter"
+            else "OpenImageDenoise's quality mode")
+    return {"name": name, "description": f"{what}{where}, as Cycles' option", "default": default,
+            "items": _PREFILTERS if name == "Prefilter" else _QUALITIES}
+
+
 def _bounces(name: str, description: str, default: int = 0, soft_max: int = 64) -> dict:
     """The arguments of a count of bounces, as the Light Paths panel shows them."""
     return {"name": name, "description": description, "default": default, "min": 0, "soft_max": soft_max,
@@ -380,8 +404,8 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     use_preview_denoising: BoolProperty(
         name="Denoise Viewport",
-        description="Denoise the viewport's Rendered shading with OpenImageDenoise from the start sample on "
-        "(Fast prefilter, Balanced quality, as Cycles' viewport defaults), on the viewport's worker thread",
+        description="Denoise the viewport's Rendered shading with OpenImageDenoise from the start sample on, "
+        "on the viewport's worker thread",
         default=False,
     )
     preview_denoising_start_sample: IntProperty(
@@ -390,28 +414,10 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
         default=1,
         min=1,
     )
-    denoising_prefilter: EnumProperty(
-        name="Prefilter",
-        description="How the albedo and normal that guide the denoiser are cleaned, as Cycles' option",
-        items=(
-            ("NONE", "None", "No prefiltering: the albedo and normal are taken as noise-free (sharpest "
-             "where they are, e.g. without depth of field or motion blur)"),
-            ("FAST", "Fast", "The denoiser allows for noise in the albedo and normal itself"),
-            ("ACCURATE", "Accurate", "The albedo and normal are denoised first, each on its own, then "
-             "guide the image's denoising (slowest, best detail)"),
-        ),
-        default="ACCURATE",
-    )
-    denoising_quality: EnumProperty(
-        name="Quality",
-        description="OpenImageDenoise's quality mode, as Cycles' option",
-        items=(
-            ("HIGH", "High", "Best quality (for final frames)"),
-            ("BALANCED", "Balanced", "Faster, somewhat lower quality"),
-            ("FAST", "Fast", "Fastest, lowest quality (for previews)"),
-        ),
-        default="HIGH",
-    )
+    preview_denoising_prefilter: EnumProperty(**_denoising_option("Prefilter", "FAST", " in the viewport"))
+    preview_denoising_quality: EnumProperty(**_denoising_option("Quality", "BALANCED", " in the viewport"))
+    denoising_prefilter: EnumProperty(**_denoising_option("Prefilter", "ACCURATE"))
+    denoising_quality: EnumProperty(**_denoising_option("Quality", "HIGH"))
 
     sample_offset: IntProperty(
         name="Sample Offset",

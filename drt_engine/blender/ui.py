@@ -148,6 +148,8 @@ class DRT_PT_sampling_denoise(DRTButtonsPanel, bpy.types.Panel):
         col = layout.column()
         col.enabled = reason is None
         col.active = drt.use_preview_denoising
+        col.prop(drt, "preview_denoising_prefilter")
+        col.prop(drt, "preview_denoising_quality")
         col.prop(drt, "preview_denoising_start_sample")
         if reason is not None:
             layout.label(text=reason, icon="INFO")

@@ -57,8 +57,8 @@ def viewport_settings(settings, preview_samples: int):
 
 
 VIEWPORT_PREFILTER, VIEWPORT_QUALITY = "FAST", "BALANCED"
-"""How the viewport denoises: Cycles' defaults for its viewport denoiser (preview_denoising_prefilter
-and preview_denoising_quality), quicker than a final render's Accurate / High."""
+"""The viewport denoiser's prefilter and quality unless the scene says (preview_denoising_prefilter
+and preview_denoising_quality): Cycles' defaults for them, quicker than a final render's Accurate / High."""
 
 
 @dataclasses.dataclass
@@ -67,6 +67,8 @@ class ViewDenoise:
     worker thread (Blender's UI thread never waits for it)."""
     denoiser: object  # core.film.denoiser.Denoiser
     start_sample: int = 1
+    prefilter: str = VIEWPORT_PREFILTER
+    quality: str = VIEWPORT_QUALITY
 
     def settings(self, settings):
         """The viewport's settings with the features the denoiser needs traced."""
@@ -80,7 +82,7 @@ class ViewDenoise:
             return combined, False
         out = combined.copy()
         out[..., :3] = filters.denoise(combined, passes.get(FEATURE_PASSES[0]), passes.get(FEATURE_PASSES[1]),
-                                       prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+                                       prefilter=self.prefilter, quality=self.quality)
         return out, True
 
 
@@ -93,7 +95,9 @@ def view_denoise(scene) -> ViewDenoise | None:
     from ..core.film.denoiser import load
 
     try:
-        return ViewDenoise(load(path), scene.drt.preview_denoising_start_sample)
+        drt = scene.drt
+        return ViewDenoise(load(path), drt.preview_denoising_start_sample, drt.preview_denoising_prefilter,
+                           drt.preview_denoising_quality)
     except DRTError as error:
         print(f"DRT: the viewport is not denoised: {one_line(str(error))}")
         return None

@@ -223,7 +223,7 @@ def test_the_denoise_setting_greys_out_with_the_reason_where_blender_has_no_oidn
 
     scene = bpy.context.scene
     names = ("use_denoising", "use_preview_denoising", "denoising_prefilter", "denoising_quality",
-             "preview_denoising_start_sample")
+             "preview_denoising_prefilter", "preview_denoising_quality", "preview_denoising_start_sample")
     assert oidn.oidn_library() is not None  # the bpy 5.0 wheel ships it
     props, labels = _draw(DRT_PT_sampling_denoise, scene)
     assert all(props[name].enabled for name in names) and not labels
@@ -334,6 +334,9 @@ def test_the_viewport_denoises_only_when_asked_and_where_blender_has_oidn(drt, m
     scene.drt.use_preview_denoising = True
     denoise = view_denoise(scene)
     assert isinstance(denoise, ViewDenoise) and denoise.start_sample == 3
+    assert (denoise.prefilter, denoise.quality) == ("FAST", "BALANCED")  # Cycles' viewport defaults
+    scene.drt.preview_denoising_prefilter, scene.drt.preview_denoising_quality = "ACCURATE", "FAST"
+    assert (view_denoise(scene).prefilter, view_denoise(scene).quality) == ("ACCURATE", "FAST")
     monkeypatch.setattr(oidn, "search", lambda: None)
     assert view_denoise(scene) is None
 
@@ -342,6 +345,8 @@ def test_the_settings_choices_are_the_cores(drt):
     from drt_engine.core.settings import DENOISING_PREFILTERS, DENOISING_QUALITIES
 
     props = bpy.types.Scene.bl_rna.properties["drt"].fixed_type.properties
-    assert tuple(i.identifier for i in props["denoising_prefilter"].enum_items) == DENOISING_PREFILTERS
-    assert tuple(i.identifier for i in props["denoising_quality"].enum_items) == DENOISING_QUALITIES
+    for name in ("denoising_prefilter", "preview_denoising_prefilter"):
+        assert tuple(i.identifier for i in props[name].enum_items) == DENOISING_PREFILTERS
+    for name in ("denoising_quality", "preview_denoising_quality"):
+        assert tuple(i.identifier for i in props[name].enum_items) == DENOISING_QUALITIES
     assert props["use_denoising"].default is False and props["denoising_prefilter"].default == "ACCURATE"

@@ -73,8 +73,8 @@ def test_the_coarse_image_is_an_eighth_with_its_long_side_128_pixels_or_more():
 
 def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_render():
     """Below the start sample the image is as traced; from it on, denoised on the worker thread: the
-    last image is the render's Combined through the same denoiser (Fast prefilter, Balanced quality,
-    the features traced with it)."""
+    last image is the render's Combined through the same denoiser (Fast prefilter, Balanced quality
+    unless the scene chose others, the features traced with it)."""
     from drt_engine.blender.viewport import VIEWPORT_PREFILTER, VIEWPORT_QUALITY, ViewDenoise
     from drt_engine.core.film import denoiser
     from tests.support.oidn import require_oidn
@@ -89,14 +89,19 @@ def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_re
     denoised = passes["Combined"].copy()
     denoised[..., :3] = oidn.denoise(passes["Combined"], passes["Denoising Albedo"], passes["Denoising Normal"],
                                      prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
-    for start, expected, note in ((2, denoised, True), (5, passes["Combined"], False)):
+    chosen = denoised.copy()  # the scene's own prefilter and quality
+    chosen[..., :3] = oidn.denoise(passes["Combined"], passes["Denoising Albedo"], passes["Denoising Normal"],
+                                   prefilter="ACCURATE", quality="FAST")
+    for start, options, expected, note in ((2, {}, denoised, True), (5, {}, passes["Combined"], False),
+                                           (2, {"prefilter": "ACCURATE", "quality": "FAST"}, chosen, True)):
         statuses = []
         viewport = ViewportRender(lambda: statuses.append(viewport.status))
-        viewport.start(base, level_cameras(camera), settings, dataclasses.replace(denoise, start_sample=start))
+        viewport.start(base, level_cameras(camera), settings, dataclasses.replace(denoise, start_sample=start, **options))
         image = finish(viewport)
         assert statuses[-1].startswith("Done") and statuses[-1].endswith("| Denoised") == note, statuses[-1]
         np.testing.assert_array_equal(image, expected.astype(np.float32))
     assert not np.array_equal(denoised[..., :3], passes["Combined"][..., :3])
+    assert not np.array_equal(denoised[..., :3], chosen[..., :3])
 
 
 def test_views_share_the_denoisers_filters_until_the_viewport_closes():
