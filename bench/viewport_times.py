@@ -58,11 +58,12 @@ def table(times: dict) -> str:
     anon, rss = [s["anon_mb"] for s in steps], [s["rss_mb"] for s in steps]
     after = [str(i + 1) for i, s in enumerate(steps) if "settled_mb" in s]
     held = [f"{s['settled_mb']:.0f}" for s in steps if "settled_mb" in s]
+    heap = [f"{s['heap_mb']:.0f}" for s in steps if "heap_mb" in s]
     rows += ["", f"Blender's anonymous resident memory over the {len(steps)} steps: {mean(anon[:10]):.0f} MB "
              f"over the first ten, {mean(anon[-10:]):.0f} MB over the last ten (all resident memory: "
              f"{mean(rss[:10]):.0f} and {mean(rss[-10:]):.0f} MB, both read while the render runs); held with "
              f"the render finished and jemalloc's freed pages purged, after steps {', '.join(after)}: "
-             f"{', '.join(held)} MB. One redraw of Blender's window took "
+             f"{', '.join(held)} MB (jemalloc's live bytes: {', '.join(heap)} MB). One redraw of Blender's window took "
              f"{times['window_redraw_s']:.2f} s here (software OpenGL): an image is on screen at the "
              "first redraw after the worker publishes it."]
     return "\n".join(rows)

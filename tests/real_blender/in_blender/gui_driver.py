@@ -321,20 +321,28 @@ def resident_mb(field: str = "VmRSS") -> float:
 
 
 def settled_mb():
-    """RssAnon with nothing in flight: yields until the viewport's worker has finished its render,
-    then purges the freed pages jemalloc (this Blender's allocator) keeps for reuse, so what stays
-    resident is what is held. Read right after a step's first full-resolution image, RssAnon
-    also counts the running render's buffers and the freed pages jemalloc returns over about ten
-    seconds: 670-775 MB within one run; settled, 533-543 MB over the same run's 70 steps."""
+    """(RssAnon, jemalloc's live bytes) in MB with nothing in flight: yields until the viewport's
+    worker has finished its render, then purges the freed pages jemalloc (this Blender's allocator)
+    keeps for reuse. Read right after a step's first full-resolution image, RssAnon also counts the
+    running render's buffers and the freed pages jemalloc returns over about ten seconds: 670-775 MB
+    within one run. Settled, it still moves between runs by what is mapped outside jemalloc (-1 to
+    +17 MB from step 5 to step 70 in four runs) while jemalloc's live bytes, everything malloc'd
+    (Blender, Python's larger objects, NumPy's and the kernels' arrays, Embree's small blocks), held
+    within 0.3 MB."""
     since = time.monotonic()
     while viewport_threads():
         if time.monotonic() - since > RENDER_TIMEOUT:
             raise RuntimeError("the viewport's render did not finish")
         yield 0.05
-    purged = ctypes.CDLL(None).mallctl(b"arena.4096.purge", None, None, None, ctypes.c_size_t(0))  # 4096: every arena
-    if purged != 0:
-        raise RuntimeError(f"jemalloc's mallctl arena.4096.purge failed ({purged})")
-    return round(resident_mb("RssAnon"), 1)
+    jemalloc = ctypes.CDLL(None)
+    purged = jemalloc.mallctl(b"arena.4096.purge", None, None, None, ctypes.c_size_t(0))  # 4096: every arena
+    size = ctypes.c_size_t(8)
+    epoch, allocated = ctypes.c_uint64(1), ctypes.c_size_t(0)
+    refreshed = jemalloc.mallctl(b"epoch", ctypes.byref(epoch), ctypes.byref(size), ctypes.byref(epoch), size)
+    read = jemalloc.mallctl(b"stats.allocated", ctypes.byref(allocated), ctypes.byref(size), None, ctypes.c_size_t(0))
+    if purged or refreshed or read:
+        raise RuntimeError(f"jemalloc's mallctl failed (purge {purged}, epoch {refreshed}, stats.allocated {read})")
+    return round(resident_mb("RssAnon"), 1), round(allocated.value / 2**20, 1)
 
 
 SETTLED_AFTER = {"orbits": (4, 9), "edits": (14, 19)}
@@ -390,7 +398,7 @@ def measure_viewport(window, view3d, scene):
         times["orbits"].append({"first_image_s": first, "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
                                 "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
         if step in SETTLED_AFTER["orbits"]:
-            times["orbits"][-1]["settled_mb"] = yield from settled_mb()
+            times["orbits"][-1]["settled_mb"], times["orbits"][-1]["heap_mb"] = yield from settled_mb()
         if step == 0:
             shot("viewport_orbit")
     light = next(o for o in scene.objects if o.type == "LIGHT")
@@ -406,7 +414,7 @@ def measure_viewport(window, view3d, scene):
                                "full_resolution_s": done, "rss_mb": round(resident_mb(), 1),
                                "anon_mb": round(resident_mb("RssAnon"), 1), "worker": seen})
         if step in SETTLED_AFTER["edits"]:
-            times["edits"][-1]["settled_mb"] = yield from settled_mb()
+            times["edits"][-1]["settled_mb"], times["edits"][-1]["heap_mb"] = yield from settled_mb()
     with bpy.context.temp_override(window=window, area=view3d, region=region):
         started = time.monotonic()
         bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=REDRAWS)
