@@ -103,16 +103,17 @@ def measure_denoise() -> dict:
     from drt_engine.blender.export.viewport import level_cameras
     from drt_engine.blender.oidn import oidn_library
     from drt_engine.blender.properties import settings_from_scene
-    from drt_engine.blender.viewport import VIEWPORT_PREFILTER, VIEWPORT_QUALITY, ViewDenoise, ViewportRender, \
-        viewport_settings
-    from drt_engine.core.film.denoiser import load
+    from drt_engine.blender.viewport import ViewportRender, view_denoise, viewport_settings
 
     drt_engine.register()
     if oidn_library() is None:
         sys.exit("error: this Blender has no OpenImageDenoise library")
     scene, data = bench_scenes.load("cornell_box", 1280, 720)
     settings = viewport_settings(settings_from_scene(scene, scene.view_layers[0]), scene.drt.preview_samples)
-    denoise = ViewDenoise(load(oidn_library()), scene.drt.preview_denoising_start_sample)
+    scene.drt.use_preview_denoising = True  # the scene's own viewport denoising settings otherwise
+    denoise = view_denoise(scene)
+    if denoise is None:
+        sys.exit("error: OpenImageDenoise did not load (the console says why)")
     cameras = level_cameras(data.camera)
     full = FullImage()
     full.viewport = ViewportRender(full)
@@ -127,11 +128,11 @@ def measure_denoise() -> dict:
     with denoise.denoiser.filters() as filters:
         for _ in range(DENOISE_RUNS + 1):
             start = time.perf_counter()
-            filters.denoise(image, features, features, VIEWPORT_PREFILTER, VIEWPORT_QUALITY)
+            filters.denoise(image, features, features, denoise.prefilter, denoise.quality)
             times.setdefault("oidn", []).append(time.perf_counter() - start)
     times["oidn"] = times["oidn"][1:]  # the first also sets the filter up
     return dict(times, resolution=list(cameras[-1].resolution), start_sample=denoise.start_sample,
-                prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY, blender=bpy.app.version_string)
+                prefilter=denoise.prefilter, quality=denoise.quality, blender=bpy.app.version_string)
 
 
 def denoise_table(m: dict) -> str:

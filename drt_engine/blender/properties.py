@@ -208,12 +208,17 @@ _QUALITIES = (
 """OpenImageDenoise's quality modes, as Cycles names them."""
 
 
+_DENOISING_OPTIONS = {
+    "Prefilter": ("How the albedo and normal that guide the denoiser are cleaned", _PREFILTERS),
+    "Quality": ("OpenImageDenoise's quality mode", _QUALITIES),
+}
+
+
 def _denoising_option(name: str, default: str, where: str = "") -> dict:
-    """The arguments of a denoiser's Prefilter or Quality, as Cycles' options."""
-    what = ("How the albedo and normal that guide the denoiser are cleaned" if name == "Prefilter"
-            else "OpenImageDenoise's quality mode")
-    return {"name": name, "description": f"{what}{where}, as Cycles' option", "default": default,
-            "items": _PREFILTERS if name == "Prefilter" else _QUALITIES}
+    """The arguments of a denoiser's Prefilter or Quality (final renders, or the viewport's
+    ``where``), as Cycles' options: the scene's properties hold their defaults, nothing else."""
+    what, items = _DENOISING_OPTIONS[name]
+    return {"name": name, "description": f"{what}{where}, as Cycles' option", "default": default, "items": items}
 
 
 def _bounces(name: str, description: str, default: int = 0, soft_max: int = 64) -> dict:

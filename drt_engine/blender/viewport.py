@@ -56,19 +56,15 @@ def viewport_settings(settings, preview_samples: int):
                                sample_start=0, sample_end=0, use_denoising=False)
 
 
-VIEWPORT_PREFILTER, VIEWPORT_QUALITY = "FAST", "BALANCED"
-"""The viewport denoiser's prefilter and quality unless the scene says (preview_denoising_prefilter
-and preview_denoising_quality): Cycles' defaults for them, quicker than a final render's Accurate / High."""
-
-
 @dataclasses.dataclass
 class ViewDenoise:
     """Denoising of the viewport's full-resolution images from ``start_sample`` samples on, on the
-    worker thread (Blender's UI thread never waits for it)."""
+    worker thread (Blender's UI thread never waits for it), with the scene's viewport prefilter and
+    quality (view_denoise)."""
     denoiser: object  # core.film.denoiser.Denoiser
-    start_sample: int = 1
-    prefilter: str = VIEWPORT_PREFILTER
-    quality: str = VIEWPORT_QUALITY
+    start_sample: int
+    prefilter: str
+    quality: str
 
     def settings(self, settings):
         """The viewport's settings with the features the denoiser needs traced."""

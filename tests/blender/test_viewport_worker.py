@@ -75,7 +75,7 @@ def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_re
     """Below the start sample the image is as traced; from it on, denoised on the worker thread: the
     last image is the render's Combined through the same denoiser (Fast prefilter, Balanced quality
     unless the scene chose others, the features traced with it)."""
-    from drt_engine.blender.viewport import VIEWPORT_PREFILTER, VIEWPORT_QUALITY, ViewDenoise
+    from drt_engine.blender.viewport import ViewDenoise
     from drt_engine.core.film import denoiser
     from tests.support.oidn import require_oidn
 
@@ -84,11 +84,11 @@ def test_viewport_denoising_starts_at_its_start_sample_and_ends_as_a_denoised_re
     settings = RenderSettings(samples=4, threads=1)
     camera = Camera(look_at((0, -5, 2), (0, 0, 0.5))[None], (-0.3, 0.3, -0.3, 0.3), (48, 32))
     moved = dataclasses.replace(base, camera=camera)
-    denoise = ViewDenoise(oidn, start_sample=2)
+    denoise = ViewDenoise(oidn, 2, "FAST", "BALANCED")  # Cycles' viewport defaults
     passes = Renderer(moved, denoise.settings(settings), PreparedScene(moved, base.camera.matrix[:3, 3])).render().passes
     denoised = passes["Combined"].copy()
     denoised[..., :3] = oidn.denoise(passes["Combined"], passes["Denoising Albedo"], passes["Denoising Normal"],
-                                     prefilter=VIEWPORT_PREFILTER, quality=VIEWPORT_QUALITY)
+                                     prefilter=denoise.prefilter, quality=denoise.quality)
     chosen = denoised.copy()  # the scene's own prefilter and quality
     chosen[..., :3] = oidn.denoise(passes["Combined"], passes["Denoising Albedo"], passes["Denoising Normal"],
                                    prefilter="ACCURATE", quality="FAST")
