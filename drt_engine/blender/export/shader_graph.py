@@ -455,7 +455,7 @@ class Compiler:
                                 altitude=float(node.altitude), air_density=float(node.air_density),
                                 aerosol_density=float(_aerosol_density(node)),
                                 ozone_density=float(node.ozone_density), sun_direction=tuple(node.sun_direction),
-                                turbidity=float(node.turbidity)), 0
+                                turbidity=float(node.turbidity), ground_albedo=float(node.ground_albedo)), 0
 
     def _node_ShaderNodeMapping(self, node, output):
         v = self._in(node, "Vector", "vector")

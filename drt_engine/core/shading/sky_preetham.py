@@ -15,12 +15,26 @@ def _perez(lam, theta, gamma):
                                                                + lam[4] * np.cos(gamma) ** 2)
 
 
+def sun_angles(sun_direction) -> tuple[float, float]:
+    """(theta, phi) of the sun's direction as Cycles' sky_spherical_coordinates gives them (the
+    direction normalised, as Blender hands it to Cycles); Hosek-Wilkie's sun too."""
+    sx, sy, sz = np.asarray(sun_direction, float) / max(float(np.linalg.norm(sun_direction)), 1e-30)
+    return math.acos(min(max(sz, -1.0), 1.0)), math.atan2(sx, sy)
+
+
+def view_angles(d: np.ndarray, sun_theta: float, sun_phi: float) -> tuple[np.ndarray, np.ndarray]:
+    """(theta, gamma) per direction: its zenith angle, held just above the horizon as Cycles holds
+    it, and its angle to the sun (svm sky.h; Hosek-Wilkie's too)."""
+    theta = np.arccos(np.clip(d[:, 2], -1.0, 1.0))
+    phi = -np.arctan2(d[:, 1], d[:, 0]) + math.pi / 2
+    cos_gamma = np.sin(theta) * math.sin(sun_theta) * np.cos(sun_phi - phi) + np.cos(theta) * math.cos(sun_theta)
+    return np.minimum(theta, math.pi / 2 - 0.001), np.arccos(np.clip(cos_gamma, -1.0, 1.0))
+
+
 def coefficients(sun_direction, turbidity: float):
     """(sun theta, sun phi, zenith (Y, x, y) over the Perez function at the zenith, Perez
-    coefficients for Y, x and y); the sun's direction normalised, as Blender hands it to Cycles."""
-    sx, sy, sz = np.asarray(sun_direction, float) / max(float(np.linalg.norm(sun_direction)), 1e-30)
-    theta = math.acos(min(max(sz, -1.0), 1.0))
-    phi = math.atan2(sx, sy)
+    coefficients for Y, x and y)."""
+    theta, phi = sun_angles(sun_direction)
     t = turbidity
     t2, th2, th3 = t * t, theta * theta, theta ** 3
     chi = (4.0 / 9.0 - t / 120.0) * (math.pi - 2.0 * theta)
@@ -42,11 +56,7 @@ def coefficients(sun_direction, turbidity: float):
 def xyz(params: dict, d: np.ndarray) -> np.ndarray:
     """(N, 3) CIE XYZ of the sky along directions d."""
     sun_theta, sun_phi, zenith, perez = coefficients(params["sun_direction"], params["turbidity"])
-    theta = np.arccos(np.clip(d[:, 2], -1.0, 1.0))
-    phi = -np.arctan2(d[:, 1], d[:, 0]) + math.pi / 2
-    cos_gamma = np.sin(theta) * math.sin(sun_theta) * np.cos(sun_phi - phi) + np.cos(theta) * math.cos(sun_theta)
-    gamma = np.arccos(np.clip(cos_gamma, -1.0, 1.0))
-    theta = np.minimum(theta, math.pi / 2 - 0.001)
+    theta, gamma = view_angles(d, sun_theta, sun_phi)
     Y, x, y = (z * _perez(lam, theta, gamma) for z, lam in zip(zenith, perez))
     safe_y = np.where(y != 0.0, y, 1.0)
     X = np.where(y != 0.0, x / safe_y * Y, 0.0)

@@ -25,6 +25,7 @@ ATMOSPHERE_RADIUS = 6420e3  # m
 STEPS = 32
 STEP_LAMBDA = 20.0  # nm, 380 to 780
 TABLE_WIDTH, TABLE_HEIGHT = 512, 256
+NISHITA_HEIGHT = 128
 IRRADIANCE = np.array([
     1.45756829855592995315, 1.56596305559738380175, 1.65148449067670455293, 1.71496242737209314555,
     1.75797983805020541226, 1.78256407885924539336, 1.79095108475838560302, 1.78541550133410664714,
@@ -111,15 +112,16 @@ def _earth_hides(px, py, pz, dx, dy, dz):
 
 
 @kernel
-def _table(sun_elevation, altitude, air, aerosol, ozone, irradiance, rayleigh, ozone_coeff, cmf, nodes, weights):
-    out = np.zeros((TABLE_HEIGHT, TABLE_WIDTH, 3))
-    half_h = TABLE_HEIGHT // 2
+def _rows(latitudes, sun_elevation, altitude, air, aerosol, ozone, irradiance, rayleigh, ozone_coeff, cmf, nodes,
+          weights):
+    """(len(latitudes), TABLE_WIDTH, 3) XYZ: a row of the table per view latitude."""
+    out = np.zeros((len(latitudes), TABLE_WIDTH, 3))
     sx, sz = math.cos(sun_elevation), math.sin(sun_elevation)
     oz = EARTH_RADIUS + altitude
     g2 = MIE_G * MIE_G
     spectrum = np.empty(len(irradiance))
-    for y in range(half_h + 1, TABLE_HEIGHT):
-        latitude = math.pi / 2 * (y / half_h - 1.0) ** 2
+    for y in range(len(latitudes)):
+        latitude = latitudes[y]
         for x in range(TABLE_WIDTH // 2):
             longitude = 2 * math.pi / TABLE_WIDTH * x - math.pi
             dx, dy, dz = (math.cos(latitude) * math.cos(longitude), math.cos(latitude) * math.sin(longitude),
@@ -156,11 +158,31 @@ def _table(sun_elevation, altitude, air, aerosol, ozone, irradiance, rayleigh, o
     return out
 
 
+def _table(latitudes, sun_elevation, altitude, air, aerosol, ozone) -> np.ndarray:
+    return _rows(np.asarray(latitudes, float), sun_elevation, altitude_m(altitude), air, aerosol, ozone, IRRADIANCE,
+                 RAYLEIGH_COEFF, OZONE_COEFF, CMF_XYZ, QUADRATURE_NODES, QUADRATURE_WEIGHTS)
+
+
 @lru_cache(maxsize=8)
 def sky_table(sun_elevation: float, altitude: float, air: float, aerosol: float, ozone: float) -> np.ndarray:
-    """The (256, 512, 3) XYZ texture Cycles precomputes for these settings (cached)."""
-    table = _table(sun_elevation, altitude_m(altitude), air, aerosol, ozone, IRRADIANCE, RAYLEIGH_COEFF,
-                   OZONE_COEFF, CMF_XYZ, QUADRATURE_NODES, QUADRATURE_WEIGHTS)
+    """The (256, 512, 3) XYZ texture Blender 5's Cycles precomputes for these settings (cached):
+    rows above the middle one at latitude pi/2 times the square of their share of the upper half."""
+    half_h = TABLE_HEIGHT // 2
+    table = np.zeros((TABLE_HEIGHT, TABLE_WIDTH, 3))
+    table[half_h + 1:] = _table([math.pi / 2 * (y / half_h - 1.0) ** 2 for y in range(half_h + 1, TABLE_HEIGHT)],
+                                sun_elevation, altitude, air, aerosol, ozone)
+    table.setflags(write=False)
+    return table
+
+
+@lru_cache(maxsize=8)
+def nishita_table(sun_elevation: float, altitude: float, air: float, aerosol: float, ozone: float) -> np.ndarray:
+    """The (128, 512, 3) XYZ texture Blender 4's Cycles precomputes for its Nishita sky (cached): the
+    upper hemisphere only, row y at latitude (pi/2 plus half a row's step) times (y / 128)^2."""
+    height = NISHITA_HEIGHT
+    step = math.pi / 2 / height
+    table = _table([(math.pi / 2 + step / 2) * (y / height) ** 2 for y in range(height)], sun_elevation, altitude,
+                   air, aerosol, ozone)
     table.setflags(write=False)
     return table
 
