@@ -30,6 +30,7 @@ from ..shading import sky
 from ..shading.lightpath import BACKGROUND_LENGTH, RayPath, camera_bounces, reads_light_path
 from ..shading.nodes import DirectionContext, Evaluator
 from ..shading.textures import Texture, equirect_direction, equirect_uv
+from .map_share import calibrated_share
 
 MAX_WIDTH = 1024
 MIN_WIDTH = 64
@@ -73,6 +74,8 @@ class Environment:
         self.col_cdf = np.concatenate([np.zeros((h, 1)), np.cumsum(cond, axis=1)], axis=1)
         self.col_cdf = np.ascontiguousarray(self.col_cdf / self.col_cdf[:, -1:])
         self.cell_area = (2 * np.pi / w) * (np.pi / h)  # in (phi, theta)
+        self.map_share = calibrated_share(self)
+        """Share of light samples the map draws, the rest cosine-weighted (lights.map_share)."""
 
     def _cell_luminance(self, w, h, rows_per_chunk=64):
         lum = np.zeros((h, w))
