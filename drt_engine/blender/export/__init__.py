@@ -48,7 +48,7 @@ def export_scene(
         camera_object = camera_object.evaluated_get(depsgraph)  # animated and constrained transform
     camera = export_camera(scene, camera_object)
     warnings: list[str] = []
-    images = ImageTable(warnings)
+    images = ImageTable(warnings, scene.frame_current)
     materials = MaterialTable(warnings, images, (scene, depsgraph.view_layer))
     light_groups = view_layer_lightgroups(depsgraph.view_layer)
     group_of = {name: i for i, name in enumerate(light_groups)}

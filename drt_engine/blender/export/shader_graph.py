@@ -16,6 +16,7 @@ from ...core.scene import Program, TextureImage
 from ...core.shading import nodes as sn
 from ...core.shading import lightpath, proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
+from . import image_sequence
 from .nodes import Issues, follow
 
 DISPLACEMENT_FILTER_WIDTH = 0.1
@@ -126,19 +127,24 @@ def is_ref(value) -> bool:
 
 
 class ImageTable:
-    """Images used by the scene's programs, each exported once."""
+    """Images used by the scene's programs, each exported once (a sequence's, once per frame shown)."""
 
-    def __init__(self, warnings: list[str]):
+    def __init__(self, warnings: list[str], frame: int = 1):
         self.images: list[TextureImage] = []
         self.warnings = warnings
-        self._index: dict[int, int] = {}
+        self.frame = frame  # the scene's, for image sequences
+        self._index: dict = {}
 
-    def index(self, image) -> int:
-        key = image.as_pointer()
+    def index(self, image, user=None) -> int:
+        """The index of ``image`` as a node with image user ``user`` shows it at this frame."""
+        number = None
+        if image.source == "SEQUENCE" and user is not None and image.packed_file is None:
+            number = image_sequence.frame_number(user, self.frame)
+        key = image.as_pointer() if number is None else (image.as_pointer(), number)
         found = self._index.get(key)
         if found is None:
             found = self._index[key] = len(self.images)
-            self.images.append(self._export(image))
+            self.images.append(self._export(image, number))
         return found
 
     def tiles(self, image) -> dict | None:
@@ -164,7 +170,8 @@ class ImageTable:
             self.warnings.append(f"image '{image.name}': colour space {space} used as linear")
         return "sRGB" if space == "sRGB" else "Non-Color"
 
-    def _export(self, image) -> TextureImage:
+    def _export(self, image, number=None) -> TextureImage:
+        """``number``: the frame of a sequence shown."""
         colorspace = self._colorspace(image)
         # Blender's own pixels where they are the only source, or where OpenImageIO is missing
         if image.packed_file is not None or image.source == "GENERATED" or not openimageio_available():
@@ -175,6 +182,10 @@ class ImageTable:
                 # byte images hold encoded values; float images are linear already
                 return TextureImage(image.name, pixels=pixels.reshape(h, w, 4),
                                     colorspace=colorspace if not image.is_float else "Non-Color")
+        if number is not None:
+            path = image_sequence.frame_path(bpy.path.abspath(image.filepath, library=image.library), number)
+            return TextureImage(f"{image.name} frame {number}", path=bpy.path.native_pathsep(path),
+                                colorspace=colorspace)
         if image.source not in ("FILE", "TILED"):
             self.warnings.append(f"image '{image.name}': {image.source.lower()} images are not supported")
         elif image.source == "TILED" and (image.packed_file is not None or "<UDIM>" not in image.filepath):
@@ -427,7 +438,8 @@ class Compiler:
         interpolation = node.interpolation
         vector = self._vector_or(node, "generated" if self.world else "uv")
         tiles = self.images.tiles(node.image)
-        first = (tiles[1001] if 1001 in tiles else min(tiles.items())[1]) if tiles else self.images.index(node.image)
+        first = (tiles[1001] if 1001 in tiles else min(tiles.items())[1]) if tiles else self.images.index(
+            node.image, node.image_user)
         if node.projection == "BOX":
             tiles = None  # Cycles: Box projection's coordinates always fall in tile 1001
         i = self.program.add("image", [vector], image=first, interpolation=interpolation,
@@ -441,7 +453,7 @@ class Compiler:
         if node.projection not in ("EQUIRECTANGULAR", "MIRROR_BALL"):
             return self._unsupported(node, f"Environment Texture {node.projection.title()} projection")
         vector = self._vector_or(node, "generated")
-        i = self.program.add("environment", [vector], image=self.images.index(node.image),
+        i = self.program.add("environment", [vector], image=self.images.index(node.image, node.image_user),
                              interpolation=node.interpolation, projection=node.projection)
         return i, 0 if output.identifier == "Color" else 1
 
