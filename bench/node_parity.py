@@ -8,9 +8,14 @@ mirror-ball environment, each sky model this Blender offers, the Ambient Occlusi
 with each case's worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
 A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
 Run from the repository root: .venv/bin/python bench/node_parity.py (``make node-parity``).
+
+With ``--sky`` it renders the sky cases alone, under whichever bpy runs it, into a block and a JSON
+of that Blender's version (``make sky-parity-4.2``: Blender 4's Nishita and its Preetham and
+Hosek / Wilkie against its own Cycles).
 """
 from __future__ import annotations
 
+import argparse
 import sys
 import tempfile
 from pathlib import Path
@@ -25,6 +30,7 @@ from bench.texture_parity import publish, row  # noqa: E402
 from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM  # noqa: E402
 from drt_engine.blender.export.shader_graph import (DISPLACEMENT_MATCHED_FROM,  # noqa: E402
                                                    FALLOFF_WORLD_MATCHED_FROM)
+from drt_engine.headless.cli import exit_now  # noqa: E402
 from tests.support import node_scenes as ns  # noqa: E402
 from tests.support import procedural_scenes as ps  # noqa: E402
 from tests.support import sky_scenes  # noqa: E402
@@ -32,6 +38,12 @@ from tests.support import sky_scenes  # noqa: E402
 MARK_BEGIN, MARK_END = "<!-- node parity: begin -->", "<!-- node parity: end -->"
 JSON_PATH = ROOT / "docs" / "node_parity.json"
 NAMED = "named in the warning: this Blender's Cycles computes it otherwise"
+
+
+def _sky_scenes() -> dict:
+    """Label -> (scene builder, (0, 0)) of the sky cases this Blender offers."""
+    return {f"Sky Texture {name}": (lambda props=props: sky_scenes.sky_scene(props), (0, 0))
+            for name, props in sky_scenes.CASES.items() if sky_scenes.offered(props["sky_type"])}
 
 
 def _whole_scenes() -> dict:
@@ -50,10 +62,7 @@ def _whole_scenes() -> dict:
                                                 (0, 0))
     for name, settings in ns.BEVEL_CASES.items():
         scenes[f"Bevel {name}"] = (lambda settings=settings: ns.bevel_scene(**settings), (0, 0))
-    for name, props in sky_scenes.CASES.items():
-        if sky_scenes.offered(props["sky_type"]):
-            scenes[f"Sky Texture {name}"] = (lambda props=props: sky_scenes.sky_scene(props), (0, 0))
-    return scenes
+    return scenes | _sky_scenes()
 
 
 def _figures(renders, part=(slice(None), slice(None))) -> dict:
@@ -87,8 +96,23 @@ def table(figures: dict) -> str:
     return "\n".join(rows) + "\n"
 
 
+def measure_sky() -> dict:
+    with tempfile.TemporaryDirectory() as out:
+        cases = {label: _figures(ps.parity_renders(build(), out, "sky")) for label, (build, _) in _sky_scenes().items()}
+    return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "cases": cases}
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sky", action="store_true", help="the sky cases alone, in this Blender's own block")
+    args = parser.parse_args()
     drt_engine.register()
+    if args.sky:
+        version = "%d.%d" % bpy.app.version[:2]
+        marks = (f"<!-- sky parity, Blender {version}: begin -->", f"<!-- sky parity, Blender {version}: end -->")
+        figures = measure_sky()
+        publish(figures, ROOT / "docs" / f"sky_parity_{version}.json", marks, table(figures))
+        exit_now(0)  # the bpy 4.2 module crashes in Python's teardown
     figures = measure()
     publish(figures, JSON_PATH, (MARK_BEGIN, MARK_END), table(figures))
 
