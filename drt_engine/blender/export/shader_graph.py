@@ -16,7 +16,7 @@ from ...core.scene import Program, TextureImage
 from ...core.shading import nodes as sn
 from ...core.shading import lightpath, proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
-from . import image_sequence
+from .image_sequence import frame_number, frame_path
 from .nodes import Issues, follow
 
 DISPLACEMENT_FILTER_WIDTH = 0.1
@@ -139,7 +139,7 @@ class ImageTable:
         """The index of ``image`` as a node with image user ``user`` shows it at this frame."""
         number = None
         if image.source == "SEQUENCE" and user is not None and image.packed_file is None:
-            number = image_sequence.frame_number(user, self.frame)
+            number = frame_number(user, self.frame)
         key = image.as_pointer() if number is None else (image.as_pointer(), number)
         found = self._index.get(key)
         if found is None:
@@ -183,7 +183,7 @@ class ImageTable:
                 return TextureImage(image.name, pixels=pixels.reshape(h, w, 4),
                                     colorspace=colorspace if not image.is_float else "Non-Color")
         if number is not None:
-            path = image_sequence.frame_path(bpy.path.abspath(image.filepath, library=image.library), number)
+            path = frame_path(bpy.path.abspath(image.filepath, library=image.library), number)
             return TextureImage(f"{image.name} frame {number}", path=bpy.path.native_pathsep(path),
                                 colorspace=colorspace)
         if image.source not in ("FILE", "TILED"):
