@@ -4,11 +4,13 @@ counts them); an environment sequence too. Each frame's file is one flat colour,
 is read off the plane's centre."""
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import bpy
 import numpy as np
 import pytest
 
-from drt_engine.blender.export import image_sequence
+from drt_engine.blender.export import image_sequence, shader_graph
 from tests.blender.test_textures_export import diffuse_from, image_node, textured_scene
 from tests.support import render_helpers as rh
 from tests.support.export_helpers import render_export
@@ -77,6 +79,21 @@ def test_an_environment_sequence_lights_by_its_frame(drt, first_file):
     _set(scene, env.image_user, 4, 1, 0, 5, False)
     data = render_export(scene)
     assert not data.warnings and data.images[0].path.endswith("seq.0004.exr")
+
+
+def test_a_sequence_without_openimageio_keeps_the_file_of_its_frame(first_file, monkeypatch):
+    """Without OpenImageIO a file image falls back to the pixels Blender has loaded; a sequence's
+    may be another frame's, so the shown frame's file is kept (the core then renders magenta and
+    names why). The bpy module never holds a sequence's pixels, so a stand-in image that does."""
+    image = SimpleNamespace(source="SEQUENCE", packed_file=None, size=(4, 4), filepath=str(first_file),
+                            library=None, name="seq", is_float=True, as_pointer=lambda: 1,
+                            colorspace_settings=SimpleNamespace(name="Non-Color"),
+                            pixels=SimpleNamespace(foreach_get=lambda out: out.fill(0.5)))
+    user = SimpleNamespace(frame_duration=5, frame_start=1, frame_offset=0, use_cyclic=False)
+    monkeypatch.setattr(shader_graph, "openimageio_available", lambda: False)
+    table = shader_graph.ImageTable([], 4)
+    exported = table.images[table.index(image, user)]
+    assert exported.pixels is None and exported.path.endswith("seq.0004.exr")
 
 
 @pytest.mark.parametrize("path, number, expected", [

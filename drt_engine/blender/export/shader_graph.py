@@ -173,8 +173,10 @@ class ImageTable:
     def _export(self, image, number=None) -> TextureImage:
         """``number``: the frame of a sequence shown."""
         colorspace = self._colorspace(image)
-        # Blender's own pixels where they are the only source, or where OpenImageIO is missing
-        if image.packed_file is not None or image.source == "GENERATED" or not openimageio_available():
+        # Blender's own pixels where they are the only source, or where OpenImageIO is missing (not a
+        # sequence's: Blender's loaded frame may not be the one shown, and its file names the reason)
+        if image.packed_file is not None or image.source == "GENERATED" or (
+                number is None and not openimageio_available()):
             w, h = image.size
             if w * h > 0:
                 pixels = np.empty(w * h * 4, np.float32)
