@@ -82,9 +82,15 @@ def measure() -> dict:
         for i, case in enumerate(closures):
             named = case.oren_nayar and bpy.app.version < OREN_NAYAR_MATCHED_FROM
             cases[case.name] = NAMED if named else _figures(renders, ns.closure_part(i, renders[0].rgb.shape[0]))
-        for label, (build, since) in _whole_scenes().items():
-            cases[label] = NAMED if bpy.app.version < since else _figures(ps.parity_renders(build(), out, "whole"))
+        cases.update(_whole(_whole_scenes(), out))
     return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "cases": cases}
+
+
+def _whole(scenes: dict, out) -> dict:
+    """Label -> figures of each scene compared whole (``_whole_scenes``' form), or NAMED before the
+    first Blender whose Cycles DRT matches."""
+    return {label: NAMED if bpy.app.version < since else _figures(ps.parity_renders(build(), out, "whole"))
+            for label, (build, since) in scenes.items()}
 
 
 def table(figures: dict) -> str:
@@ -98,7 +104,7 @@ def table(figures: dict) -> str:
 
 def measure_sky() -> dict:
     with tempfile.TemporaryDirectory() as out:
-        cases = {label: _figures(ps.parity_renders(build(), out, "sky")) for label, (build, _) in _sky_scenes().items()}
+        cases = _whole(_sky_scenes(), out)
     return {"blender": bpy.app.version_string, "samples": ps.SAMPLES, "cases": cases}
 
 

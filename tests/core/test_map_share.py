@@ -3,7 +3,7 @@ cosine for a world smooth over the hemisphere, the map for one with a sun; and a
 under a smooth sky less noisy with the chosen share than with the old fixed 0.75."""
 import numpy as np
 
-from drt_engine.core.lights import map_share
+from drt_engine.core.lights import environment, map_share
 from drt_engine.core.lights.environment import Environment
 from drt_engine.core.render.render import Renderer
 from drt_engine.core.scene import Closure, Instance, Material, Program, SceneData, World
@@ -34,20 +34,13 @@ def test_a_world_with_a_small_sun_takes_the_map():
 def _floor_noise(monkeypatch, share=None):
     """Pixel variance over four seeds of a diffuse floor seen from above under the zenith sky."""
     if share is not None:
-        monkeypatch.setattr(Environment, "__init__", _with_share(Environment.__init__, share))
+        monkeypatch.setattr(environment, "calibrated_share", lambda env: share)
     mat = Material("white", [Closure("DIFFUSE", color=(0.8, 0.8, 0.8), roughness=0.0)])
     scene = SceneData(camera=ortho_top(16, half=1.0, height=1.0), meshes=[uv_plane(half=50)],
                       instances=[Instance(0, np.eye(4))], materials=[mat], world=sky_world(ZENITH_SKY))
     images = [Renderer(scene, RenderSettings(samples=64, seed=seed, threads=1)).render().passes["Combined"][..., :3]
               for seed in range(4)]
     return np.stack(images).astype(np.float64).var(axis=0, ddof=1).mean(), np.mean(images)
-
-
-def _with_share(init, share):
-    def patched(self, *args, **kwargs):
-        init(self, *args, **kwargs)
-        self.map_share = share
-    return patched
 
 
 def test_the_chosen_share_is_less_noisy_than_the_old_fixed_one_under_a_smooth_sky(monkeypatch):
