@@ -343,6 +343,14 @@ class Light:
     """Light linking: the objects' receiver sets it lights (bit s: set s; core.lights.linking)."""
     shadow_set_membership: int = LIGHT_SETS_ALL
     """Shadow linking: the objects' blocker sets that cast its shadows."""
+    program: Program | None = None
+    emission: tuple | None = None
+    """A node tree whose Emission colour or strength varies (an IES Texture, Light Falloff): the
+    program's ``emission`` output (colour x strength, (N, 3)) scales the light's radiance at each
+    sample and hit, in the coordinates Cycles gives a light's shader (core.lights.programs)."""
+    object_scale: tuple = (1.0, 1.0, 1.0)
+    """The lengths of the light object's axes, which ``matrix`` leaves out: its program's Normal and
+    Object coordinates are in the object's space, scale included, as Cycles transforms them."""
 
     def __post_init__(self):
         if self.kind not in LIGHT_KINDS:

@@ -152,7 +152,8 @@ class Integrator:
         self.light_dims = D.LightDims(D.strategy_keys(self.lights), settings.max_depth)
         self.ratio = frozenset(plan.ratio)
         self.light_path = reads_light_path(scene.world.program) or any(
-            reads_light_path(m.material.program) for m in prepared.shading)
+            reads_light_path(m.material.program) for m in prepared.shading) or any(
+            reads_light_path(light.program) for light in self.lights.lights)
         # the Ambient Occlusion and Bevel nodes' rays, from the surfaces paths hit (core.shading.occlusion)
         self.occlusion = any(traces(m.material.program) for m in prepared.shading)
         self.mist = Mist(scene.camera, scene.world) if "Mist" in settings.passes else None
@@ -386,6 +387,7 @@ class Integrator:
             rays, t, light_id, le = rays.take(keep), t[keep], light_id[keep], le[keep]
         if len(rays) == 0:
             return
+        le = self.lights.emitted(light_id, rays.origins, rays.dirs, t, le, rays.time, rays.bounces)
 
         def light_pdf(smooth):  # each ray's own light, in one call
             origins, dist = rays.mis_ray(smooth, t[smooth])
@@ -487,7 +489,7 @@ class Integrator:
         hit = surf.row[glowing]
         emission = self.lights.emission_seen(prim, hits.u[hit], hits.v[hit], surf.normal[glowing],
                                              self._ray_path(surf, hits, glowing),
-                                             None if occlusion is None else occlusion.take(glowing))
+                                             None if occlusion is None else occlusion.take(glowing), state.dirs[hit])
 
         def emissive_pdf(smooth):
             rows = hit[smooth]

@@ -13,7 +13,7 @@ lights.choice, the environment map's in lights.environment, the world's in light
 strategy is sampled in one kernel call per depth step (lights.strategies); hits and densities
 of rays that found a light are one batch loop per wave (below, with the table lights'
 closed-form unoccluded light for the ratio estimator); shader programs (textured emission, the
-environment's radiance) stay NumPy.
+environment's radiance, a light's node tree: lights.programs) stay NumPy.
 """
 from __future__ import annotations
 
@@ -31,6 +31,7 @@ from ..geometry.visibility import shadow_ray_mask
 from ..scene import LIGHT_SETS_ALL, Light, SceneData
 from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_path
 from ..shading.surface import SurfaceAttributes, SurfaceContext
+from . import programs
 from .choice import pick_probability
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
@@ -92,7 +93,10 @@ class Lights:
         tabulated again: its table is most of the lights' cost under an image world."""
         for light in scene.lights:
             validate_light(light)
-        self.lights = [light for light in scene.lights if not light_power_zero(light)]
+        self.textures = list(textures)
+        self.lights = [self._constant_sun(light) for light in scene.lights if not light_power_zero(light)]
+        self.programmed = np.array([i for i, light in enumerate(self.lights) if light.program is not None], np.int64)
+        """Lights whose node tree scales each sample and hit (lights.programs)."""
         self.table = light_table(self.lights)
         """One row per light (lights.table's columns): what every light kernel reads."""
         self.camera_visible = np.array([light.visible_camera for light in self.lights] + [False])
@@ -150,6 +154,56 @@ class Lights:
         self._fixed_suns = np.array([i for i in suns if i not in self.motions], np.int64)
         self._moving_hittable = [i for i in hittable if i in self.motions]
         self._moving_suns = [i for i in suns if i in self.motions]
+
+    def _constant_sun(self, light: Light) -> Light:
+        """A sun's node tree evaluated once, along the direction it shines: its disk is too small for
+        the tree to vary over it (a Light Path there, which varies with the path, the export names)."""
+        if light.kind != "SUN" or light.program is None:
+            return light
+        axes = _unit_axes(light.matrix)
+        toward = axes[:, 2][None]
+        down = np.array([[0.0, 0.0, -1.0]])
+        factor = programs.emission(light, self.textures, -toward, down, -toward, down, toward, np.array([np.inf]),
+                                   axes[None], light.matrix[None, :3, 3], None)[0]
+        return replace(light, irradiance=light.irradiance * factor, program=None, emission=None)
+
+    def _emission(self, i, points, wi, dist, time=None, bounces=None) -> np.ndarray:
+        """Light i's program output (N, 3) for the rays from ``points`` along ``wi`` that reach it at
+        ``dist`` (its samples and the rays that hit it), in the frame where it stands at ``time``."""
+        light = self.lights[i]
+        _, local, dloc, rotation = self._frame(i, points, wi, time)
+        if rotation is None:
+            rotation = np.broadcast_to(_unit_axes(light.matrix), (len(points), 3, 3))
+            local = np.einsum("nji,nj->ni", rotation, points - light.matrix[:3, 3])
+            dloc = np.einsum("nji,nj->ni", rotation, wi)
+        ng_local, p_local = programs.light_geometry(light, local, dloc, dist)
+        ng = np.einsum("nij,nj->ni", rotation, ng_local)
+        centre = points - np.einsum("nij,nj->ni", rotation, local)
+        finite = np.isfinite(dist)[:, None]
+        p = np.where(finite, points + wi * np.where(finite[:, 0], dist, 0.0)[:, None], ng)
+        return programs.emission(light, self.textures, ng, ng_local, p, p_local, wi, dist, rotation, centre, bounces)
+
+    def _program_samples(self, out: LightSamples, pick, pos, time, bounces) -> None:
+        """The table strategies' samples of lights with a node tree, scaled by its output."""
+        for k in range(self.light_slots):
+            for i in np.intersect1d(pick[k], self.programmed):
+                rows = np.flatnonzero((pick[k] == i) & out.value[k].any(axis=1))
+                if len(rows):
+                    out.value[k, rows] *= self._emission(i, pos[rows], out.wi[k, rows], out.dist[k, rows],
+                                                         None if time is None else time[rows],
+                                                         None if bounces is None else bounces[rows])
+
+    def emitted(self, light_id, origins, dirs, t, le, time=None, bounces=None) -> np.ndarray:
+        """``le``, the radiance of the lights rays hit (``light_id``, at ``t``), with the node trees
+        of those that have one applied."""
+        if not len(self.programmed):
+            return le
+        for i in np.intersect1d(light_id, self.programmed):
+            rows = np.flatnonzero(light_id == i)
+            le[rows] = le[rows] * self._emission(i, origins[rows], dirs[rows], np.asarray(t, float)[rows],
+                                                 None if time is None else time[rows],
+                                                 None if bounces is None else bounces[rows])
+        return le
 
     def _emitters(self, geometry, scene: SceneData) -> None:
         """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
@@ -272,11 +326,13 @@ class Lights:
             best = np.maximum(best, self._emission_at(tris, weights, ng, corners))
         return best
 
-    def _emission_at(self, prim, bary, normal=None, corners=None, path=None, occlusion=None):
+    def _emission_at(self, prim, bary, normal=None, corners=None, path=None, occlusion=None, direction=None):
         """Emission of triangles ``prim`` at ``bary``, its texture seeing ``normal`` (the hits'
         shading normals), or the triangles' geometric normals at light-sampled points; ``path``
         the rays there, for Light Path (core.shading.lightpath); ``occlusion`` the Ambient
-        Occlusion node's rays from hits (None: AO 1, as Cycles' light samples)."""
+        Occlusion node's rays from hits (None: AO 1, as Cycles' light samples); ``direction`` the
+        rays' (a light sample's: toward the triangle), which Incoming, Fresnel, Layer Weight and an
+        IES Texture read."""
         g = self.geometry
         mats = g.material_of(prim)
         out = self.emission[mats]
@@ -287,18 +343,19 @@ class Lights:
                 pos = np.einsum("ni,nij->nj", bary[sel], p)
                 n = g.world_normals(prim[sel], p)[0] if normal is None else normal[sel]
                 ctx = SurfaceContext(self.attributes, prim[sel], bary[sel], pos, n,
+                                     direction=None if direction is None else direction[sel],
                                      light_path=None if path is None else path.take(sel),
                                      occlusion=None if occlusion is None else occlusion.take(sel))
                 out[sel] = self.shaders[m].emission_at(ctx)
         return out
 
-    def emission_seen(self, prim, u, v, normal=None, path=None, occlusion=None):
+    def emission_seen(self, prim, u, v, normal=None, path=None, occlusion=None, direction=None):
         """Emitted radiance at hits (triangles ``prim``, barycentrics u, v, shading ``normal``, the
-        rays that reached them ``path``, their Ambient Occlusion rays ``occlusion``)."""
+        rays that reached them ``path`` along ``direction``, their Ambient Occlusion rays ``occlusion``)."""
         if not self.textured:
             return self.emission[self.geometry.material_of(prim)]
         return self._emission_at(prim, np.stack([1.0 - u - v, u, v], axis=1), normal, path=path,
-                                 occlusion=occlusion)
+                                 occlusion=occlusion, direction=direction)
 
     def _frame(self, i, points, dirs, time):
         """(table, points, directions, rotation) in the frame where light i stands still."""
@@ -340,13 +397,15 @@ class Lights:
                           out.value, out.pdf, out.cycles_pdf, out.stop, pick, chosen, bary, lit)
         if time is not None and self.motions:
             self._moving_samples(out, pick, chosen, pos, u, time)
+        if len(self.programmed):
+            self._program_samples(out, pick, pos, time, bounces)
         e = self.light_slots
         if len(self.emissive) and self.textured:  # emission from the shader program at the sampled points
             k = np.flatnonzero(np.isin(g.material_of(pick[e]), self.textured) & lit[e])
             if len(k):
                 path = None if bounces is None else RayPath.light_samples(bounces[k], out.dist[e, k])
-                out.value[e, k] = self._emission_at(pick[e, k], bary[k], path=path) / np.maximum(
-                    out.pdf[e, k], TINY)[:, None]
+                emitted = self._emission_at(pick[e, k], bary[k], path=path, direction=out.wi[e, k])
+                out.value[e, k] = emitted / np.maximum(out.pdf[e, k], TINY)[:, None]
         if self.world is not None:
             w = strategies - 1
             k = np.flatnonzero(lit[w])
@@ -552,6 +611,12 @@ class Lights:
                 value[k] = self.environment.radiance(dirs[k], None if path is None else path.take(k))
             return value
         return np.where(shown[:, None], self.world_constant, 0.0)
+
+
+def _unit_axes(matrix) -> np.ndarray:
+    """The light's rotation: its matrix's axes made unit length (columns)."""
+    axes = np.asarray(matrix, float)[:3, :3]
+    return axes / np.maximum(np.linalg.norm(axes, axis=0), TINY)
 
 
 # -- lights of the table ------------------------------------------------------------------------------

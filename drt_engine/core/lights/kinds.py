@@ -30,7 +30,7 @@ from ..base.jit import kernel
 from .area import hit_area, pdf_area, sample_area, unoccluded_area
 from .point import hit_point, pdf_point, sample_point, unoccluded_point
 from .sun import sample_sun, sun_seen, unoccluded_sun
-from .table import DISK, EB, EG, ER, INF, KIND, POINT, RADIUS, RECT, SPOT, SPREAD_MODE, SUN
+from .table import DISK, EB, EG, ER, INF, KIND, POINT, RADIUS, RECT, SPOT, SPREAD_MODE, SUN, VARYING
 
 
 @kernel(inline="always")
@@ -71,8 +71,11 @@ def closed_form(table, i):
     """Whether ``unoccluded`` gives light i's exact irradiance: False for a spot light with a
     radius (its cone weights each sampled ray of the sphere or disk differently: no closed form)
     and for area lights with a spread between 0 and 180 degrees (the spread factor varies over
-    the light). Spread 0 is exact: such a light lights nothing."""
+    the light), nor for a light whose node tree varies its emission (lights.programs). Spread 0 is
+    exact: such a light lights nothing."""
     kind = table[i, KIND]
+    if table[i, VARYING] != 0.0:
+        return False
     if kind == SPOT:
         return table[i, RADIUS] <= 0
     if kind == RECT or kind == DISK:

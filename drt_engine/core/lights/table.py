@@ -28,7 +28,8 @@ COS_HALF, SMOOTH = 24, 25  # spot: cosine of the half cone, blend width in cosin
 SOLID, SUN_SCALE = 26, 27  # sun: solid angle of its disk, radiance per irradiance 1 / (pi sin^2 half)
 SPREAD_MODE, SPREAD_TAN, SPREAD_NORM = 28, 29, 30  # area spread: 0 none, 1 narrowed, 2 zero
 SEL_POWER, SEL_SIZE2 = 31, 32  # for choosing among many lights: power, squared size
-COLUMNS = 33
+VARYING = 33  # 1: a node tree scales each sample and hit (lights.programs), so no closed form
+COLUMNS = 34
 
 def _unit(v):
     return v / np.linalg.norm(v)
@@ -41,6 +42,7 @@ def light_row(light: Light) -> np.ndarray:
     row[PX:PZ + 1] = m[:3, 3]
     row[EXX:EXZ + 1], row[EYX:EYZ + 1], row[EZX:EZZ + 1] = _unit(m[:3, 0]), _unit(m[:3, 1]), _unit(m[:3, 2])
     row[DX:DZ + 1] = -row[EZX:EZZ + 1]
+    row[VARYING] = float(light.program is not None)
     if light.kind in ("POINT", "SPOT"):
         row[KIND] = POINT if light.kind == "POINT" else SPOT
         row[RADIUS], row[SOFT] = light.radius, float(light.soft_falloff)

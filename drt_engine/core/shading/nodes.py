@@ -22,7 +22,7 @@ from ..base.vectors import orthonormal_basis
 from ..scene import Program
 from . import colornodes as cn
 from . import geometrynodes as gn
-from . import lightpath, proctex, sky
+from . import ies, lightpath, proctex, sky
 from .textures import MAGENTA, Texture, equirect_uv
 
 """Rec.709 luminance weights: Blender's implicit colour-to-float conversion in linear sRGB."""
@@ -383,6 +383,8 @@ class Evaluator:
             return rgba[:, :3], rgba[:, 3]
         if op == "sky":
             return (sky.evaluate(p, x[0]),)
+        if op == "ies":
+            return (ies.lookup(p["profile"], x[0], x[1]),)
         if op == "math":
             out = _math(p["operation"], x[0], x[1], x[2])
             return (np.clip(out, 0, 1) if p.get("clamp") else out,)
