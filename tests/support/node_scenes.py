@@ -3,9 +3,9 @@ scenes that show them, for the Cycles parity test: the procedural texture grid's
 (procedural_scenes: emissive 2 x 2 m tiles seen straight down, each case's output as the
 emission colour through Vector Math Absolute) with a material per case that links every input
 it can to the tile's mapped Object coordinates, so each node is evaluated over a range of
-inputs. Fresnel and Layer Weight depend on the direction a hit is seen from, which DRT's
-emission does not see: ``facing_scene`` shows them as the colour of diffuse spheres seen at
-every angle, from the front and from the back.
+inputs. Fresnel and Layer Weight depend on the direction a hit is seen from, which the flat
+tiles seen straight down hardly vary: ``facing_scene`` shows them as the colour of diffuse
+spheres seen at every angle, from the front and from the back.
 """
 from __future__ import annotations
 

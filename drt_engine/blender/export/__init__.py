@@ -68,7 +68,7 @@ def export_scene(
         links.look_at(obj)
         matrix = np.array(instance.matrix_world, dtype=np.float64)
         if obj.type == "LIGHT":
-            light = export_light(obj, matrix, warnings)
+            light = export_light(obj, matrix, warnings, images)
             if light is not None:
                 light.lightgroup = lightgroup_of(obj, group_of)
                 lights.append(light)

@@ -3,7 +3,8 @@
 From intern/cycles/blender/light.cpp and intern/cycles/scene/light.cpp (Blender 5.0):
 
 - strength S = color × temperature_color (if used) × energy × 2^exposure, times the
-  light's node-tree emission (colour × strength) when it has one.
+  light's node-tree emission (colour × strength) when it has one: a constant, or, where nodes
+  vary it (an IES Texture, Light Falloff), a program the core evaluates at each sample and hit.
 - point and spot: Cycles stores ``eval_fac = invarea / π`` with ``invarea = 1 /
   (4π r²)`` (4 for r = 0) when normalised, else 1. The sphere (or facing disk) then
   has radiance S·eval_fac, i.e. intensity S/(4π) W/sr when normalised, S·r² (r > 0)
@@ -24,19 +25,32 @@ import numpy as np
 
 from ...core.errors import SceneError
 from ...core.scene import Light
+from ...core.lights import programs
+from ...core.shading.nodes import GEOMETRY_OPS
 from .materials import uses_nodes
-from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
+from .nodes import Issues, find_input, flatten, input_value, report_linked_inputs, rgb
+from .shader_graph import Compiler, ImageTable, is_ref
 
 
-def _node_emission(light, warnings: list[str]) -> np.ndarray:
-    """Colour × strength of the light's Emission nodes (1 without nodes, as in Cycles)."""
-    if not uses_nodes(light):
-        return np.ones(3)
-    output = light.node_tree.get_output_node("CYCLES")
-    if output is None:
-        return np.zeros(3)
-    issues = Issues()
+UNAVAILABLE_OPS = ("attribute", "instance_attribute", "ao", "bevel", "normal_map", "bump") + GEOMETRY_OPS
+"""Program operations a light's shader has no value for in DRT (its coordinates: lights.programs)."""
 
+
+def _unavailable(program) -> set[str]:
+    """What a light's program reads that DRT has no value for at a light."""
+    out = set()
+    for node in program.nodes:
+        if node.op == "coord" and node.params["name"] not in programs.COORDS:
+            out.add(f"{node.params['name'].replace('_', ' ')} coordinates")
+        elif node.op in UNAVAILABLE_OPS:
+            out.add(f"{node.op.replace('_', ' ')} at a light")
+        elif node.op == "vector_transform" and "CAMERA" in (node.params["from"], node.params["to"]):
+            out.add("Vector Transform to or from camera space at a light")
+    return out
+
+
+def _constant_emission(output, issues: Issues) -> np.ndarray:
+    """Colour x strength of the Emission nodes, linked inputs at their default values."""
     def leaf(node, weight):
         if node.bl_idname != "ShaderNodeEmission":
             issues.add(f"shader node '{node.name}'")
@@ -46,27 +60,68 @@ def _node_emission(light, warnings: list[str]) -> np.ndarray:
         return [weight * color * input_value(node, issues, 1.0, "Strength")]
 
     parts = flatten(output.inputs["Surface"], leaf, issues)
-    message = issues.message(f"Light '{light.name}'")
-    if message:
-        warnings.append(message)
     return np.sum(parts, axis=0) if parts else np.zeros(3)
 
 
-def light_strength(light, warnings: list[str]) -> np.ndarray:
-    """Cycles' light strength: watts for point, spot and area lights, W/m² for suns."""
+def _node_emission(light, warnings: list[str], images: ImageTable) -> tuple:
+    """(colour x strength of the light's Emission nodes, program, its output): the constant is 1
+    without nodes, as in Cycles; a tree whose emission varies (an IES Texture, Light Falloff)
+    becomes a program the core evaluates at each sample and hit, the constant then 1."""
+    if not uses_nodes(light):
+        return np.ones(3), None, None
+    output = light.node_tree.get_output_node("CYCLES")
+    if output is None:
+        return np.zeros(3), None, None
+    issues = Issues()
+    compiler = Compiler(images, issues)
+
+    def leaf(node, weight):
+        if node.bl_idname != "ShaderNodeEmission":
+            issues.add(f"shader node '{node.name}'")
+            return []
+        color = compiler.value(find_input(node, "Color"), "color")
+        return [compiler.scale(compiler.mul(weight, color), compiler.value(find_input(node, "Strength"), "float"))]
+
+    parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
+    constant, program, total = None, None, None
+    if any(is_ref(p) for p in parts):
+        unavailable = _unavailable(compiler.program)
+        if unavailable:
+            issues = Issues({f"{what} in its node tree" for what in unavailable})
+            constant = _constant_emission(output, issues)
+        else:
+            program, total = compiler.program, compiler.ref(np.zeros(3))
+            for p in parts:
+                total = compiler.op("vector_math", (total, p if is_ref(p) else compiler.ref(rgb(p)), np.zeros(3), 1.0),
+                                    operation="ADD"), 0
+            constant = np.ones(3)
+            if light.type == "SUN" and any(node.op == "light_path" for node in program.nodes):
+                issues.add("Light Path in a sun's node tree (evaluated once, at the first bounce)")
+    else:
+        constant = np.sum([rgb(p) for p in parts], axis=0) if parts else np.zeros(3)
+    message = issues.message(f"Light '{light.name}'")
+    if message:
+        warnings.append(message)
+    return constant, program, total
+
+
+def light_strength(light, warnings: list[str], images: ImageTable) -> tuple:
+    """Cycles' light strength (watts for point, spot and area lights, W/m² for suns) and the
+    program of a node tree that varies it (None, None without one)."""
     color = np.array(light.color[:3], dtype=np.float64)
     if getattr(light, "use_temperature", False):
         color *= np.array(light.temperature_color[:3])
     exposure = getattr(light, "exposure", 0.0)
-    return color * light.energy * 2.0**exposure * _node_emission(light, warnings)
+    emission, program, total = _node_emission(light, warnings, images)
+    return color * light.energy * 2.0**exposure * emission, program, total
 
 
-def export_light(obj, matrix: np.ndarray, warnings: list[str]) -> Light | None:
+def export_light(obj, matrix: np.ndarray, warnings: list[str], images: ImageTable) -> Light | None:
     """The light of an evaluated light object placed by ``matrix``; None if Cycles drops it."""
     light = obj.data
     if light.type == "AREA" and getattr(getattr(light, "cycles", None), "is_portal", False):
         return None
-    strength = light_strength(light, warnings)
+    strength, program, emission = light_strength(light, warnings, images)
     if not np.isfinite(strength).all() or (strength < 0).any():
         quantity, unit = ("strength", "W/m²") if light.type == "SUN" else ("power", "W")
         raise SceneError(f"Light '{obj.name}' has an invalid {quantity} ({light.energy:g} {unit}, colour "
@@ -80,6 +135,7 @@ def export_light(obj, matrix: np.ndarray, warnings: list[str]) -> Light | None:
     rotation = matrix.copy()
     rotation[:3, :3] /= np.where(axes > 0.0, axes, 1.0)
     common = dict(matrix=rotation, name=obj.name, visible_camera=bool(getattr(obj, "visible_camera", False)),
+                  program=program, emission=emission, object_scale=tuple(float(a) for a in axes),
                   cast_shadow=bool(getattr(light, "use_shadow", True)),
                   **{f"visible_{kind}": bool(getattr(obj, f"visible_{kind}", True))
                      for kind in ("diffuse", "glossy", "transmission")})

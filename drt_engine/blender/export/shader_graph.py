@@ -14,7 +14,7 @@ import numpy as np
 from ...core.base.colour import LUMINANCE
 from ...core.scene import Program, TextureImage
 from ...core.shading import nodes as sn
-from ...core.shading import lightpath, proctex, sky
+from ...core.shading import ies, lightpath, proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .image_sequence import frame_number, frame_path
 from .nodes import Issues, follow
@@ -33,6 +33,12 @@ FALLOFF_WORLD_MATCHED_FROM = (5, 0)
 world's FLT_MAX ray length; measured with 5.0's and 5.2's Cycles): 4.2's differs (worst 4x4 block
 0.27 on the tests' Light Falloff scene against a limit of 0.043)."""
 VERSION_FALLOFF_WORLD = "this Blender's Light Falloff at the world: rendered as Cycles 5.0+ computes it"
+
+IES_MATCHED_FROM = (5, 0)
+"""The first Blender whose Cycles reads and looks up an IES profile as DRT does (measured with 5.0's
+and 5.2's Cycles): 4.2's takes the table's unwrapped ends as 0 and differs on the tests' lit floor
+(worst 4x4 block 0.074 against a limit of 0.044, a delta point light's image mean 1% apart)."""
+VERSION_IES = "this Blender's IES Texture: rendered as Cycles 5.0+ computes it"
 
 FISHEYE_WINDOW_MATCHED_FROM = (4, 3)
 """The first Blender whose Cycles gives Texture Coordinate's Window under a fisheye as DRT does,
@@ -195,6 +201,19 @@ class ImageTable:
                                  "(its first tile used everywhere)")
         path = bpy.path.abspath(image.filepath, library=image.library)
         return TextureImage(image.name, path=bpy.path.native_pathsep(path), colorspace=colorspace)
+
+
+def _ies_text(node) -> tuple:
+    """(the IES Texture's profile text or None, what it names): its Text datablock or its file."""
+    if node.mode == "INTERNAL":
+        text = node.ies
+        return (text.as_string() if text is not None else None), f"text '{text.name if text else ''}'"
+    path = bpy.path.native_pathsep(bpy.path.abspath(node.filepath, library=getattr(node.id_data, "library", None)))
+    try:
+        with open(path, encoding="latin-1") as f:
+            return f.read(), f"file '{node.filepath}'"
+    except OSError:
+        return None, f"file '{node.filepath}'"
 
 
 def _socket_kind(socket) -> str:
@@ -414,13 +433,14 @@ class Compiler:
         return self._attribute(node.layer_name, output)
 
     def _vector_or(self, node, default):
-        """The node's Vector input when linked, else the ``default`` coordinates, through the
+        """The node's Vector input when linked, else the ``default`` coordinates (a name or a
+        reference), through the
         node's Texture Mapping (its panel hidden in Blender's UI, older files set it)."""
         socket = node.inputs.get("Vector")
         if socket is not None and socket.is_linked:
             vector = self.ref(self.value(socket, "vector"))
         else:
-            vector = self._coord(default)
+            vector = self._coord(default) if isinstance(default, str) else default
         matrix = texture_mapping_matrix(getattr(node, "texture_mapping", None))
         if matrix is None:
             return vector
@@ -470,6 +490,24 @@ class Compiler:
                                 aerosol_density=float(_aerosol_density(node)),
                                 ozone_density=float(node.ozone_density), sun_direction=tuple(node.sun_direction),
                                 turbidity=float(node.turbidity), ground_albedo=float(node.ground_albedo)), 0
+
+    def _node_ShaderNodeTexIES(self, node, output):
+        """Cycles' IES Texture: unless its Vector is linked, the incoming direction carried into the
+        object's space as a normal is (Cycles' LINK_TEXTURE_INCOMING: Geometry Incoming through a
+        Vector Transform), at a light the direction from the light toward the lit point; a profile
+        Cycles cannot read (no text, no file, not LM-63) gives its constant ``ies.UNREADABLE`` and is
+        named."""
+        text, where = _ies_text(node)
+        profile = ies.parse(text) if text else None
+        if profile is None:
+            self.issues.add(f"'{node.name}' ({where} is no IES profile Cycles can read: {ies.UNREADABLE:g} "
+                            "x Strength, as Cycles gives)")
+        if bpy.app.version < IES_MATCHED_FROM:
+            self.issues.add(f"'{node.name}' ({VERSION_IES})")
+        incoming = self.op("vector_transform", (self._coord("incoming"),), type="NORMAL",
+                           **{"from": "WORLD", "to": "OBJECT"}), 0
+        vector = self._vector_or(node, incoming)
+        return self.op("ies", (vector, self._in(node, "Strength", "float")), profile=profile), 0
 
     def _node_ShaderNodeMapping(self, node, output):
         v = self._in(node, "Vector", "vector")
