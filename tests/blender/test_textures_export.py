@@ -220,10 +220,10 @@ def test_color_attribute_per_corner():
 
 def test_unsupported_node_warns_once_naming_type_and_material():
     scene, mat = textured_scene()
-    diffuse_from(mat, lambda tree: tree.nodes.new("ShaderNodeTexIES").outputs["Fac"])
+    diffuse_from(mat, lambda tree: tree.nodes.new("ShaderNodePointInfo").outputs["Radius"])
     data = render_export(scene)
     lines = [w for w in data.warnings if "Textured" in w]
-    assert len(lines) == 1 and "IES Texture" in lines[0]
+    assert len(lines) == 1 and "Point Info" in lines[0]
     img, _ = render_data(data)
     assert np.allclose(img[4:-4, 4:-4], 0.8, atol=1e-6)  # the Diffuse Color socket's default
 
