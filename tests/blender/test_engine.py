@@ -186,8 +186,8 @@ def test_unexpected_error_is_one_report(bl, monkeypatch):
 def test_export_warnings_are_reported(bl, tmp_path, capfd):
     scene = bl.emission_scene()
     tree = bpy.data.materials["Emitter"].node_tree
-    ies = tree.nodes.new("ShaderNodeTexIES")  # a node DRT does not evaluate
-    tree.links.new(ies.outputs["Fac"], tree.nodes["Emission"].inputs["Color"])
+    info = tree.nodes.new("ShaderNodePointInfo")  # a node DRT does not evaluate
+    tree.links.new(info.outputs["Radius"], tree.nodes["Emission"].inputs["Color"])
     bl.render_exr(scene, tmp_path / "warn.exr")
     out = capfd.readouterr().out
     assert any(line.startswith("Warning:") and "Emitter" in line for line in out.splitlines()), out

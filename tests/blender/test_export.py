@@ -441,9 +441,9 @@ def test_linked_sockets_fall_back_to_defaults_with_one_warning():
     bsdf = tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.1, 0.2, 0.3, 1.0)
     bsdf.inputs["Roughness"].default_value = 0.4
-    ies = tree.nodes.new("ShaderNodeTexIES")  # a node DRT does not evaluate
-    tree.links.new(ies.outputs["Fac"], bsdf.inputs["Base Color"])
-    tree.links.new(ies.outputs["Fac"], bsdf.inputs["Roughness"])
+    info = tree.nodes.new("ShaderNodePointInfo")  # a node DRT does not evaluate
+    tree.links.new(info.outputs["Radius"], bsdf.inputs["Base Color"])
+    tree.links.new(info.outputs["Radius"], bsdf.inputs["Roughness"])
     value = tree.nodes.new("ShaderNodeValue")  # a constant node is evaluated, not warned about
     value.outputs[0].default_value = 0.9
     tree.links.new(value.outputs[0], bsdf.inputs["Metallic"])
@@ -453,7 +453,7 @@ def test_linked_sockets_fall_back_to_defaults_with_one_warning():
     assert closure.roughness == pytest.approx(0.4)
     assert closure.metallic == pytest.approx(0.9)
     assert len(data.warnings) == 1
-    assert "Textured" in data.warnings[0] and "IES Texture" in data.warnings[0]
+    assert "Textured" in data.warnings[0] and "Point Info" in data.warnings[0]
 
 
 def test_unconnected_surface_has_no_closures():
