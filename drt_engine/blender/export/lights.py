@@ -90,11 +90,7 @@ def _node_emission(light, warnings: list[str], images: ImageTable) -> tuple:
             issues = Issues({f"{what} in its node tree" for what in unavailable})
             constant = _constant_emission(output, issues)
         else:
-            program, total = compiler.program, compiler.ref(np.zeros(3))
-            for p in parts:
-                total = compiler.op("vector_math", (total, p if is_ref(p) else compiler.ref(rgb(p)), np.zeros(3), 1.0),
-                                    operation="ADD"), 0
-            constant = np.ones(3)
+            program, total, constant = compiler.program, compiler.add_all(parts), np.ones(3)
             if light.type == "SUN" and any(node.op == "light_path" for node in program.nodes):
                 issues.add("Light Path in a sun's node tree (evaluated once, at the first bounce)")
     else:

@@ -275,6 +275,14 @@ class Compiler:
         a3 = a if is_ref(a) else self.ref(_fit(a, "vector"))
         return self.op("vector_math", (a3, np.zeros(3), np.zeros(3), s), operation="SCALE"), 0
 
+    def add_all(self, parts):
+        """A reference to the sum of the colours ``parts`` (constants and references)."""
+        total = self.ref(np.zeros(3))
+        for p in parts:
+            total = self.op("vector_math", (total, p if is_ref(p) else self.ref(_fit(p, "vector")), np.zeros(3), 1.0),
+                            operation="ADD"), 0
+        return total
+
     def clamp01(self, a):
         if not is_ref(a):
             return float(np.clip(a, 0.0, 1.0))

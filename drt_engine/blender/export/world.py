@@ -76,8 +76,4 @@ def _background(world, warnings: list[str], images: ImageTable, view_layer=None)
     if not any(is_ref(p) for p in parts):
         radiance = np.sum([rgb(p) for p in parts], axis=0) if parts else np.zeros(3)
         return World(radiance=radiance, **visibility)
-    total = compiler.ref(np.zeros(3))
-    for p in parts:
-        total = compiler.op("vector_math", (total, compiler.ref(rgb(p)) if not is_ref(p) else p, np.zeros(3), 1.0),
-                            operation="ADD"), 0
-    return World(program=compiler.program, color=total, **visibility)
+    return World(program=compiler.program, color=compiler.add_all(parts), **visibility)
