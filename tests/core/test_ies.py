@@ -11,7 +11,7 @@ from drt_engine.core.lights.collection import closed_forms
 from drt_engine.core.render.prepared import PreparedScene
 from drt_engine.core.scene import Light, Program
 from drt_engine.core.shading import ies
-from tests.support.ies_scenes import ASYMMETRIC, QUADRANT, TYPE_B, V_FULL, lm63
+from tests.support.ies_profiles import ASYMMETRIC, QUADRANT, TYPE_B, V_FULL, lm63
 from tests.support.scenes import lit_plane_scene, look_at, translation
 
 RNG = np.random.default_rng(23)

@@ -2,15 +2,18 @@
 
 Every import in drt_engine/, at module level or inside a function, is an edge: a module
 imports only its own package and the layers below it, no import circle exists anywhere, and
-only drt_engine/blender/ imports bpy. The checker is tested on a small tree of its own, so
-that a rule it stopped seeing fails here too.
+only drt_engine/blender/ imports bpy (and the core's own tests import without it). The checker is
+tested on a small tree of its own, so that a rule it stopped seeing fails here too.
 """
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parents[2] / "drt_engine"
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGE = ROOT / "drt_engine"
 
 CONTRACT = ("scene", "settings", "errors", "validate")
 """The modules at core/'s top: the plain-data description both sides fill in and read."""
@@ -162,6 +165,19 @@ def test_no_import_circle_but_the_known_ones():
 
 def test_only_the_blender_layer_imports_blender():
     assert bpy_outside_blender(PACKAGE) == KNOWN_BPY_OUTSIDE_BLENDER
+
+
+def test_the_cores_tests_import_without_blender():
+    """tests/core also runs where there is no bpy (tests/real_blender/test_core_on_python313.py, on
+    the Python Debian's Blender runs on): none of its modules, nor the support modules they use,
+    may import bpy or mathutils."""
+    code = ("import importlib, pathlib, sys\n"
+            "sys.modules['bpy'] = sys.modules['mathutils'] = None\n"
+            "sys.path.insert(0, 'tests/core')\n"
+            "for path in sorted(pathlib.Path('tests/core').glob('test_*.py')):\n"
+            "    importlib.import_module('tests.core.' + path.stem)\n")
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
 
 
 def _tree(tmp_path, files: dict[str, str]) -> Path:
