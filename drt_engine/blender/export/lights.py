@@ -28,7 +28,7 @@ from ...core.scene import Light
 from ...core.lights import programs
 from ...core.shading.nodes import GEOMETRY_OPS
 from .materials import uses_nodes
-from .nodes import Issues, find_input, flatten, input_value, report_linked_inputs, rgb
+from .nodes import Issues, flatten, input_value, report_linked_inputs, rgb
 from .shader_graph import Compiler, ImageTable, is_ref
 
 
@@ -79,8 +79,7 @@ def _node_emission(light, warnings: list[str], images: ImageTable) -> tuple:
         if node.bl_idname != "ShaderNodeEmission":
             issues.add(f"shader node '{node.name}'")
             return []
-        color = compiler.value(find_input(node, "Color"), "color")
-        return [compiler.scale(compiler.mul(weight, color), compiler.value(find_input(node, "Strength"), "float"))]
+        return [compiler.emitted(node, weight)]
 
     parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     constant, program, total = None, None, None

@@ -17,7 +17,7 @@ from ...core.shading import nodes as sn
 from ...core.shading import ies, lightpath, proctex, sky
 from ...core.shading.textures import MAGENTA, openimageio_available
 from .image_sequence import frame_number, frame_path
-from .nodes import Issues, follow
+from .nodes import Issues, find_input, follow
 
 DISPLACEMENT_FILTER_WIDTH = 0.1
 """The pixel footprint's share Cycles' bump of the Displacement socket differentiates over (the
@@ -275,6 +275,11 @@ class Compiler:
         a3 = a if is_ref(a) else self.ref(_fit(a, "vector"))
         return self.op("vector_math", (a3, np.zeros(3), np.zeros(3), s), operation="SCALE"), 0
 
+    def emitted(self, node, weight):
+        """An Emission or Background node's colour x strength, times the colour ``weight``."""
+        color = self.value(find_input(node, "Color"), "color")
+        return self.scale(self.mul(weight, color), self.value(find_input(node, "Strength"), "float"))
+
     def add_all(self, parts):
         """A reference to the sum of the colours ``parts`` (constants and references)."""
         total = self.ref(np.zeros(3))
@@ -442,8 +447,8 @@ class Compiler:
 
     def _vector_or(self, node, default):
         """The node's Vector input when linked, else the ``default`` coordinates (a name or a
-        reference), through the
-        node's Texture Mapping (its panel hidden in Blender's UI, older files set it)."""
+        reference), through the node's Texture Mapping (its panel hidden in Blender's UI, older
+        files set it)."""
         socket = node.inputs.get("Vector")
         if socket is not None and socket.is_linked:
             vector = self.ref(self.value(socket, "vector"))

@@ -14,7 +14,7 @@ import numpy as np
 
 from ...core.scene import World
 from .materials import aov_outputs, unread_outputs, uses_nodes
-from .nodes import Issues, find_input, flatten, rgb
+from .nodes import Issues, flatten, rgb
 from .shader_graph import Compiler, ImageTable, is_ref
 
 EMITTERS = ("ShaderNodeBackground", "ShaderNodeEmission")
@@ -63,9 +63,7 @@ def _background(world, warnings: list[str], images: ImageTable, view_layer=None)
         if node.bl_idname not in EMITTERS:
             issues.add(f"shader node '{node.name}'")
             return []
-        color = compiler.value(find_input(node, "Color"), "color")
-        strength = compiler.value(find_input(node, "Strength"), "float")
-        return [compiler.scale(compiler.mul(weight, color), strength)]
+        return [compiler.emitted(node, weight)]
 
     parts = flatten(output.inputs["Surface"], leaf, issues, compiler=compiler)
     unread_outputs(world.node_tree, output, issues)
