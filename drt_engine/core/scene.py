@@ -67,6 +67,27 @@ class Closure:
     """The thin film's IOR."""
     thin_film_metal: bool = True
     """The film covers the metal lobe too (Cycles 5.0 on; 4.x leaves metal bare)."""
+    hair_roughness_v: float = 1.0
+    """HAIR_*: the Hair BSDF's RoughnessV (across the strand; ``roughness`` is RoughnessU)."""
+    hair_offset: float = 0.0
+    """HAIR_*: the Hair BSDF's Offset; PRINCIPLED_HAIR: its Offset (the scales' tilt), radians."""
+    hair_model: str = "CHIANG"
+    """PRINCIPLED_HAIR: "CHIANG" or "HUANG"."""
+    hair_parametrization: str = "COLOR"
+    """PRINCIPLED_HAIR: "COLOR" (``color`` as reflectance), "MELANIN" or "ABSORPTION"."""
+    melanin: float = 0.8
+    melanin_redness: float = 1.0
+    hair_tint: np.ndarray = field(default_factory=lambda: np.ones(3))
+    absorption: np.ndarray = field(default_factory=lambda: np.array([0.245531, 0.52, 1.365]))
+    radial_roughness: float = 0.3
+    hair_coat: float = 0.0
+    random_color: float = 0.0
+    random_roughness: float = 0.0
+    hair_random: float = 0.0
+    """PRINCIPLED_HAIR: the node's Random (a mesh has no per-strand random, so Cycles reads the socket)."""
+    aspect_ratio: float = 0.85
+    hair_gains: np.ndarray = field(default_factory=lambda: np.ones(3))
+    """PRINCIPLED_HAIR, Huang: the Reflection, Transmission and Secondary Reflection gains."""
     inputs: dict = field(default_factory=dict)
     """Inputs that vary over the surface: field name ("weight", "color", "roughness",
     "metallic", "ior", "transmission", "emission", "normal", "coat_normal", ...) -> output ``(node, socket)``
@@ -75,7 +96,8 @@ class Closure:
     def __post_init__(self):
         if self.kind not in CLOSURE_KINDS:
             raise ValueError(f"unknown closure kind {self.kind!r}")
-        for name in ("weight", "color", "specular_tint", "coat_tint", "sheen_tint", "emission"):
+        for name in ("weight", "color", "specular_tint", "coat_tint", "sheen_tint", "emission", "hair_tint",
+                     "absorption", "hair_gains"):
             setattr(self, name, _vec3(getattr(self, name)))
 
 
@@ -92,6 +114,9 @@ CLOSURE_KINDS = (
     "HOLDOUT",  # no light: where the camera sees it, that share of the pixel is transparent (Cycles' holdout)
     "DIFFUSE_TOON",  # Cycles' diffuse toon: a cone about the normal, colour = weight
     "GLOSSY_TOON",  # Cycles' glossy toon: a cone about the mirror direction, colour = weight
+    "HAIR_REFLECTION",  # the Hair BSDF's Reflection component about the strand, colour = weight
+    "HAIR_TRANSMISSION",  # its Transmission component
+    "PRINCIPLED_HAIR",  # the Principled Hair BSDF (``hair_model``), colour through its parametrization
 )
 
 

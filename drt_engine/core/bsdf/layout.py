@@ -11,6 +11,7 @@
 DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOON_GLOSSY = 0, 1, 2, 3, 4, 5, 6, 7
 F_DIELECTRIC, F_F82, F_TINT, F_FILM, F_F82_FILM = 0, 1, 2, 3, 4  # F_FILM: thin film over a dielectric
 SHEEN = 8
+HAIR_REFLECTION, HAIR_TRANSMISSION, HAIR_CHIANG, HAIR_HUANG = 9, 10, 11, 12
 # which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
 # with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
 # covers every lobe (slot = lobe index) and the diffuse lobes outside the bits get no share
@@ -46,9 +47,11 @@ P_FILM = 37  # thin film's thickness (nm; reflect lobes of F_FILM / F_F82_FILM, 
 P_FILM_IOR = 38  # thin film's IOR
 P_OWN_NORMAL = 39  # 1: the lobe has its own normal H_NORMAL (a Principled Coat Normal), tables read at H_PLACE
 P_UNDER_OWN = 40  # 1: the lobe's first layer term (the coat above it) is read at H_PLACE
-P_SHEEN_TABLE = 41  # (3 x SHEEN_N) sheen: a, b and albedo over the view cosines k / (SHEEN_N - 1), at its roughness
+P_HAIR = 41  # (7) hair: the closure's constants (core.bsdf.hair, hair_chiang, hair_huang)
+P_HAIR_CUT = 48  # Principled Hair: 1 where Cycles 5 cuts its light by the closure's normal (core.bsdf.hair_lobes)
+P_SHEEN_TABLE = 49  # (3 x SHEEN_N) sheen: a, b and albedo over the view cosines k / (SHEEN_N - 1), at its roughness
 SHEEN_N = 32
-P = 41 + 3 * SHEEN_N
+P = 49 + 3 * SHEEN_N
 
 # lt: tables per lobe over mu
 T_E = 0  # (3) total albedo, for lobe choice
@@ -70,4 +73,7 @@ H_F0 = 12  # (3) Fresnel colour
 H_NORMAL = 15  # (3) P_OWN_NORMAL: the lobe's normal in the local shading frame
 H_PLACE = 18  # (2) P_OWN_NORMAL, P_UNDER_OWN: ``tables.locate`` of wo's cosine to that normal (j, t)
 H_BLUR = 20  # Filter Glossy's least alpha for a reflect or glass lobe at this hit (core.bsdf.blur); 0: none
-H = 21
+H_HAIR = 21  # (10) hair: its tangent in the local frame, what its model derives per hit, the shading normal
+# (core.bsdf.hair_lobes.hair_frames)
+H_SIGMA = 31  # (3) Principled Hair: absorption coefficient
+H = 34

@@ -26,8 +26,9 @@ from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
-from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SAMPLE_DIFFUSE,
-                     SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .hair_lobes import hair_lobe_eval, hair_lobe_sample, is_hair, own_hair_normal
+from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
+                     SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
@@ -84,9 +85,11 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 @kernel(inline="always")
 def needs_wo_above(lp, l, woz):
     """Lobe l (not diffuse) gives nothing toward or from wo (z its cosine to the shading normal): a
-    GGX reflection, glass or toon glossy lobe about the shading normal with wo not above it."""
+    GGX reflection, glass or toon glossy lobe about the shading normal with wo not above it (a hair
+    lobe shades about its strand, whatever side wo is on)."""
     kind = int(lp[l, P_KIND])
-    return woz <= 0.0 and kind != TRANSPARENT and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
+    return woz <= 0.0 and kind != TRANSPARENT and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0) \
+        and not is_hair(kind)
 
 
 @kernel(inline="always")
@@ -157,6 +160,14 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd0 += d0
             fd1 += d1
             fd2 += d2
+            continue
+        if is_hair(kind):
+            f0, f1, f2, p = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+            s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
+            fn0 += s0 * f0 * lit
+            fn1 += s1 * f1 * lit
+            fn2 += s2 * f2 * lit
+            pdf += sel[si, slot(lp, l, diffuse)] * p
             continue
         if needs_wo_above(lp, l, woz):
             continue
@@ -267,6 +278,9 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
             wix, wiy, wiz = out_of(dx, dy, dz, wix, wiy, wiz)
         w0 = w1 = w2 = 1.0
         ok = True
+    elif is_hair(kind):  # its sample's own value and density, which the mixture keeps (below)
+        wix, wiy, wiz, h0, h1, h2, h_pdf, ok = hair_lobe_sample(lp, hp, r, l, wox, woy, woz, u_re, u0, u1)
+        w0, w1, w2 = h0 / max(h_pdf, TINY), h1 / max(h_pdf, TINY), h2 / max(h_pdf, TINY)
     else:
         wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
                                                     lobe_eta(lp, l, inside))
@@ -288,6 +302,16 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
                                               sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz)
+        if is_hair(kind) and own_hair_normal(lp, l):
+            # Cycles keeps a sampled Principled Hair's own value and density: Huang's is its path's
+            # weight (its evaluation is a quadrature), and Cycles 5 cuts neither by the closure's
+            # normal as it cuts their evaluation (hair_lobes.hair_lobe_eval)
+            _, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
+            e0, e1, e2, e_pdf = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
+            f0 += s0 * shade * (h0 - e0)
+            f1 += s1 * shade * (h1 - e1)
+            f2 += s2 * shade * (h2 - e2)
+            pdf += p_choice * (h_pdf - e_pdf)
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:

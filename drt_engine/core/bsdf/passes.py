@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from ..base.jit import kernel
 from . import microfacet as mf
-from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND, P_REFRACT_ONLY, REFLECT,
-                     SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .hair_lobes import is_hair
+from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, HAIR_TRANSMISSION, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND,
+                     P_REFRACT_ONLY, REFLECT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
 
 
@@ -34,7 +35,8 @@ def colours(lp, lt, hp, r, mu, mu_o):
             g0 += s0 * e0
             g1 += s1 * e1
             g2 += s2 * e2
-        elif kind == TOON_GLOSSY:  # Cycles' albedo of a closure without tables: its weight
+        elif kind == TOON_GLOSSY or (is_hair(kind) and kind != HAIR_TRANSMISSION):
+            # Cycles' albedo of a closure without tables: its weight (Principled Hair's too, here)
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
             g0 += a0
             g1 += a1
@@ -53,10 +55,16 @@ def colours(lp, lt, hp, r, mu, mu_o):
 def transmission_colour(lp, lt, hp, r, mu, mu_o):
     """The transmission colour RGB as the TransCol pass shows it: Cycles' surface_shader_transmission,
     each glass lobe's transmitted share (its transmission tint times 1 - Fresnel at wo; the whole tint
-    of a Refraction BSDF's), which its transmission closures' albedo estimate gives for a smooth surface."""
+    of a Refraction BSDF's), which its transmission closures' albedo estimate gives for a smooth surface,
+    and the Hair BSDF's transmission lobe's weight."""
     j, t = locate(mu, mu_o)
     c0 = c1 = c2 = 0.0
     for l in range(lp.shape[0]):
+        if int(lp[l, P_KIND]) == HAIR_TRANSMISSION:
+            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            c0 += a0
+            c1 += a1
+            c2 += a2
         if int(lp[l, P_KIND]) != GLASS:
             continue
         s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
@@ -76,8 +84,8 @@ DENOISE_ROUGH = 0.075
 def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
     """(diffuse-like albedo RGB, specular-like albedo RGB, whether the hit is diffuse-like enough
     to take the denoising features), by Cycles' rule: each lobe's albedo goes to one side by its
-    roughness (the glossy toon's counts as 1, as Cycles' bsdf_get_specular_roughness_squared has
-    it for a closure that is not microfacet), and the hit waits for the next bounce if 75% or more
+    roughness (the glossy toon's and hair's count as 1, as Cycles' bsdf_get_specular_roughness_squared
+    has it for a closure that is not microfacet), and the hit waits for the next bounce if 75% or more
     of the lobes' weight (the mean of their albedos) is specular-like."""
     j, t = locate(mu, mu_o)
     d0 = d1 = d2 = s0 = s1 = s2 = 0.0
@@ -100,7 +108,8 @@ def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         weight = (a0 + a1 + a2) / 3.0
         total += weight
-        if diffuse_kind(kind) or kind == TOON_GLOSSY or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH):
+        rough = kind == TOON_GLOSSY or is_hair(kind) or (kind != TRANSPARENT and lp[l, P_ALPHA] > DENOISE_ROUGH)
+        if diffuse_kind(kind) or rough:
             d0 += a0
             d1 += a1
             d2 += a2

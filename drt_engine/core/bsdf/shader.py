@@ -1,5 +1,5 @@
 """Materials as sums of lobes: Lambert, Oren-Nayar, translucent, GGX reflection, dielectric (glass),
-transparent, toon (diffuse and glossy), sheen.
+transparent, toon (diffuse and glossy), sheen, hair (the Hair BSDF's two, Principled Hair).
 
 A ``MaterialShader`` turns one ``Material`` (closures with constant inputs) into lobes
 with Cycles' Principled layering: coat over (metal | glass | specular over diffuse),
@@ -30,6 +30,10 @@ from . import layout
 from . import microfacet as mf
 from . import thin_film as tf
 from .records import BsdfSample, BsdfValue
+from .hair_absorption import melanin_sigma, random_factor, sigma_from_reflectance
+from .hair_chiang import chiang_constants
+from .hair_huang import huang_constants, huang_present
+from .hair_lobes import hair_frames
 from .sheen import sheen_albedo, sheen_rows
 from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, selection_rows, transmission_rows,
                    transparency_rows, weights_rows)
@@ -40,7 +44,7 @@ class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
     arrays of ``layout``."""
     kind: str  # "diffuse" | "oren_nayar" | "translucent" | "reflect" | "glass" | "transparent" | "toon_diffuse"
-    # | "toon_glossy" | "sheen"
+    # | "toon_glossy" | "sheen" | "hair_reflection" | "hair_transmission" | "hair_chiang" | "hair_huang"
     weight: np.ndarray  # constant RGB weight
     layers: list = field(default_factory=list)  # [(max albedo of the layer above over mu, tint)]
     albedo: np.ndarray = field(default_factory=lambda: np.ones(3))  # diffuse colour / transparent tint
@@ -62,10 +66,14 @@ class Lobe:
     f82: np.ndarray | None = None  # metal: F82 tint
     source: int = 0  # index of the closure the lobe comes from
     role: str = ""  # "diffuse" | "metal" | "spec" | "coat" | "glass" | "glossy" | "transparent" | "translucent"
-    # | "toon"
+    # | "toon" | "hair" | "principled_hair"
     affine: tuple | None = None  # (E_A, E_B, e1, a_avg, b_avg): tables of a Fresnel p A(c) + B(c), per-hit p
     alpha_xy: tuple | None = None  # anisotropic reflect lobe: (alpha_x, alpha_y), alpha their geometric mean
     film: tuple = (0.0, 1.0)  # thin film (thickness nm, IOR): reflect lobes of F_FILM / F_F82_FILM, glass
+    hair: tuple = ()  # hair: its model's constants (layout.P_HAIR)
+    hair_cut: bool = False  # Principled Hair: Cycles 5 cuts its light by its own normal (layout.P_HAIR_CUT)
+    hair_sigma: np.ndarray = field(default_factory=lambda: np.zeros(3))  # Principled Hair: absorption
+    hair_radial: float = 0.0  # Principled Hair: the radial roughness a per-hit reflectance colour's sigma takes
     own_normal: bool = False  # the coat of a Principled whose Coat Normal varies: its own normal per hit
     under_own: bool = False  # under such a coat: its first layer term read at the coat normal's cosine
 
@@ -458,6 +466,35 @@ def sheen_lobe(weight, colour, roughness) -> Lobe:
                 role="sheen")
 
 
+def principled_hair_lobe(c: Closure, cut: bool) -> Lobe | None:
+    """The Principled Hair BSDF as Cycles' svm_node_closure_bsdf sets its closure up on a mesh: Random
+    (the socket's; a mesh has no per-strand random) spreads Roughness and the melanin, the
+    absorption from the parametrization (colour as reflectance, melanin with its tint, or direct),
+    then the model's own setup (core.bsdf.hair_chiang, hair_huang; Huang's radial roughness is its
+    roughness, and it makes no closure with its three gains at 0). The node's colour is no weight.
+    ``cut``: the material's Cycles (5.x) cuts the closure's light by its own normal (hair_lobes)."""
+    random = float(c.hair_random)
+    spread = float(random_factor(random, float(c.random_roughness)))
+    roughness = float(c.roughness) * spread
+    huang = c.hair_model == "HUANG"
+    radial = roughness if huang else float(c.radial_roughness) * spread
+    if c.hair_parametrization == "ABSORPTION":
+        sigma = np.array(c.absorption, float)
+    elif c.hair_parametrization == "MELANIN":
+        tint_spread = random_factor(random, float(np.clip(c.random_color, 0.0, 1.0)))
+        sigma = melanin_sigma(c.melanin, c.melanin_redness, c.hair_tint, radial, tint_spread)
+    else:
+        sigma = sigma_from_reflectance(c.color, radial)
+    if huang:
+        if not huang_present(*c.hair_gains):
+            return None
+        kind, constants = "hair_huang", huang_constants(roughness, c.hair_offset, c.ior, c.aspect_ratio, *c.hair_gains)
+    else:
+        kind, constants = "hair_chiang", chiang_constants(roughness, radial, c.hair_coat, c.hair_offset, c.ior)
+    return Lobe(kind, c.weight, hair=tuple(float(x) for x in constants), hair_cut=cut,
+                hair_sigma=np.asarray(sigma, float), hair_radial=radial, role="principled_hair")
+
+
 def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
     lobes = []
     for i, c in enumerate(material.closures):
@@ -486,6 +523,11 @@ def lobes_of(material: Material, tables: Tables = EXACT) -> list[Lobe]:
             new = [sheen_lobe(c.weight, np.clip(c.color, 0, 1), c.roughness)]
         elif c.kind == "TRANSPARENT":
             new = [Lobe("transparent", c.weight, albedo=np.clip(c.color, 0, 1), role="transparent")]
+        elif c.kind in ("HAIR_REFLECTION", "HAIR_TRANSMISSION"):
+            new = [Lobe(c.kind.lower(), c.weight, albedo=np.array(c.color, float), role="hair",
+                        hair=(c.roughness, c.hair_roughness_v, -c.hair_offset))]
+        elif c.kind == "PRINCIPLED_HAIR":
+            new = [lobe for lobe in [principled_hair_lobe(c, material.bump_shadowing == "GGX")] if lobe is not None]
         else:
             new = []
         for lobe in new:
@@ -504,7 +546,9 @@ def see_through(material: Material) -> bool:
 
 _KINDS = {"diffuse": layout.DIFFUSE, "reflect": layout.REFLECT, "glass": layout.GLASS,
           "transparent": layout.TRANSPARENT, "translucent": layout.TRANSLUCENT, "oren_nayar": layout.OREN_NAYAR,
-          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY, "sheen": layout.SHEEN}
+          "toon_diffuse": layout.TOON_DIFFUSE, "toon_glossy": layout.TOON_GLOSSY, "sheen": layout.SHEEN,
+          "hair_reflection": layout.HAIR_REFLECTION, "hair_transmission": layout.HAIR_TRANSMISSION,
+          "hair_chiang": layout.HAIR_CHIANG, "hair_huang": layout.HAIR_HUANG}
 
 
 def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -524,6 +568,8 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         row[layout.P_TOON_SIZE], row[layout.P_TOON_SMOOTH] = lobe.toon
         row[layout.P_FILM], row[layout.P_FILM_IOR] = lobe.film
         row[layout.P_OWN_NORMAL], row[layout.P_UNDER_OWN] = lobe.own_normal, lobe.under_own
+        row[layout.P_HAIR:layout.P_HAIR + len(lobe.hair)] = lobe.hair
+        row[layout.P_HAIR_CUT] = lobe.hair_cut
         if lobe.sheen is not None:
             row[layout.P_SHEEN_TABLE:layout.P_SHEEN_TABLE + 3 * layout.SHEEN_N] = lobe.sheen.reshape(-1)
         if lobe.anisotropic:
@@ -558,6 +604,7 @@ def _pack(lobes: list[Lobe], sampled: list[Lobe]) -> tuple[np.ndarray, np.ndarra
         h[layout.H_TINT_T:layout.H_TINT_T + 3] = lobe.tint_t
         h[layout.H_F0:layout.H_F0 + 3] = lobe.f0
         h[layout.H_NORMAL + 2] = 1.0
+        h[layout.H_SIGMA:layout.H_SIGMA + 3] = lobe.hair_sigma
     return lp, lt, hp
 
 
@@ -586,6 +633,8 @@ class MaterialShader:
         self.emission = material.emission
         self.sampled = [lobe for lobe in self.lobes if not lobe.diffuse]
         self.has_glass = any(lobe.kind == "glass" for lobe in self.lobes)
+        self.hair = any(lobe.role in ("hair", "principled_hair") for lobe in self.lobes)
+        """It has hair lobes: a bound shader takes their frames with ``turn_hair``."""
         for lobe in self.lobes:
             names = (varying or {}).get(lobe.source, ())
             if "color" in names and lobe.role == "metal":
@@ -627,8 +676,16 @@ class MaterialShader:
                 hp[:, l, layout.H_SCALE:layout.H_SCALE + 3] = v["weight"]
             if "coat_normal" in v and lobe.own_normal:
                 hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = v["coat_normal"]  # world, until turn_coat
+            if "hair_tangent" in v and lobe.hair:
+                hp[:, l, layout.H_HAIR:layout.H_HAIR + 3] = v["hair_tangent"]  # world, until turn_hair
             color = v.get("color")
             if color is None:
+                continue
+            if lobe.role == "principled_hair":  # its colour is a reflectance: the absorption per hit
+                hp[:, l, layout.H_SIGMA:layout.H_SIGMA + 3] = sigma_from_reflectance(color, lobe.hair_radial)
+                continue
+            if lobe.role == "hair":  # Cycles takes its colour as the weight, unclipped
+                hp[:, l, layout.H_COLOUR:layout.H_COLOUR + 3] = color
                 continue
             base = np.clip(color, 0.0, 1.0)
             if lobe.role in ("diffuse", "transparent", "translucent", "toon", "sheen"):
@@ -670,6 +727,20 @@ class MaterialShader:
                 hp[:, l, layout.H_NORMAL:layout.H_NORMAL + 3] = normal_l
             if lobe.own_normal or lobe.under_own:
                 hp[:, l, layout.H_PLACE], hp[:, l, layout.H_PLACE + 1] = j, t
+        turned = copy.copy(self)
+        turned.hp = hp
+        return turned
+
+    def turn_hair(self, to_local: Callable, ng_l: np.ndarray, n_l: np.ndarray, wo_l: np.ndarray) -> "MaterialShader":
+        """The bound shader with each hit's hair frames: its hair lobes' tangents (world, as bound) in
+        the shading frame (``to_local``) and what each model derives from them, the geometric normal
+        facing wo ``ng_l``, the shading normal ``n_l`` and ``wo_l`` (local; hair_lobes.hair_frames)."""
+        hp = self.hp.copy()
+        tangent = np.zeros((len(hp), len(self.lobes), 3))
+        for l, lobe in enumerate(self.lobes):
+            if lobe.hair:
+                tangent[:, l] = to_local(hp[:, l, layout.H_HAIR:layout.H_HAIR + 3])
+        hair_frames(self.lp, hp, tangent, _floats(ng_l), _floats(n_l), _floats(wo_l))
         turned = copy.copy(self)
         turned.hp = hp
         return turned
@@ -784,9 +855,9 @@ class MaterialShader:
         return diff, gloss
 
     def transmission_color(self, mu_o: np.ndarray, rows=None) -> np.ndarray:
-        """The transmission colour as the TransCol pass shows it (zero without glass lobes)."""
+        """The transmission colour as the TransCol pass shows it (zero without glass or hair transmission lobes)."""
         out = np.zeros((len(mu_o), 3))
-        if self.has_glass:
+        if self.has_glass or any(lobe.kind == "hair_transmission" for lobe in self.lobes):
             transmission_rows(self.lp, self.lt, self.hp, self.hit_rows(len(mu_o), rows), self.mu, _floats(mu_o), out)
         return out
 

@@ -630,8 +630,11 @@ class Integrator:
                                 dn=_diffuse_normal(frame, n, kept), smooth=smooth)
             for sub, shader in groups:
                 taken = group.take(sub)
-                yield g.start + sub, taken, (_coat_turned(shader, taken, shading.material.bump_correction)
-                                             if shader.coat_normal else shader)
+                if shader.coat_normal:
+                    shader = _coat_turned(shader, taken, shading.material.bump_correction)
+                if shader.hair:
+                    shader = _hair_turned(shader, taken)
+                yield g.start + sub, taken, shader
 
     def _context(self, group: SurfaceHits, hits, shadow: bool = False,
                  occlusion: OcclusionRays | None = None) -> SurfaceContext:
@@ -815,6 +818,14 @@ def _diffuse_normal(frame: Frame, n, kept) -> np.ndarray:
     if len(own):
         dn[own] = frame[own].to_local(kept[own])
     return dn
+
+
+def _hair_turned(shader, hits: SurfaceHits):
+    """The bound shader with its hair lobes' frames at each hit (MaterialShader.turn_hair): the
+    geometric normal turned toward wo, as Cycles' sd->Ng on a back face, and the mesh's shading normal."""
+    ng = np.where((vec.dot(hits.wo, hits.ng) < 0)[:, None], -hits.ng, hits.ng)
+    frame = hits.frame
+    return shader.turn_hair(frame.to_local, frame.to_local(ng), frame.to_local(hits.ns), hits.wo_l)
 
 
 def _coat_turned(shader, hits: SurfaceHits, raises: bool):

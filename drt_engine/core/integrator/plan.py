@@ -57,6 +57,11 @@ class RenderPlan:
         return text
 
 
+REFLECTING = {"reflect", "glass", "toon_glossy", "hair_reflection", "hair_chiang", "hair_huang"}
+TRANSMITTING = {"glass", "hair_transmission", "hair_chiang", "hair_huang"}
+"""Lobe kinds (core.bsdf.shader.Lobe) paths continue through by reflection, and through the surface."""
+
+
 def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     """The plan for one scene (SceneData), its settings and the renderer's built parts."""
     camera = scene.camera
@@ -74,8 +79,8 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     bounces = settings.max_depth > 0
     rays = {"camera": True,
             "shadow": lights.strategies > 0 and bool(kinds),
-            "reflection": bounces and bool(kinds & {"reflect", "glass", "toon_glossy"}),
-            "refraction": bounces and "glass" in kinds,
+            "reflection": bounces and bool(kinds & REFLECTING),
+            "refraction": bounces and bool(kinds & TRANSMITTING),
             "transparent": bounces and "transparent" in kinds,
             "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS)),
             "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion and Bevel nodes

@@ -23,8 +23,9 @@ from . import geometrynodes as gn
 from .nodes import Evaluator
 from .textures import Texture
 
-LINEAR_INPUTS = ("weight", "color", "coat_normal")
-"""Inputs that enter the lobes per hit (a coat normal as it is, its frame set by the integrator);
+LINEAR_INPUTS = ("weight", "color", "coat_normal", "hair_tangent")
+"""Inputs that enter the lobes per hit (a coat normal and a hair's strand as they are, their frames set
+by the integrator);
 the others key a cached shader, but for ``PER_HIT_INPUTS``."""
 PER_HIT_INPUTS = ("normal", "emission", "tangent", "anisotropic_rotation")
 """Inputs read per hit outside the lobes: the shading frame's normal and tangent, emission."""
@@ -100,6 +101,9 @@ class SurfaceContext:
             return self._window()
         if name == "parametric":  # Cycles' (1 - u - v, u, 0): the weights of the triangle's first two corners
             return np.concatenate([self.bary[:, :2], np.zeros((self.n, 1))], axis=1)
+        if name in ("dpdu", "dpdv"):  # Cycles' sd->dPdu, dPdv: the edges from the first corner, turned on back faces
+            edge = a.edges(self.prim)[0 if name == "dpdu" else 1]
+            return np.where(self.backfacing()[:, None], -edge, edge)
         if name == "tangent":
             return self.tangent_node("RADIAL", "Z")
         p = a.object_position(self.prim, self.bary)
@@ -321,7 +325,7 @@ class SurfaceAttributes:
         """(N, 3, 3) world-space corners (mid-shutter) of triangles ``prim``."""
         return self.geometry.world_corners(prim)
 
-    def _edges(self, prim):
+    def edges(self, prim):
         """World-space edges (mid-shutter) of triangles ``prim`` from their first corner."""
         p = self.world_corners(prim)
         return p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
@@ -346,7 +350,7 @@ class SurfaceAttributes:
 
     def bary_shift(self, prim, dp):
         """Barycentric change for a world-space step dp in the triangle's plane."""
-        e1, e2 = self._edges(prim)
+        e1, e2 = self.edges(prim)
         a11 = np.einsum("ij,ij->i", e1, e1)
         a12 = np.einsum("ij,ij->i", e1, e2)
         a22 = np.einsum("ij,ij->i", e2, e2)
@@ -389,7 +393,7 @@ class SurfaceAttributes:
         du2, dv2 = (uv2 - uv0).T
         det = du1 * dv2 - du2 * dv1
         det = np.where(np.abs(det) > 1e-20, det, 1e-20)
-        e1, e2 = self._edges(prim)
+        e1, e2 = self.edges(prim)
         dpdu = (e1 * dv2[:, None] - e2 * dv1[:, None]) / det[:, None]
         dpdv = (e2 * du1[:, None] - e1 * du2[:, None]) / det[:, None]
         t = vec.normalize(dpdu - normal * np.einsum("ij,ij->i", dpdu, normal)[:, None], 1e-300)
