@@ -15,6 +15,7 @@ from bpy_extras.object_utils import world_to_camera_view
 from mathutils import Vector
 
 from drt_engine.blender.export import export_scene
+from drt_engine.blender.export.materials import HUANG_NOTE
 from drt_engine.core.errors import SceneError
 from drt_engine.core.scene import DEFAULT_MATERIAL
 
@@ -805,14 +806,14 @@ def test_view_layer_material_and_world_overrides():
 
 def test_unsupported_shader_node_renders_default_grey_with_one_warning():
     scene = empty_scene()
-    material, tree, output = _new_node_material("Hair")
-    tree.links.new(tree.nodes.new("ShaderNodeBsdfHair").outputs[0], output.inputs["Surface"])
+    material, tree, output = _new_node_material("Portal")
+    tree.links.new(tree.nodes.new("ShaderNodeBsdfRayPortal").outputs[0], output.inputs["Surface"])
     data = render_export(_material_scene(material))
-    closures = _closures(data, "Hair")
+    closures = _closures(data, "Portal")
     assert [(c.kind, tuple(c.color)) for c in closures] == [
         (c.kind, tuple(c.color)) for c in DEFAULT_MATERIAL.closures
     ]
-    assert len(data.warnings) == 1 and "Hair BSDF" in data.warnings[0]
+    assert len(data.warnings) == 1 and "Ray Portal BSDF" in data.warnings[0]
 
 
 @pytest.mark.parametrize("distribution", ["MICROFIBER", "ASHIKHMIN"])
@@ -852,6 +853,71 @@ def test_toon_bsdf_exports_its_component_size_and_smooth_without_a_warning(compo
     np.testing.assert_allclose(closure.color, (0.2, 0.4, 0.6), rtol=1e-6)
     assert (closure.toon_size, closure.toon_smooth) == pytest.approx((0.3, 0.1))
     assert data.warnings == []
+
+
+def _program_coord(material, ref):
+    """The coordinate name of the program node ``ref`` points at."""
+    node = material.program.nodes[ref[0]]
+    assert node.op == "coord"
+    return node.params["name"]
+
+
+@pytest.mark.parametrize("component, kind", [("Reflection", "HAIR_REFLECTION"), ("Transmission", "HAIR_TRANSMISSION")])
+def test_hair_bsdf_exports_about_the_triangles_dpdv_without_a_warning(component, kind):
+    """Unlinked Tangent: the strand is each triangle's dPdv and Offset 0, as Cycles on a mesh;
+    linked: that direction, with the node's Offset."""
+    empty_scene()
+    material, tree, output = _new_node_material("Hair")
+    hair = tree.nodes.new("ShaderNodeBsdfHair")
+    hair.component = component
+    hair.inputs["Color"].default_value = (0.2, 0.4, 0.6, 1.0)
+    hair.inputs["Offset"].default_value = 0.1
+    hair.inputs["RoughnessU"].default_value = 0.2
+    hair.inputs["RoughnessV"].default_value = 0.7
+    tree.links.new(hair.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Hair")
+    (exported,) = [m for m in data.materials if m.name == "Hair"]
+    assert closure.kind == kind and data.warnings == []
+    assert (closure.roughness, closure.hair_roughness_v, closure.hair_offset) == pytest.approx((0.2, 0.7, 0.0))
+    np.testing.assert_allclose(closure.color, (0.2, 0.4, 0.6), rtol=1e-6)
+    assert _program_coord(exported, closure.inputs["hair_tangent"]) == "dpdv"
+    tree.links.new(tree.nodes.new("ShaderNodeTexCoord").outputs["Object"], hair.inputs["Tangent"])
+    data = render_export(bpy.context.scene)
+    (closure,) = _closures(data, "Hair")
+    (exported,) = [m for m in data.materials if m.name == "Hair"]
+    assert closure.hair_offset == pytest.approx(0.1)
+    assert _program_coord(exported, closure.inputs["hair_tangent"]) == "object"
+
+
+@pytest.mark.parametrize("model", ["CHIANG", "HUANG"])
+def test_principled_hair_exports_its_model_and_parametrization(model):
+    """Chiang without a warning; Huang named (export.materials.HUANG_NOTE)."""
+    empty_scene()
+    material, tree, output = _new_node_material("Principled Hair")
+    hair = tree.nodes.new("ShaderNodeBsdfHairPrincipled")
+    hair.model, hair.parametrization = model, "MELANIN"
+    values = {"Melanin": 0.3, "Melanin Redness": 0.6, "Roughness": 0.25, "IOR": 1.4, "Random Roughness": 0.2}
+    for name, value in values.items():
+        hair.inputs[name].default_value = value
+    hair.inputs["Tint"].default_value = (0.9, 0.8, 0.7, 1.0)
+    if model == "HUANG":  # Huang's alone
+        hair.inputs["Secondary Reflection"].default_value = 0.5
+    tree.links.new(hair.outputs[0], output.inputs["Surface"])
+    data = render_export(_material_scene(material))
+    (closure,) = _closures(data, "Principled Hair")
+    (exported,) = [m for m in data.materials if m.name == "Principled Hair"]
+    assert closure.kind == "PRINCIPLED_HAIR"
+    if model == "HUANG":
+        assert len(data.warnings) == 1 and HUANG_NOTE in data.warnings[0], data.warnings
+    else:
+        assert data.warnings == []
+    assert (closure.hair_model, closure.hair_parametrization) == (model, "MELANIN")
+    got = (closure.melanin, closure.melanin_redness, closure.roughness, closure.ior, closure.random_roughness)
+    assert got == pytest.approx(tuple(values.values()), rel=1e-6)
+    np.testing.assert_allclose(closure.hair_tint, (0.9, 0.8, 0.7), rtol=1e-6)
+    np.testing.assert_allclose(closure.hair_gains, (1.0, 1.0, 0.5) if model == "HUANG" else (1.0, 1.0, 1.0), rtol=1e-6)
+    assert _program_coord(exported, closure.inputs["hair_tangent"]) == "dpdu"
 
 
 def test_principled_thin_film_exports_thickness_and_ior_without_a_warning_from_5_0():

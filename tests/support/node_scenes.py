@@ -958,6 +958,25 @@ def _translucent_over_diffuse(tree):
     return mix
 
 
+def _hair(component):
+    """The Hair BSDF's Reflection or Transmission component (defaults but the colour): on a mesh
+    about each triangle's dPdv."""
+    def build(tree):
+        node = _link(tree, _node(tree, "ShaderNodeBsdfHair"), Color=(0.9, 0.6, 0.3, 1.0))
+        node.component = component
+        return node
+    return build
+
+
+def _principled_hair(model, parametrization, **inputs):
+    """A Principled Hair BSDF of this model and parametrization (set before the inputs it enables)."""
+    def build(tree):
+        node = _node(tree, "ShaderNodeBsdfHairPrincipled")
+        node.model, node.parametrization = model, parametrization
+        return _link(tree, node, **inputs)
+    return build
+
+
 @dataclass(frozen=True)
 class ClosureCase:
     name: str
@@ -983,6 +1002,12 @@ CLOSURES = (
     ClosureCase("Translucent mixed with Diffuse", "square", _translucent_over_diffuse),
     ClosureCase("Sheen BSDF, roughness 0.3", "sphere", _sheen),
     ClosureCase("Principled BSDF, Sheen Weight 1 over a dark base", "sphere", _principled_sheen),
+    ClosureCase("Hair BSDF, Reflection", "sphere", _hair("Reflection")),
+    ClosureCase("Hair BSDF, Transmission", "sphere", _hair("Transmission")),
+    ClosureCase("Principled Hair BSDF, Chiang, Direct Coloring", "sphere",
+                _principled_hair("CHIANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))),
+    ClosureCase("Principled Hair BSDF, Chiang, Melanin, Coat 0.3", "sphere",
+                _principled_hair("CHIANG", "MELANIN", Melanin=0.5, Coat=0.3)),
 )
 """Closures under two suns, each in its own square of ``closure_scene``: toon spheres, glossy and
 diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere, thin-film spheres from 5.0 (whose
@@ -994,7 +1019,9 @@ textured, and a Principled BSDF's Diffuse Roughness), upright squares lit throug
 (Translucent, alone and mixed with a Diffuse lit in front) and sheen spheres (the Sheen BSDF, a
 Principled's sheen over a dark base; last: each square's neighbours light it, and between the
 rough diffuse spheres and the squares the sheen spheres took the Principled sheen to 0.0242 against a
-limit of 0.0238 and, before the thin films, the rough diffuse and translucent cases over theirs)."""
+limit of 0.0238 and, before the thin films, the rough diffuse and translucent cases over theirs), then
+the hair closures on spheres (shaded about each triangle's edge, as Cycles does on a mesh; Principled
+Hair's Huang model, named in its warning, in tests/blender/test_hair_cycles.py)."""
 
 
 def closure_part(i: int, size: int):

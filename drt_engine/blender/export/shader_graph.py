@@ -388,6 +388,13 @@ class Compiler:
             self._memo[key] = self._coord("tangent")
         return self._memo[key]
 
+    def triangle_edge(self, name):
+        """Cycles' sd->dPdu ("dpdu") or sd->dPdv ("dpdv") of the hit triangle, the strand a hair
+        closure on a mesh shades about, one program node however many closures read it."""
+        if name not in self._memo:
+            self._memo[name] = self._coord(name)
+        return self._memo[name]
+
     def _node_ShaderNodeTexCoord(self, node, output):
         name = output.identifier
         if self.world:

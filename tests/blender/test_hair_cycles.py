@@ -1,0 +1,81 @@
+"""Hair closures on meshes against Cycles: two smooth UV spheres under an area light and a point
+light, shaded about each triangle's edge as Cycles shades a hair closure on a surface that is not
+a curve (the Hair BSDF about dPdv, the Principled Hair BSDF about dPdu, each turned on back faces).
+
+- Hair BSDF: the Reflection component on one sphere, Transmission on the other (RoughnessU 0.1,
+  RoughnessV 1, the node's defaults: Cycles' sampled and evaluated densities agree there).
+- Principled Hair BSDF, Chiang: Direct Coloring on one sphere, Melanin with a Coat on the other;
+  Huang: Direct Coloring, and Melanin with an Aspect Ratio of 0.6.
+
+Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) within
+1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the node left out (default
+grey, as before DRT had it) must fail that limit. Measured (96x48, 128 spp, 5.0.1): Hair BSDF within;
+Chiang 0.0574 against 0.0886, image means within DRT's own seeds (left sphere 0.0346-0.0369 over
+three seeds, Cycles 0.0359); Huang 0.0637 against 0.0864, but its means 9% under Cycles' (0.0460-0.0467
+against 0.0505-0.0521): equal under the point light alone, under the area light not, and Cycles'
+image with both lights is not the sum of its images with each (its Huang estimate mixes an
+evaluation and a sampling that disagree in energy), so Huang is named (HUANG_NOTE)."""
+from __future__ import annotations
+
+import pytest
+
+from drt_engine.blender.export import materials as export_materials
+from drt_engine.blender.export.materials import HUANG_NOTE
+from tests.support import procedural_scenes as ps
+from tests.support import render_helpers as rh
+from tests.support.export_helpers import render_export
+
+WIDTH, HEIGHT = 96, 48
+SAMPLES = 128
+
+
+def _hair_bsdf(name, component, colour):
+    material, node = ps.closure_material(name, "ShaderNodeBsdfHair", Color=colour)
+    node.component = component
+    return material
+
+
+def _principled_hair(name, model, parametrization, **inputs):
+    material, node = ps.closure_material(name, "ShaderNodeBsdfHairPrincipled")
+    node.model, node.parametrization = model, parametrization  # before the inputs they enable
+    for socket, value in inputs.items():
+        node.inputs[socket].default_value = value
+    return material
+
+
+def hair_scene(node):
+    """Two spheres of ``node``'s closure, lit by an area and a point light over a black world."""
+    scene = ps._scene(WIDTH, HEIGHT)
+    ps.aim(scene.camera, (0.0, -7.0, 1.5))
+    scene.camera.data.lens = 50.0
+    ps.black_world(scene)
+    ps.add_light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
+    ps.add_light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
+    if node == "ShaderNodeBsdfHair":
+        left = _hair_bsdf("Reflection", "Reflection", (0.9, 0.6, 0.3, 1.0))
+        right = _hair_bsdf("Transmission", "Transmission", (0.6, 0.8, 0.9, 1.0))
+    elif node == "CHIANG":
+        left = _principled_hair("Coloured", "CHIANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))
+        right = _principled_hair("Melanin", "CHIANG", "MELANIN", Melanin=0.5, Coat=0.3)
+    else:
+        left = _principled_hair("Coloured", "HUANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))
+        right = _principled_hair("Melanin", "HUANG", "MELANIN", Melanin=0.5, **{"Aspect Ratio": 0.6})
+    ps.smooth_sphere("Left", -1.1, left)
+    ps.smooth_sphere("Right", 1.1, right)
+    return scene
+
+
+@pytest.mark.parametrize("node", ["ShaderNodeBsdfHair", "CHIANG", "HUANG"])
+def test_hair_closures_match_cycles(drt, tmp_path, monkeypatch, node):
+    """Parity (and Huang named in the warning: its image means differ, see HUANG_NOTE)."""
+    scene = hair_scene(node)
+    warnings = render_export(scene).warnings
+    named = [w for w in warnings if HUANG_NOTE in w]
+    assert (len(named) == len(warnings) == 2) if node == "HUANG" else warnings == [], warnings
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, node)
+    monkeypatch.delitem(export_materials.CLOSURE_NODES, node if node.startswith("Shader") else
+                        "ShaderNodeBsdfHairPrincipled")
+    grey = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="grey")
+    off = ps.parity(grey.rgb, cycles0.rgb, cycles1.rgb)
+    print("left grey", off)
+    assert not off["ok"], f"the {node} left grey passes too: {off}"
