@@ -59,6 +59,13 @@ def hair_eval(lp, hp, r, l, transmit, wox, woy, woz, wix, wiy, wiz):
     (``transmit`` False) or bsdf_hair_transmission_eval; 0 on the wrong side of the normal (z)."""
     if (wiz < 0.0) != transmit:
         return 0.0
+    return _density(lp, hp, r, l, transmit, True, wox, woy, woz, wix, wiy, wiz)
+
+
+@kernel(inline="always")
+def _density(lp, hp, r, l, transmit, evaluated, wox, woy, woz, wix, wiy, wiz):
+    """The lobe's density toward wi; ``evaluated``: with the evaluation's check that reflection
+    stays on the view's side of the strand (Cycles' sampling reports its density without it)."""
     r1, r2, offset = _params(lp, l)
     tx, ty, tz = hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2]
     iz, lx, ly, lz = _across(tx, ty, tz, wox, woy, woz)
@@ -68,7 +75,7 @@ def hair_eval(lp, hp, r, l, transmit, wox, woy, woz, wix, wiy, wiz):
     oz, yx, yy, yz = _across(tx, ty, tz, wix, wiy, wiz)
     theta_i = 0.5 * math.pi - math.acos(min(max(oz, -1.0), 1.0))
     cos_phi = min(max(yx * lx + yy * ly + yz * lz, -1.0), 1.0)
-    if 0.5 * math.pi - abs(theta_i) < GRAZING or (cos_phi < 0.0 and not transmit):
+    if 0.5 * math.pi - abs(theta_i) < GRAZING or (cos_phi < 0.0 and not transmit and evaluated):
         return 0.0
     a, b = _width(r1, offset, theta_r)
     theta_pdf = _theta_pdf(r1, offset, theta_r, theta_i, a - b)
@@ -82,10 +89,12 @@ def hair_eval(lp, hp, r, l, transmit, wox, woy, woz, wix, wiy, wiz):
 
 @kernel(inline="always")
 def hair_sample(lp, hp, r, l, transmit, wox, woy, woz, u0, u1):
-    """(wi, its f |cos| = pdf as ``hair_eval`` gives it): bsdf_hair_reflection_sample or
-    bsdf_hair_transmission_sample. Cycles' sampled azimuth for reflection has the density
-    ``hair_eval`` gives (its sample function reports cos(phi / 2) / (4 RoughnessV), which differs
-    unless RoughnessV is 1); the density returned here is the evaluated one."""
+    """(wi, its f |cos| = pdf): bsdf_hair_reflection_sample or bsdf_hair_transmission_sample, whose
+    value and density do not look at the side of the normal wi leaves by (a reflection may go
+    below the surface, a transmission stay above: Cycles continues either with weight 1; the
+    mixture keeps them, core.bsdf.mixture.sample_lobes). Cycles' sampled azimuth for reflection has
+    the density its evaluation gives (its sample function reports cos(phi / 2) / (4 RoughnessV),
+    which differs unless RoughnessV is 1); the density returned here is the true one."""
     r1, r2, offset = _params(lp, l)
     tx, ty, tz = hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2]
     iz, lx, ly, lz = _across(tx, ty, tz, wox, woy, woz)
@@ -104,4 +113,4 @@ def hair_sample(lp, hp, r, l, transmit, wox, woy, woz, u0, u1):
     wix = cp * ct * lx - sp * ct * bx + st * tx
     wiy = cp * ct * ly - sp * ct * by + st * ty
     wiz = cp * ct * lz - sp * ct * bz + st * tz
-    return wix, wiy, wiz, hair_eval(lp, hp, r, l, transmit, wox, woy, woz, wix, wiy, wiz)
+    return wix, wiy, wiz, _density(lp, hp, r, l, transmit, False, wox, woy, woz, wix, wiy, wiz)

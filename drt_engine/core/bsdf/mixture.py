@@ -26,7 +26,7 @@ from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
-from .hair_lobes import hair_lobe_eval, hair_lobe_sample, is_hair, own_hair_normal
+from .hair_lobes import hair_lobe_eval, hair_lobe_sample, is_hair
 from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
                      SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
@@ -302,10 +302,11 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     if valid and not delta:
         _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
                                               sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz)
-        if is_hair(kind) and own_hair_normal(lp, l):
-            # Cycles keeps a sampled Principled Hair's own value and density: Huang's is its path's
-            # weight (its evaluation is a quadrature), and Cycles 5 cuts neither by the closure's
-            # normal as it cuts their evaluation (hair_lobes.hair_lobe_eval)
+        if is_hair(kind):
+            # Cycles keeps a sampled hair closure's own value and density: the Hair BSDF's ignore
+            # the side of the surface wi leaves by, Huang's is its path's weight (its evaluation is a
+            # quadrature), and Cycles 5 cuts no sample by Principled Hair's own normal as it cuts
+            # their evaluation (hair_lobes.hair_lobe_eval)
             _, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
             e0, e1, e2, e_pdf = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
             f0 += s0 * shade * (h0 - e0)
