@@ -14,13 +14,16 @@ Chiang 0.0574 against 0.0886, image means within DRT's own seeds (left sphere 0.
 three seeds, Cycles 0.0359); Huang 0.0637 against 0.0864, but its means 9% under Cycles' (0.0460-0.0467
 against 0.0505-0.0521): equal under the point light alone, under the area light not, and Cycles'
 image with both lights is not the sum of its images with each (its Huang estimate mixes an
-evaluation and a sampling that disagree in energy), so Huang is named (HUANG_NOTE)."""
+evaluation and a sampling that disagree in energy), so Huang is named (HUANG_NOTE). Blender 4.2's
+Cycles computes Principled Hair otherwise (Chiang's left sphere 0.0451 there, 0.0359 in 5.0): before
+5.0 the node is named (VERSION_PRINCIPLED_HAIR) and not compared."""
 from __future__ import annotations
 
+import bpy
 import pytest
 
 from drt_engine.blender.export import materials as export_materials
-from drt_engine.blender.export.materials import HUANG_NOTE
+from drt_engine.blender.export.materials import HUANG_NOTE, PRINCIPLED_HAIR_MATCHED_FROM, VERSION_PRINCIPLED_HAIR
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support.export_helpers import render_export
@@ -70,8 +73,11 @@ def test_hair_closures_match_cycles(drt, tmp_path, monkeypatch, node):
     """Parity (and Huang named in the warning: its image means differ, see HUANG_NOTE)."""
     scene = hair_scene(node)
     warnings = render_export(scene).warnings
+    if node != "ShaderNodeBsdfHair" and bpy.app.version < PRINCIPLED_HAIR_MATCHED_FROM:
+        assert len(warnings) == 2 and all(VERSION_PRINCIPLED_HAIR in w for w in warnings), warnings
+        return
     named = [w for w in warnings if HUANG_NOTE in w]
-    assert (len(named) == len(warnings) == 2) if node == "HUANG" else warnings == [], warnings
+    assert len(named) == len(warnings) == (2 if node == "HUANG" else 0), warnings
     cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, node)
     monkeypatch.delitem(export_materials.CLOSURE_NODES, node if node.startswith("Shader") else
                         "ShaderNodeBsdfHairPrincipled")

@@ -1005,9 +1005,9 @@ CLOSURES = (
     ClosureCase("Hair BSDF, Reflection", "sphere", _hair("Reflection")),
     ClosureCase("Hair BSDF, Transmission", "sphere", _hair("Transmission")),
     ClosureCase("Principled Hair BSDF, Chiang, Direct Coloring", "sphere",
-                _principled_hair("CHIANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))),
+                _principled_hair("CHIANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0)), since=(5, 0)),
     ClosureCase("Principled Hair BSDF, Chiang, Melanin, Coat 0.3", "sphere",
-                _principled_hair("CHIANG", "MELANIN", Melanin=0.5, Coat=0.3)),
+                _principled_hair("CHIANG", "MELANIN", Melanin=0.5, Coat=0.3), since=(5, 0)),
 )
 """Closures under two suns, each in its own square of ``closure_scene``: toon spheres, glossy and
 diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere, thin-film spheres from 5.0 (whose

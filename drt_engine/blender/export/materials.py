@@ -306,6 +306,11 @@ def _hair(node, weight, issues, compiler):
     return [_weighted(closure, weight, value.varying)]
 
 
+PRINCIPLED_HAIR_MATCHED_FROM = (5, 0)
+"""The first Blender whose Cycles computes the Principled Hair BSDF as DRT does (5.0's kernels):
+4.2's Chiang renders the test spheres 25% brighter (its closure code differs in 150 lines); there the
+node is named in the warning."""
+VERSION_PRINCIPLED_HAIR = "Principled Hair BSDF: rendered as Cycles 5.0 computes it"
 HUANG_NOTE = ("Huang hair model (rendered as Cycles computes it, but Cycles' own evaluation and sampling of it "
               "disagree in energy, so its image depends on how it weighs light samples: measured up to 9% darker "
               "than Cycles under an area light, equal under a point light)")
@@ -318,6 +323,8 @@ def _principled_hair(node, weight, issues, compiler):
     node's Random socket in place of a strand's random value (core.bsdf.shader.principled_hair_lobe)."""
     value = _Inputs(node, compiler, issues)
     model = getattr(node, "model", "CHIANG")
+    if bpy.app.version < PRINCIPLED_HAIR_MATCHED_FROM:
+        issues.add(f"'{node.name}' {VERSION_PRINCIPLED_HAIR}")
     parametrization = getattr(node, "parametrization", "COLOR")  # Direct Coloring, Melanin, Absorption
     closure = Closure("PRINCIPLED_HAIR", hair_model=model, hair_parametrization=parametrization,
                       roughness=value(0.3, "Roughness", field="roughness", kind="float"),
