@@ -47,9 +47,10 @@ def _frame(d, n, wo):
 
 
 @kernel
-def _transparent(ar, fr, wo):
-    """huang_transparent of one hit."""
-    return hh.huang_transparent(ar, fr[0], fr[1], fr[2], fr[3], fr[4], fr[5], fr[6], wo[0], wo[1], wo[2])
+def _albedo(eta, sigma, fr, wo):
+    """huang_albedo of one hit."""
+    return hh.huang_albedo(eta, sigma[0], sigma[1], sigma[2], fr[0], fr[1], fr[2], fr[3], fr[4], fr[5], fr[6],
+                           wo[0], wo[1], wo[2])
 
 
 def _unit(v):
@@ -216,20 +217,50 @@ def test_gains():
 
 
 def test_frame():
-    """The mesh case of the setup: Y along dPdu, X across dPdu and wo, h = -X . N; |h| = 1 (the
-    normal along X) is Cycles' transparent case. Degenerate dPdu, normal and wo give unit frames."""
+    """The mesh case of the setup: Y along dPdu, X across dPdu and wo, h = -X . N; |h| = 1 only with
+    the normal along X. Degenerate dPdu, normal and wo give unit frames."""
     y, x, h = FRAME[:3], FRAME[3:6], FRAME[6]
     assert np.allclose(y, TANGENT) and np.allclose(x, _unit(np.cross(TANGENT, WO)))
     assert h == pytest.approx(-x @ NORMAL)
-    assert not _transparent(1.0, FRAME, WO) and not _transparent(0.5, FRAME, WO)
     edge = np.array(_frame(TANGENT, x, WO))
-    assert abs(edge[6]) == pytest.approx(1.0) and _transparent(1.0, edge, WO)
+    assert abs(edge[6]) == pytest.approx(1.0)
     for d, n, wo in ((np.zeros(3), NORMAL, WO), (WO, NORMAL, WO), (np.full(3, np.nan), NORMAL, WO),
                      (TANGENT, np.zeros(3), WO), (np.zeros(3), np.zeros(3), WO), (TANGENT, NORMAL, np.full(3, np.inf))):
         fr = np.array(_frame(d, n, wo))
         assert np.all(np.isfinite(fr))
         assert np.linalg.norm(fr[:3]) == pytest.approx(1.0) and np.linalg.norm(fr[3:6]) == pytest.approx(1.0)
         assert fr[:3] @ fr[3:6] == pytest.approx(0.0, abs=1e-12)
+
+
+def _fresnel(cos_i, eta):
+    """Unpolarised dielectric reflectance (textbook form) and the refracted ray's cosine."""
+    sin_t2 = (1.0 - cos_i**2) / eta**2
+    if sin_t2 >= 1.0:
+        return 1.0, 0.0
+    cos_t = np.sqrt(1.0 - sin_t2)
+    rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
+    rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
+    return 0.5 * (rs**2 + rp**2), cos_t
+
+
+def test_albedo_is_cycles_series():
+    """bsdf_hair_huang_albedo: 1 without absorption, the surface's Fresnel with an opaque fibre, and in
+    between the series (A - 2fA + f) / (1 - fA) with A = exp(-2 sigma cos_t / (1 - wt_y^2)), wt the
+    ray refracted at the micro normal (h, 0, sqrt(1 - h^2)); finite at grazing views and infinite sigma."""
+    h = FRAME[6]
+    ix, iy, iz = FRAME[3:6] @ WO, FRAME[:3] @ WO, np.cross(FRAME[3:6], FRAME[:3]) @ WO
+    m = np.array([h, 0.0, np.sqrt(1 - h * h)])
+    f, cos_t = _fresnel(m @ (ix, iy, iz), IOR)
+    wt = (-(m @ (ix, iy, iz)) / IOR + cos_t) * m - np.array([ix, iy, iz]) / IOR  # refracted, into the fibre
+    sigma = np.array([0.0, 0.7, np.inf])
+    a = np.exp(-2.0 * sigma * cos_t / (1.0 - wt[1] ** 2))
+    want = (a - 2 * f * a + f) / (1 - f * a)
+    got = np.array(_albedo(IOR, sigma, FRAME, WO))
+    np.testing.assert_allclose(got, want, rtol=1e-9)
+    assert got[0] == pytest.approx(1.0) and got[2] == pytest.approx(f) and 0 < f < got[1] < 1
+    for wo in (_unit([0.0, 1.0, 1e-12]), TANGENT, _unit([1.0, 0.0, 1e-9])):
+        fr = np.array(_frame(TANGENT, NORMAL, wo))
+        assert np.all(np.isfinite(_albedo(IOR, sigma, fr, wo)))
 
 
 def test_finite_at_extreme_inputs():

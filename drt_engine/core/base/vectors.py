@@ -117,6 +117,28 @@ def unit(x, y, z, tiny=TINY):
 
 
 @kernel(inline="always")
+def dot3(ax, ay, az, bx, by, bz):
+    """a . b of two vectors given by components (the per-ray form of ``dot``)."""
+    return ax * bx + ay * by + az * bz
+
+
+@kernel(inline="always")
+def cross3(ax, ay, az, bx, by, bz):
+    """a x b of two vectors given by components."""
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@kernel(inline="always")
+def safe_unit(x, y, z):
+    """Cycles' safe_normalize: (x, y, z) scaled to unit length, the zero vector left as it is
+    (``unit`` instead lengthens short vectors past their length)."""
+    length = np.sqrt(x * x + y * y + z * z)
+    if length == 0.0:
+        return x, y, z
+    return x / length, y / length, z / length
+
+
+@kernel(inline="always")
 def basis(nx, ny, nz):
     """Two unit vectors completing a unit vector to a right-handed frame (Duff et al. 2017);
     the per-ray form of ``orthonormal_basis``."""

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
+from ..base.vectors import cross3, safe_unit
 from .hair_absorption import albedo_roughness_scale
 from .microfacet import fresnel_dielectric1
 
@@ -72,22 +73,6 @@ def _safe_asin(a):
 def _safe_divide(a, b):
     """a / b, 0 where b is 0."""
     return a / b if b != 0.0 else 0.0
-
-
-@kernel(inline="always")
-def _cross(ax, ay, az, bx, by, bz):
-    """a x b."""
-    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-
-
-@kernel(inline="always")
-def _safe_normalize(x, y, z):
-    """The unit vector along (x, y, z); the zero vector stays zero (Cycles' safe_normalize)."""
-    t = math.sqrt(x * x + y * y + z * z)
-    if t == 0.0:
-        return x, y, z
-    inv = 1.0 / t
-    return x * inv, y * inv, z * inv
 
 
 @kernel(inline="always")
@@ -252,8 +237,8 @@ def _lobes(v, s, m0, alpha, sin_theta_o, cos_theta_o, gamma_o, gamma_t, sin_thet
 @kernel(inline="always")
 def _view(xx, xy, xz, yx, yy, yz, wox, woy, woz):
     """(Z = X x Y normalised, sin theta_o, cos theta_o, phi_o); Z is 0 for a degenerate frame."""
-    zx, zy, zz = _cross(xx, xy, xz, yx, yy, yz)
-    zx, zy, zz = _safe_normalize(zx, zy, zz)
+    zx, zy, zz = cross3(xx, xy, xz, yx, yy, yz)
+    zx, zy, zz = safe_unit(zx, zy, zz)
     sin_theta_o = wox * xx + woy * xy + woz * xz
     phi_o = math.atan2(wox * zx + woy * zy + woz * zz, wox * yx + woy * yy + woz * yz)
     return zx, zy, zz, sin_theta_o, _cos_from_sin(sin_theta_o), phi_o
@@ -263,11 +248,11 @@ def _view(xx, xy, xz, yx, yy, yz, wox, woy, woz):
 def chiang_frame(xx, xy, xz, ngx, ngy, ngz, wox, woy, woz):
     """(Y = X x wo normalised, h = (Ng x X) . Z clamped to [-1, 1]) for the unit tangent X: the
     setup's frame and offset for a thick curve; Y and h are 0 when wo is along X."""
-    yx, yy, yz = _cross(xx, xy, xz, wox, woy, woz)
-    yx, yy, yz = _safe_normalize(yx, yy, yz)
-    zx, zy, zz = _cross(xx, xy, xz, yx, yy, yz)
-    zx, zy, zz = _safe_normalize(zx, zy, zz)
-    cx, cy, cz = _cross(ngx, ngy, ngz, xx, xy, xz)
+    yx, yy, yz = cross3(xx, xy, xz, wox, woy, woz)
+    yx, yy, yz = safe_unit(yx, yy, yz)
+    zx, zy, zz = cross3(xx, xy, xz, yx, yy, yz)
+    zx, zy, zz = safe_unit(zx, zy, zz)
+    cx, cy, cz = cross3(ngx, ngy, ngz, xx, xy, xz)
     return yx, yy, yz, min(max(cx * zx + cy * zy + cz * zz, -1.0), 1.0)
 
 

@@ -34,6 +34,7 @@ import math
 import numpy as np
 
 from ..base.jit import kernel
+from ..base.vectors import cross3, dot3, safe_unit
 from ..base.warps import concentric_disk
 from .ggx_glass_tables import GLASS_E
 from .hair_chiang import longitudinal
@@ -65,27 +66,6 @@ def huang_present(r_gain, tt_gain, trt_gain):
 # -- Cycles' small helpers (util/math, sample/mapping, sample/lcg, util/hash) --
 
 @kernel(inline="always")
-def _dot(ax, ay, az, bx, by, bz):
-    """a . b"""
-    return ax * bx + ay * by + az * bz
-
-
-@kernel(inline="always")
-def _cross(ax, ay, az, bx, by, bz):
-    """a x b"""
-    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-
-
-@kernel(inline="always")
-def _unit(x, y, z):
-    """safe_normalize: the unit vector along (x, y, z), or (x, y, z) itself where its length is 0."""
-    length = math.sqrt(x * x + y * y + z * z)
-    if length == 0.0:
-        return x, y, z
-    return x / length, y / length, z / length
-
-
-@kernel(inline="always")
 def _usable(x, y, z):
     """Neither zero nor with a non-finite component."""
     return (x != 0.0 or y != 0.0 or z != 0.0) and math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
@@ -95,31 +75,31 @@ def _usable(x, y, z):
 def _orthonormals(nx, ny, nz):
     """make_orthonormals: a unit a across the unit n (from (1, 1, 1) x n, or (-1, 1, 1) x n), and n x a."""
     if nx != ny or nx != nz:
-        ax, ay, az = _unit(nz - ny, nx - nz, ny - nx)
+        ax, ay, az = safe_unit(nz - ny, nx - nz, ny - nx)
     else:
-        ax, ay, az = _unit(nz - ny, nx + nz, -ny - nx)
-    bx, by, bz = _cross(nx, ny, nz, ax, ay, az)
+        ax, ay, az = safe_unit(nz - ny, nx + nz, -ny - nx)
+    bx, by, bz = cross3(nx, ny, nz, ax, ay, az)
     return ax, ay, az, bx, by, bz
 
 
 @kernel(inline="always")
 def _reflect(ix, iy, iz, nx, ny, nz):
     """reflect: incident - 2 (incident . n) n."""
-    d = 2.0 * _dot(ix, iy, iz, nx, ny, nz)
+    d = 2.0 * dot3(ix, iy, iz, nx, ny, nz)
     return ix - d * nx, iy - d * ny, iz - d * nz
 
 
 @kernel(inline="always")
 def _refract_angle(ix, iy, iz, nx, ny, nz, cos_t, inv_eta):
     """refract_angle: the refracted direction from the cosine of the refraction angle."""
-    s = inv_eta * _dot(nx, ny, nz, ix, iy, iz) + cos_t
+    s = inv_eta * dot3(nx, ny, nz, ix, iy, iz) + cos_t
     return s * nx - inv_eta * ix, s * ny - inv_eta * iy, s * nz - inv_eta * iz
 
 
 @kernel(inline="always")
 def _visible(vx, vy, vz, mx, my, mz, hx, hy, hz):
     """microfacet_visible: both the micronormal h and the mesonormal m face v."""
-    return _dot(vx, vy, vz, hx, hy, hz) > 0.0 and _dot(vx, vy, vz, mx, my, mz) > 0.0
+    return dot3(vx, vy, vz, hx, hy, hz) > 0.0 and dot3(vx, vy, vz, mx, my, mz) > 0.0
 
 
 @kernel(inline="always")
@@ -199,12 +179,12 @@ def _d(alpha2, cos_h):
 @kernel(inline="always")
 def _sample_vndf(wx, wy, wz, alpha, u0, u1):
     """microfacet_ggx_sample_vndf (isotropic): Heitz 2018's visible normal toward w."""
-    vx, vy, vz = _unit(alpha * wx, alpha * wy, wz)
+    vx, vy, vz = safe_unit(alpha * wx, alpha * wy, wz)
     lensq = vx * vx + vy * vy
     if lensq > 1e-7:
         inv = 1.0 / math.sqrt(lensq)
         t1x, t1y, t1z = -vy * inv, vx * inv, 0.0
-        t2x, t2y, t2z = _cross(vx, vy, vz, t1x, t1y, t1z)
+        t2x, t2y, t2z = cross3(vx, vy, vz, t1x, t1y, t1z)
     else:
         t1x, t1y, t1z = 1.0, 0.0, 0.0
         t2x, t2y, t2z = 0.0, 1.0, 0.0
@@ -214,15 +194,15 @@ def _sample_vndf(wx, wy, wz, alpha, u0, u1):
     hx = px * t1x + py * t2x + pz * vx
     hy = px * t1y + py * t2y + pz * vy
     hz = px * t1z + py * t2z + pz * vz
-    return _unit(alpha * hx, alpha * hy, max(0.0, hz))
+    return safe_unit(alpha * hx, alpha * hy, max(0.0, hz))
 
 
 @kernel(inline="always")
 def _sample_wh(roughness, wx, wy, wz, mx, my, mz, u0, u1):
     """sample_wh: a GGX microfacet normal visible from w about the mesonormal m."""
     sx, sy, sz, tx, ty, tz = _orthonormals(mx, my, mz)
-    hx, hy, hz = _sample_vndf(_dot(wx, wy, wz, sx, sy, sz), _dot(wx, wy, wz, tx, ty, tz),
-                              _dot(wx, wy, wz, mx, my, mz), roughness, u0, u1)
+    hx, hy, hz = _sample_vndf(dot3(wx, wy, wz, sx, sy, sz), dot3(wx, wy, wz, tx, ty, tz),
+                              dot3(wx, wy, wz, mx, my, mz), roughness, u0, u1)
     return hx * sx + hy * tx + hz * mx, hx * sy + hy * ty + hz * my, hx * sz + hy * tz + hz * mz
 
 
@@ -389,14 +369,14 @@ def huang_frame(dx, dy, dz, nx, ny, nz, wox, woy, woz):
     and a non-finite h is 0."""
     if not _usable(dx, dy, dz):
         if _usable(nx, ny, nz):
-            ux, uy, uz = _unit(nx, ny, nz)
+            ux, uy, uz = safe_unit(nx, ny, nz)
             dx, dy, dz, _, _, _ = _orthonormals(ux, uy, uz)
         else:
             dx, dy, dz = 1.0, 0.0, 0.0
-    yx, yy, yz = _unit(dx, dy, dz)
-    cx, cy, cz = _cross(dx, dy, dz, wox, woy, woz)
-    xx, xy, xz = _unit(cx, cy, cz)
-    h = -_dot(xx, xy, xz, nx, ny, nz)
+    yx, yy, yz = safe_unit(dx, dy, dz)
+    cx, cy, cz = cross3(dx, dy, dz, wox, woy, woz)
+    xx, xy, xz = safe_unit(cx, cy, cz)
+    h = -dot3(xx, xy, xz, nx, ny, nz)
     if not math.isfinite(h):
         h = 0.0
     if not _usable(xx, xy, xz):
@@ -407,20 +387,37 @@ def huang_frame(dx, dy, dz, nx, ny, nz, wox, woy, woz):
 @kernel(inline="always")
 def _local(yx, yy, yz, xx, xy, xz, x, y, z):
     """The caller's direction (x, y, z) in the hair frame (X, Y, Z = X x Y)."""
-    zx, zy, zz = _cross(xx, xy, xz, yx, yy, yz)
-    return _dot(x, y, z, xx, xy, xz), _dot(x, y, z, yx, yy, yz), _dot(x, y, z, zx, zy, zz)
+    zx, zy, zz = cross3(xx, xy, xz, yx, yy, yz)
+    return dot3(x, y, z, xx, xy, xz), dot3(x, y, z, yx, yy, yz), dot3(x, y, z, zx, zy, zz)
 
 
 @kernel(inline="always")
-def huang_transparent(aspect_ratio, yx, yy, yz, xx, xy, xz, h, wox, woy, woz):
-    """Whether bsdf_hair_huang_setup replaces the closure by a transparent one (same weight): the
-    hit lies outside the projected radius, |h| >= radius. Arguments: the aspect ratio as
-    ``huang_constants`` gives it, ``huang_frame``'s seven values, wo."""
-    ix, _, iz = _local(yx, yy, yz, xx, xy, xz, wox, woy, woz)
-    e2 = 1.0 - aspect_ratio * aspect_ratio
-    if e2 != 0.0 and ix == 0.0 and iz == 0.0:  # Cycles' radius is NaN: no comparison holds
-        return False
-    return abs(h) >= _radius(e2, ix, iz)
+def _series(f, sigma, cos_t, spread):
+    """One channel of ``huang_albedo``: (A - 2 f A + f) / (1 - f A), A the absorption of the path
+    across the fiber (1 without absorption, 0 along a refracted ray with no spread)."""
+    x = 2.0 * sigma * cos_t
+    if x != x:  # an infinite absorption at total internal reflection: nothing crosses
+        x = -math.inf
+    a = math.exp(x / spread) if spread > 0.0 else (1.0 if x == 0.0 else 0.0)
+    d = 1.0 - f * a
+    return (a - 2.0 * f * a + f) / d if d != 0.0 else 0.0
+
+
+@kernel(inline="always")
+def huang_albedo(eta, sg0, sg1, sg2, yx, yy, yz, xx, xy, xz, h, wox, woy, woz):
+    """bsdf_hair_huang_albedo, RGB: Cycles' estimate of the closure's albedo for its passes (GlossCol,
+    the denoising albedo), the geometric series of specular bounces inside a circular fiber hit at
+    offset h. Arguments: the IOR, the absorption sigma RGB, ``huang_frame``'s seven values, wo.
+
+    (bsdf_hair_huang_setup also turns the closure into a transparent one where |h| reaches the
+    projected radius; on a mesh that radius is 1 and |h| = |X . N| reaches it only where the
+    shading normal lies across both dPdu and wo: a view exactly grazing the surface, never made.)"""
+    ix, iy, iz = _local(yx, yy, yz, xx, xy, xz, wox, woy, woz)
+    ch = math.sqrt(max(1.0 - h * h, 0.0))
+    f, cos_t = _fresnel(h * ix + ch * iz, eta)
+    _, wty, _ = _refract_angle(ix, iy, iz, h, 0.0, ch, cos_t, 1.0 / eta)
+    spread = 1.0 - wty * wty
+    return _series(f, sg0, cos_t, spread), _series(f, sg1, cos_t, spread), _series(f, sg2, cos_t, spread)
 
 
 # -- eval (bsdf_hair_huang_eval, far field) --
@@ -430,7 +427,7 @@ def _eval_r(rough, tilt, eta, b, gain, hmin, hmax, ix, iy, iz, ox, oy, oz, cos_i
     """bsdf_hair_huang_eval_r: the primary reflection, Simpson's rule over h in [hmin, hmax]."""
     if gain <= 0.0:
         return 0.0
-    hx, hy, hz = _unit(ix + ox, iy + oy, iz + oz)
+    hx, hy, hz = safe_unit(ix + ox, iy + oy, iz + oz)
     if hx == 0.0 and hy == 0.0 and hz == 0.0:  # wi opposite wo: no half vector
         return 0.0
     alpha2 = rough * rough
@@ -446,13 +443,13 @@ def _eval_r(rough, tilt, eta, b, gain, hmin, hmax, ix, iy, iz, ox, oy, oz, cos_i
         mx, my, mz = _sphg_dir(tilt, gamma, b)
         if _visible(ix, iy, iz, mx, 0.0, mz, hx, hy, hz) and _visible(ox, oy, oz, mx, 0.0, mz, hx, hy, hz):
             weight = (0.5 if i == 0 or i == intervals else i % 2 + 1.0) * _d_gamma_d_h(sin_phi_i, cos_phi_i, gamma, b)
-            cos_mi = _dot(mx, my, mz, ix, iy, iz)
-            term = (weight * _d(alpha2, _dot(mx, my, mz, hx, hy, hz)) * _g(alpha2, cos_mi, _dot(mx, my, mz, ox, oy, oz))
+            cos_mi = dot3(mx, my, mz, ix, iy, iz)
+            term = (weight * _d(alpha2, dot3(mx, my, mz, hx, hy, hz)) * _g(alpha2, cos_mi, dot3(mx, my, mz, ox, oy, oz))
                     * _arc_length(e2, gamma) * _energy_scale(cos_mi, sqrt_rough, eta))
             if math.isfinite(term):
                 integral += term
     integral *= 2.0 / 3.0 * res
-    return gain * 0.25 * fresnel_dielectric1(abs(_dot(ix, iy, iz, hx, hy, hz)), eta) * integral
+    return gain * 0.25 * fresnel_dielectric1(abs(dot3(ix, iy, iz, hx, hy, hz)), eta) * integral
 
 
 @kernel(inline="always")
@@ -478,10 +475,10 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
         state, r0 = _lcg(state)
         state, r1 = _lcg(state)
         h1x, h1y, h1z = _sample_wh(rough, ix, iy, iz, mix_, miy, miz, r0, r1)
-        cos_hi1 = _dot(ix, iy, iz, h1x, h1y, h1z)
+        cos_hi1 = dot3(ix, iy, iz, h1x, h1y, h1z)
         if not cos_hi1 > 0.0:
             continue
-        cos_mi1 = _dot(ix, iy, iz, mix_, miy, miz)
+        cos_mi1 = dot3(ix, iy, iz, mix_, miy, miz)
         f1, cos_t1 = _fresnel(cos_hi1, eta)
         t1 = 1.0 - f1
         scale1 = _energy_scale(cos_mi1, sqrt_rough, eta)
@@ -491,8 +488,8 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
         gamma_mt = 2.0 * _to_phi(phi_t, b) - gamma_mi
         mtx, mty, mtz = _sphg_dir(-tilt, gamma_mt, b)
         ntx, nty, ntz = _sphg_dir(0.0, gamma_mt, b)
-        cos_mo1 = -_dot(wtx, wty, wtz, mix_, miy, miz)
-        cos_mi2 = -_dot(wtx, wty, wtz, mtx, mty, mtz)
+        cos_mo1 = -dot3(wtx, wty, wtz, mix_, miy, miz)
+        cos_mi2 = -dot3(wtx, wty, wtz, mtx, mty, mtz)
         g1o = _go(alpha2, cos_mi1, cos_mo1)
         if not (_visible(ix, iy, iz, mix_, miy, miz, h1x, h1y, h1z)
                 and _visible(-wtx, -wty, -wtz, mix_, miy, miz, h1x, h1y, h1z)
@@ -506,15 +503,15 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
         at1 = _absorption(sg1, cos_wt, length_t)
         at2 = _absorption(sg2, cos_wt, length_t)
         scale2 = _energy_scale(cos_mi2, sqrt_rough, inv_eta)
-        if gtt > 0.0 and _dot(ox, oy, oz, wtx, wty, wtz) >= inv_eta - 1e-5:  # total internal reflection otherwise
+        if gtt > 0.0 and dot3(ox, oy, oz, wtx, wty, wtz) >= inv_eta - 1e-5:  # total internal reflection otherwise
             w2x, w2y, w2z = -wtx + inv_eta * ox, -wty + inv_eta * oy, -wtz + inv_eta * oz
             rcp_norm = 1.0 / math.sqrt(w2x * w2x + w2y * w2y + w2z * w2z)
             w2x, w2y, w2z = w2x * rcp_norm, w2y * rcp_norm, w2z * rcp_norm
-            cos_mh2 = _dot(mtx, mty, mtz, w2x, w2y, w2z)
+            cos_mh2 = dot3(mtx, mty, mtz, w2x, w2y, w2z)
             if cos_mh2 >= 0.0:  # microfacet visible from the macronormal
-                cos_hi2 = -_dot(wtx, wty, wtz, w2x, w2y, w2z)
-                cos_ho2 = -_dot(ox, oy, oz, w2x, w2y, w2z)
-                cos_mo2 = -_dot(ox, oy, oz, mtx, mty, mtz)
+                cos_hi2 = -dot3(wtx, wty, wtz, w2x, w2y, w2z)
+                cos_ho2 = -dot3(ox, oy, oz, w2x, w2y, w2z)
+                cos_mo2 = -dot3(ox, oy, oz, mtx, mty, mtz)
                 t2 = (1.0 - fresnel_dielectric1(abs(cos_hi2), inv_eta)) * scale2
                 common = (weight * t1 * scale1 * t2 * _d(alpha2, cos_mh2) * g1o * _g(alpha2, cos_mi2, cos_mo2) / cos_mo1
                           * cos_mi1 * cos_hi2 * cos_ho2 * rcp_norm * rcp_norm)
@@ -528,7 +525,7 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
             state, r0 = _lcg(state)
             state, r1 = _lcg(state)
             h2x, h2y, h2z = _sample_wh(rough, -wtx, -wty, -wtz, mtx, mty, mtz, r0, r1)
-            cos_hi2 = -_dot(wtx, wty, wtz, h2x, h2y, h2z)
+            cos_hi2 = -dot3(wtx, wty, wtz, h2x, h2y, h2z)
             if not cos_hi2 > 0.0:
                 continue
             r2 = fresnel_dielectric1(abs(cos_hi2), inv_eta)
@@ -536,7 +533,7 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
             trrt_ok = math.isfinite(q0) and math.isfinite(q1) and math.isfinite(q2)
             rx, ry, rz = _reflect(wtx, wty, wtz, h2x, h2y, h2z)
             wrx, wry, wrz = -rx, -ry, -rz
-            if -_dot(wrx, wry, wrz, ox, oy, oz) < inv_eta - 1e-5:  # total internal reflection
+            if -dot3(wrx, wry, wrz, ox, oy, oz) < inv_eta - 1e-5:  # total internal reflection
                 if trrt_ok:
                     rr0, rr1, rr2 = rr0 + weight * q0, rr1 + weight * q1, rr2 + weight * q2
                 continue
@@ -552,7 +549,7 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
             w3x, w3y, w3z = wrx + inv_eta * ox, wry + inv_eta * oy, wrz + inv_eta * oz
             rcp_norm3 = 1.0 / math.sqrt(w3x * w3x + w3y * w3y + w3z * w3z)
             w3x, w3y, w3z = w3x * rcp_norm3, w3y * rcp_norm3, w3z * rcp_norm3
-            cos_mh3 = _dot(mrx, mry, mrz, w3x, w3y, w3z)
+            cos_mh3 = dot3(mrx, mry, mrz, w3x, w3y, w3z)
             if (cos_mh3 < 0.0 or not _visible(wrx, wry, wrz, mrx, mry, mrz, w3x, w3y, w3z)
                     or not _visible(-ox, -oy, -oz, mrx, mry, mrz, w3x, w3y, w3z)
                     or not _visible(wrx, wry, wrz, nrx, nry, nrz, w3x, w3y, w3z)
@@ -560,16 +557,16 @@ def _eval_residual(rough, tilt, eta, b, gtt, gtrt, sg0, sg1, sg2, hmin, hmax, ix
                 if trrt_ok:
                     rr0, rr1, rr2 = rr0 + weight * q0, rr1 + weight * q1, rr2 + weight * q2
                 continue
-            cos_hi3 = _dot(w3x, w3y, w3z, wrx, wry, wrz)
-            cos_ho3 = -_dot(w3x, w3y, w3z, ox, oy, oz)
-            cos_mi3 = _dot(mrx, mry, mrz, wrx, wry, wrz)
+            cos_hi3 = dot3(w3x, w3y, w3z, wrx, wry, wrz)
+            cos_ho3 = -dot3(w3x, w3y, w3z, ox, oy, oz)
+            cos_mi3 = dot3(mrx, mry, mrz, wrx, wry, wrz)
             t3 = (1.0 - fresnel_dielectric1(abs(cos_hi3), inv_eta)) * _energy_scale(cos_mi3, sqrt_rough, inv_eta)
             cos_wr = _cos_theta(wrx, wrz)
             length_r = -(2.0 * abs(math.cos(phi_tr - gamma_mt)) if b == 1.0 else _chord(gamma_mtr, gamma_mt, b))
-            cos_mo2 = -_dot(mtx, mty, mtz, wrx, wry, wrz)
+            cos_mo2 = -dot3(mtx, mty, mtz, wrx, wry, wrz)
             common = (weight * t1 * scale1 * r2 * scale2 * t3 * _d(alpha2, cos_mh3) * g1o
                       * _go(alpha2, cos_mi2, cos_mo2)
-                      * _g(alpha2, cos_mi3, -_dot(mrx, mry, mrz, ox, oy, oz)) / (cos_mo1 * cos_mo2)
+                      * _g(alpha2, cos_mi3, -dot3(mrx, mry, mrz, ox, oy, oz)) / (cos_mo1 * cos_mo2)
                       * cos_mi1 * cos_mi2 * cos_hi3 * cos_ho3 * rcp_norm3 * rcp_norm3)
             r_0 = common * at0 * _absorption(sg0, cos_wr, length_r)
             r_1 = common * at1 * _absorption(sg1, cos_wr, length_r)
@@ -595,7 +592,7 @@ def huang_eval(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0, s
     """(f0, f1, f2, pdf): bsdf_hair_huang_eval toward wi, f |cos| RGB without the closure's weight,
     pdf 1 (0 where the svm makes no closure: all gains 0). Arguments in order: ``huang_constants``'
     seven (roughness, tilt, eta, aspect ratio, R, TT, TRT gains), the absorption sigma RGB,
-    ``huang_frame``'s Y and X (its h only decides ``huang_transparent``), wo, wi."""
+    ``huang_frame``'s Y and X (its h is for ``huang_albedo``), wo, wi."""
     if r_gain <= 0.0 and tt_gain <= 0.0 and trt_gain <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     ix, iy, iz = _local(yx, yy, yz, xx, xy, xz, wox, woy, woz)
@@ -679,8 +676,8 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
     nix, niy, niz = _sphg_dir(0.0, gamma_mi, b)  # macronormal
     st, ct = math.sin(tilt), math.cos(tilt)
     mix_, miy, miz = nix * ct, st, niz * ct  # mesonormal
-    cos_mi1 = _dot(mix_, miy, miz, ix, iy, iz)
-    if cos_mi1 < 0.0 or _dot(nix, niy, niz, ix, iy, iz) < 0.0:
+    cos_mi1 = dot3(mix_, miy, miz, ix, iy, iz)
+    if cos_mi1 < 0.0 or dot3(nix, niy, niz, ix, iy, iz) < 0.0:
         return none
     # R
     alpha2 = rough * rough
@@ -690,10 +687,10 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
     wrx, wry, wrz = -rx, -ry, -rz
     if not _visible(ix, iy, iz, nix, niy, niz, h1x, h1y, h1z):
         return none
-    r1, cos_t1 = _fresnel(_dot(ix, iy, iz, h1x, h1y, h1z), eta)
+    r1, cos_t1 = _fresnel(dot3(ix, iy, iz, h1x, h1y, h1z), eta)
     scale1 = _energy_scale(cos_mi1, sqrt_rough, eta)
     lobe_r = (r_gain * r1 * scale1 * (1.0 if _visible(wrx, wry, wrz, nix, niy, niz, h1x, h1y, h1z) else 0.0)
-              * _go(alpha2, cos_mi1, _dot(mix_, miy, miz, wrx, wry, wrz)))
+              * _go(alpha2, cos_mi1, dot3(mix_, miy, miz, wrx, wry, wrz)))
     if not math.isfinite(lobe_r):
         lobe_r = 0.0
     # TT
@@ -708,7 +705,7 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
     wrx2, wry2, wrz2 = -qx, -qy, -qz  # wtr
     ttx = tty = ttz = trtx = trty = trtz = rrx = rry = rrz = 0.0
     tt0 = tt1 = tt2 = trt0 = trt1 = trt2 = rr0 = rr1 = rr2 = 0.0
-    cos_mi2 = -_dot(wtx, wty, wtz, mtx, mty, mtz)
+    cos_mi2 = -dot3(wtx, wty, wtz, mtx, mty, mtz)
     if (cos_mi2 > 0.0 and _visible(-wtx, -wty, -wtz, nix, niy, niz, h1x, h1y, h1z)
             and _visible(-wtx, -wty, -wtz, ntx, nty, ntz, h2x, h2y, h2z)):
         cos_wt = _cos_theta(wtx, wtz)
@@ -716,23 +713,23 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
         at0 = _absorption(sg0, cos_wt, length_t)
         at1 = _absorption(sg1, cos_wt, length_t)
         at2 = _absorption(sg2, cos_wt, length_t)
-        r2, cos_t2 = _fresnel(-_dot(wtx, wty, wtz, h2x, h2y, h2z), inv_eta)
-        t1 = (1.0 - r1) * scale1 * _go(alpha2, cos_mi1, -_dot(mix_, miy, miz, wtx, wty, wtz))
+        r2, cos_t2 = _fresnel(-dot3(wtx, wty, wtz, h2x, h2y, h2z), inv_eta)
+        t1 = (1.0 - r1) * scale1 * _go(alpha2, cos_mi1, -dot3(mix_, miy, miz, wtx, wty, wtz))
         t2 = 1.0 - r2
         scale2 = _energy_scale(cos_mi2, sqrt_rough, inv_eta)
         ttx, tty, ttz = _refract_angle(-wtx, -wty, -wtz, h2x, h2y, h2z, cos_t2, eta)
-        if (-_dot(mtx, mty, mtz, ttx, tty, ttz) > 0.0 and t2 > 0.0
+        if (-dot3(mtx, mty, mtz, ttx, tty, ttz) > 0.0 and t2 > 0.0
                 and _visible(-ttx, -tty, -ttz, ntx, nty, ntz, h2x, h2y, h2z)):
-            k = tt_gain * t1 * t2 * scale2 * _go(alpha2, cos_mi2, -_dot(mtx, mty, mtz, ttx, tty, ttz))
+            k = tt_gain * t1 * t2 * scale2 * _go(alpha2, cos_mi2, -dot3(mtx, mty, mtz, ttx, tty, ttz))
             tt0, tt1, tt2 = _finite_or_0(k * at0, k * at1, k * at2)
         # TRT
         phi_tr = math.atan2(wrx2, wrz2)
         gamma_mtr = gamma_mi - 2.0 * (_to_phi(phi_t, b) - _to_phi(phi_tr, b)) + math.pi
         mrx, mry, mrz = _sphg_dir(-tilt, gamma_mtr, b)
         h3x, h3y, h3z = _sample_wh(rough, wrx2, wry2, wrz2, mrx, mry, mrz, sample_h3[0], sample_h3[1])
-        r3, cos_t3 = _fresnel(_dot(wrx2, wry2, wrz2, h3x, h3y, h3z), inv_eta)
+        r3, cos_t3 = _fresnel(dot3(wrx2, wry2, wrz2, h3x, h3y, h3z), inv_eta)
         trtx, trty, trtz = _refract_angle(wrx2, wry2, wrz2, h3x, h3y, h3z, cos_t3, eta)
-        cos_mi3 = _dot(mrx, mry, mrz, wrx2, wry2, wrz2)
+        cos_mi3 = dot3(mrx, mry, mrz, wrx2, wry2, wrz2)
         if cos_mi3 > 0.0:
             cos_wr = _cos_theta(wrx2, wrz2)
             length_r = -(2.0 * abs(math.cos(phi_tr - gamma_mt)) if b == 1.0 else _chord(gamma_mt, gamma_mtr, b))
@@ -740,12 +737,12 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
             atr1 = _absorption(sg1, cos_wr, length_r)
             atr2 = _absorption(sg2, cos_wr, length_r)
             k = (t1 * r2 * scale2 * _energy_scale(cos_mi3, sqrt_rough, inv_eta)
-                 * _go(alpha2, cos_mi2, -_dot(mtx, mty, mtz, wrx2, wry2, wrz2)))
+                 * _go(alpha2, cos_mi2, -dot3(mtx, mty, mtz, wrx2, wry2, wrz2)))
             tr0, tr1, tr2 = k * at0 * atr0, k * at1 * atr1, k * at2 * atr2
             t3 = 1.0 - r3
             if t3 > 0.0 and _visible(wrx2, wry2, wrz2, mrx, 0.0, mrz, h3x, h3y, h3z) \
                     and _visible(-trtx, -trty, -trtz, mrx, 0.0, mrz, h3x, h3y, h3z):
-                k = trt_gain * t3 * _go(alpha2, cos_mi3, -_dot(mrx, mry, mrz, trtx, trty, trtz))
+                k = trt_gain * t3 * _go(alpha2, cos_mi3, -dot3(mrx, mry, mrz, trtx, trty, trtz))
                 trt0, trt1, trt2 = _finite_or_0(k * tr0, k * tr1, k * tr2)
             # TRRT+: theta from Chiang's longitudinal lobe, phi uniform
             state, v = _lcg(state)
@@ -760,7 +757,7 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
             rrx, rry, rrz = math.sin(phi_o) * cos_theta_o, sin_theta_o, math.cos(phi_o) * cos_theta_o
             t_avg = max(0.5 * (t2 + t3), 1e-5)
             fx, fy, fz = _reflect(wrx2, wry2, wrz2, h3x, h3y, h3z)
-            k = r3 * _go(alpha2, cos_mi3, _dot(mrx, mry, mrz, fx, fy, fz))
+            k = r3 * _go(alpha2, cos_mi3, dot3(mrx, mry, mrz, fx, fy, fz))
             rr0, rr1, rr2 = _finite_or_0(_residual(tr0, k, at0, atr0, t_avg), _residual(tr1, k, at1, atr1, t_avg),
                                          _residual(tr2, k, at2, atr2, t_avg))
     # the lobe by energy
@@ -781,6 +778,6 @@ def huang_sample(rough, tilt, eta, aspect_ratio, r_gain, tt_gain, trt_gain, sg0,
         ox, oy, oz, f0, f1, f2 = rrx, rry, rrz, rr0 / trrt * total, rr1 / trrt * total, rr2 / trrt * total
     else:  # u0 * total rounded up to total with no TRRT+
         return none
-    zx, zy, zz = _cross(xx, xy, xz, yx, yy, yz)
+    zx, zy, zz = cross3(xx, xy, xz, yx, yy, yz)
     return (ox * xx + oy * yx + oz * zx, ox * xy + oy * yy + oz * zy, ox * xz + oy * yz + oz * zz,
             f0, f1, f2, 1.0, True)
