@@ -305,7 +305,7 @@ class DRTSceneSettings(bpy.types.PropertyGroup):
     )
     filter_glossy: FloatProperty(
         name="Filter Glossy",
-        description="Blur glossy and glass surfaces seen after blurry bounces, as much as the least likely "
+        description="Blur glossy, glass and Principled Hair surfaces seen after blurry bounces, as much as the least likely "
         "bounce of the path allows (Cycles' Filter Glossy): less noise in caustics at the cost of accuracy; "
         "0 turns it off (DRT's default; Cycles' is 1)",
         default=0.0,

@@ -182,8 +182,8 @@ class RenderSettings:
     # after (indirect) its path's first bounce kept within them (core.integrator.clamp); 0: off
     sample_clamp_direct: float = 0.0
     sample_clamp_indirect: float = 0.0
-    # Cycles' Filter Glossy: after a path's blurry bounces its GGX reflection and glass lobes are made
-    # at least as rough as the least likely bounce allows (core.bsdf.blur); 0: off (Cycles' default is
+    # Cycles' Filter Glossy: after a path's blurry bounces its GGX reflection, glass and Principled Hair
+    # lobes are made at least as rough as the least likely bounce allows (core.bsdf.blur); 0: off (Cycles' default is
     # 1, DRT's 0 keeps the image of paths that see highlights through rough bounces as it was)
     filter_glossy: float = 0.0
     threads: int = 0

@@ -200,3 +200,64 @@ def test_huang_samples_keep_their_own_path_weight():
         np.testing.assert_allclose(s.weight[i], (f0, f1, f2), rtol=1e-9)
         checked += 1
     assert checked > n // 2
+
+
+@pytest.mark.parametrize("model", ["CHIANG", "HUANG"])
+def test_principled_hair_passes_show_cycles_albedo_estimate(model):
+    """GlossCol and the denoising albedo of Principled Hair are its weight times Cycles' bsdf_albedo
+    estimate at the hit (Chiang's exp(-sqrt(sigma) scale(v)) + Fresnel, Huang's series), not the
+    weight alone; the Hair BSDF's are its colour."""
+    from drt_engine.core.bsdf import hair_chiang, hair_huang
+    n = 5
+    wo = _view(n)
+    shader = _principled(model, wo)
+    lp, hp = shader.lp[0], shader.hp
+    want = np.empty((n, 3))
+    for i in range(n):
+        sigma, frame = hp[i, 0, layout.H_SIGMA:layout.H_SIGMA + 3], hp[i, 0, layout.H_HAIR:layout.H_HAIR + 7]
+        if model == "CHIANG":
+            want[i] = hair_chiang.chiang_albedo(lp[layout.P_HAIR], lp[layout.P_HAIR + 4], *sigma, frame[6], *STRAND,
+                                                *wo[i])
+        else:
+            want[i] = hair_huang.huang_albedo(lp[layout.P_HAIR + 2], *sigma, *frame, *wo[i])
+    assert np.all((want > 0.01) & (want < 0.99))
+    diffuse, glossy = shader.colors(wo[:, 2])
+    np.testing.assert_allclose(glossy, want, rtol=1e-12)
+    assert np.all(diffuse == 0.0)
+    d, s, take = shader.denoising_albedos(wo[:, 2], np.zeros(n, bool))
+    np.testing.assert_allclose(d, want, rtol=1e-12)  # hair counts as rough: the diffuse-like side
+    assert np.all(s == 0.0) and np.all(take)
+    _, glossy = _bound(_hair("HAIR_REFLECTION"), n, wo=wo).colors(wo[:, 2])
+    np.testing.assert_allclose(glossy, np.tile(COLOUR, (n, 1)))
+
+
+@pytest.mark.parametrize("model", ["CHIANG", "HUANG"])
+def test_filter_glossy_raises_principled_hair_roughness(model):
+    """After a blurry bounce Cycles raises Chiang's v, s and m0 and Huang's roughness to the blur
+    (bsdf_hair_*_blur): the blurred shader evaluates as its model with those raised; no blur leaves it
+    as it was; the Hair BSDF is not blurred."""
+    from drt_engine.core.bsdf import hair_chiang, hair_huang
+    n = 64
+    wo, wi = _view(n), _uniform_sphere(n)
+    shader = _principled(model, wo)
+    assert shader.blurs and not _bound(_hair("HAIR_REFLECTION"), 1).blurs
+    above, inside = wi[:, 2] >= 0, np.zeros(n, bool)
+    plain = shader.evaluate(wo, wi, above, inside)
+    same = shader.blurred(np.zeros(n)).evaluate(wo, wi, above, inside)
+    np.testing.assert_array_equal(same.glossy, plain.glossy)
+    blur = 0.45
+    blurred = shader.blurred(np.full(n, blur)).evaluate(wo, wi, above, inside)
+    lp, hp = shader.lp[0], shader.hp
+    c = lp[layout.P_HAIR:layout.P_HAIR + 7]
+    want = np.zeros((n, 3))
+    for i in range(n):
+        sigma, frame = hp[i, 0, layout.H_SIGMA:layout.H_SIGMA + 3], hp[i, 0, layout.H_HAIR:layout.H_HAIR + 7]
+        if model == "CHIANG":
+            v, s, m0 = hair_chiang.chiang_blur(c[0], c[1], c[2], blur)
+            f = hair_chiang.chiang_eval(v, s, m0, c[3], c[4], *sigma, frame[6], *frame[:6], *wo[i], *wi[i])
+        else:
+            f = hair_huang.huang_eval(max(c[0], blur), *c[1:7], *sigma, *frame[:6], *wo[i], *wi[i])
+        want[i] = f[:3]
+    shade = blurred.pdf > 0  # Cycles 5 cuts by the closure's own normal: nothing there, blurred or not
+    np.testing.assert_allclose(blurred.glossy[shade], want[shade], rtol=1e-9, atol=1e-15)
+    assert np.abs(blurred.glossy - plain.glossy).max() > 1e-3

@@ -88,7 +88,7 @@ def test_scalar_functions_give_the_batch_results():
     for i in range(n):
         mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, 0)
         e = mixture.eval_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *wi[i], above[i], inside[i],
-                               sel, 0, 0, 0, *NO_BUMP)
+                               sel, 0, 0, 0, *NO_BUMP, -1)
         assert np.array_equal(e, [*f_diff[i], *f_nd[i], pdf[i]])
         s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], u_sel[i], *u2[i], inside[i],
                                  sel, 0, 0, *NO_BUMP)
@@ -138,14 +138,14 @@ def test_sampling_with_diffuse_lobes_integrates_the_whole_bsdf(name, bump):
         s = mixture.sample_lobes(*args, *wo, u[i, 0], u[i, 1], u[i, 2], False, sel, 0, bits, *bump)
         if s[8]:
             sampled += s[3:6]
-            e = mixture.eval_lobes(*args, *wo, *s[:3], s[2] > 0, False, sel, 0, bits, 0, *bump)
+            e = mixture.eval_lobes(*args, *wo, *s[:3], s[2] > 0, False, sel, 0, bits, 0, *bump, -1)
             assert e[6] == pytest.approx(s[6], rel=1e-9) and not any(e[:3])  # every lobe is sampled
         diffuse_taken += s[10]
     wi = rng.normal(size=(n, 3))
     wi /= np.linalg.norm(wi, axis=1)[:, None]
     uniform = np.zeros(3)
     for i in range(n):
-        e = mixture.eval_lobes(*args, *wo, *wi[i], wi[i, 2] > 0, False, sel, 0, bits, 0, *bump)
+        e = mixture.eval_lobes(*args, *wo, *wi[i], wi[i, 2] > 0, False, sel, 0, bits, 0, *bump, -1)
         uniform += np.add(e[:3], e[3:6])
     assert diffuse_taken > 0 and (diffuse_taken < n or all(lobe.diffuse for lobe in shader.lobes))
     np.testing.assert_allclose(sampled / n, uniform * 4 * np.pi / n, rtol=0.03)

@@ -7,7 +7,8 @@ The path keeps the least density of its non-transparent bounces (Cycles' min_ray
 direction's pdf over the whole mixture, a delta lobe's infinite); with Filter Glossy f > 0,
 blur_pdf = min_ray_pdf / f, and where it is below 1 every GGX reflection and glass lobe takes
 alpha = max(alpha, sqrt(1 - blur_pdf) / 2) (Cycles' bsdf_microfacet_blur, on both alphas of an
-anisotropic lobe; the blur roughness is an alpha, not squared). Toon, sheen and diffuse lobes
+anisotropic lobe; the blur roughness is an alpha, not squared). Principled Hair's roughnesses
+are raised to the same value (core.bsdf.hair_lobes); toon, sheen, diffuse and Hair BSDF lobes
 stay as they are, and, as in Cycles, the lobe's choice weight and multiple-scattering factor
 stay those of its own roughness. A delta lobe blurred past ``DELTA_ALPHA`` becomes a rough one.
 

@@ -7,23 +7,37 @@ kernel that holds the mixture, hair or not; a call costs only the hits that have
 A hair closure shades about a strand's tangent, not the surface's normal: on a mesh Cycles takes
 the triangle's dPdu (Principled Hair) or dPdv (Hair BSDF), each turned with the face toward the
 ray. The binding carries that tangent per hit (world); ``hair_frames`` turns it into the local
-frame and derives what each model fixes per hit from it and wo (Cycles' setup)."""
+frame and derives what each model fixes per hit from it and wo (Cycles' setup).
+
+After a blurry bounce Filter Glossy raises Principled Hair's roughnesses to the hit's ``H_BLUR``
+(core.bsdf.blur) as Cycles' bsdf_hair_chiang_blur and bsdf_hair_huang_blur do; the Hair BSDF has
+no blur in Cycles."""
 from __future__ import annotations
 
 import math
 
 from ..base.jit import kernel
 from .hair import hair_eval, hair_sample
-from .hair_chiang import chiang_eval, chiang_frame, chiang_sample
-from .hair_huang import huang_eval, huang_frame, huang_sample
-from .layout import (H_COLOUR, H_HAIR, H_SIGMA, HAIR_CHIANG, HAIR_HUANG, HAIR_REFLECTION, HAIR_TRANSMISSION,
-                     P_HAIR, P_HAIR_CUT, P_KIND)
+from .hair_chiang import chiang_albedo, chiang_blur, chiang_eval, chiang_frame, chiang_sample
+from .hair_huang import huang_albedo, huang_eval, huang_frame, huang_sample
+from .layout import (H_BLUR, H_COLOUR, H_HAIR, H_HAIR_ALBEDO, H_SIGMA, HAIR_CHIANG, HAIR_HUANG, HAIR_REFLECTION,
+                     HAIR_TRANSMISSION, P_HAIR, P_HAIR_CUT, P_KIND)
+from .tables import lobe_albedo, lobe_scale
 
 
 @kernel(inline="always")
 def is_hair(kind):
     """One of the hair lobes: they have no side of the surface of their own."""
     return kind == HAIR_REFLECTION or kind == HAIR_TRANSMISSION or kind == HAIR_CHIANG or kind == HAIR_HUANG
+
+
+@kernel(inline="always")
+def has_hair(lp):
+    """The mixture has a hair lobe."""
+    for l in range(lp.shape[0]):
+        if is_hair(int(lp[l, P_KIND])):
+            return True
+    return False
 
 
 @kernel(inline="always")
@@ -53,14 +67,15 @@ def hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
     if own_hair_normal(lp, l) and _cut(lp, hp, r, l, wix, wiy, wiz):
         return 0.0, 0.0, 0.0, 0.0
     if kind == HAIR_CHIANG:
-        return chiang_eval(lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
+        v, s, m0 = chiang_blur(lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], hp[r, l, H_BLUR])
+        return chiang_eval(v, s, m0, lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
                            hp[r, l, H_SIGMA], hp[r, l, H_SIGMA + 1], hp[r, l, H_SIGMA + 2], hp[r, l, H_HAIR + 6],
                            hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2],
                            hp[r, l, H_HAIR + 3], hp[r, l, H_HAIR + 4], hp[r, l, H_HAIR + 5],
                            wox, woy, woz, wix, wiy, wiz)
     if kind == HAIR_HUANG:
-        return huang_eval(lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
-                          lp[l, P_HAIR + 5], lp[l, P_HAIR + 6],
+        return huang_eval(max(lp[l, P_HAIR], hp[r, l, H_BLUR]), lp[l, P_HAIR + 1], lp[l, P_HAIR + 2],
+                          lp[l, P_HAIR + 3], lp[l, P_HAIR + 4], lp[l, P_HAIR + 5], lp[l, P_HAIR + 6],
                           hp[r, l, H_SIGMA], hp[r, l, H_SIGMA + 1], hp[r, l, H_SIGMA + 2],
                           hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2],
                           hp[r, l, H_HAIR + 3], hp[r, l, H_HAIR + 4], hp[r, l, H_HAIR + 5],
@@ -71,29 +86,33 @@ def hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz):
 
 @kernel
 def hair_lobe_sample(lp, hp, r, l, wox, woy, woz, u_choice, u0, u1):
-    """(wi, f |cos| RGB without the weight, pdf, valid) of hair lobe l as its sample gives them:
+    """(wi, f |cos| RGB without the weight, pdf, valid, reflect) of hair lobe l as its sample gives them:
     Cycles' rand (u0, u1, u_choice) for Principled Hair, (u0, u1) for the Hair BSDF. Huang's f is
     its sampled path's weight (pdf 1), not its evaluation toward wi; core.bsdf.mixture.sample_lobes
-    keeps the sample's own f and pdf, as Cycles does."""
+    keeps the sample's own f and pdf, as Cycles does. Last, whether Cycles labels the sample a
+    reflection (the Hair BSDF's Reflection, Principled Hair's R lobe) rather than a transmission."""
     kind = int(lp[l, P_KIND])
     if kind == HAIR_CHIANG:
-        wix, wiy, wiz, f0, f1, f2, pdf, _ = chiang_sample(
-            lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
+        v, s, m0 = chiang_blur(lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], hp[r, l, H_BLUR])
+        wix, wiy, wiz, f0, f1, f2, pdf, reflect = chiang_sample(
+            v, s, m0, lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
             hp[r, l, H_SIGMA], hp[r, l, H_SIGMA + 1], hp[r, l, H_SIGMA + 2], hp[r, l, H_HAIR + 6],
             hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2],
             hp[r, l, H_HAIR + 3], hp[r, l, H_HAIR + 4], hp[r, l, H_HAIR + 5], wox, woy, woz, u0, u1, u_choice)
     elif kind == HAIR_HUANG:
-        wix, wiy, wiz, f0, f1, f2, pdf, _ = huang_sample(
-            lp[l, P_HAIR], lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], lp[l, P_HAIR + 3], lp[l, P_HAIR + 4],
-            lp[l, P_HAIR + 5], lp[l, P_HAIR + 6], hp[r, l, H_SIGMA], hp[r, l, H_SIGMA + 1], hp[r, l, H_SIGMA + 2],
+        wix, wiy, wiz, f0, f1, f2, pdf, reflect = huang_sample(
+            max(lp[l, P_HAIR], hp[r, l, H_BLUR]), lp[l, P_HAIR + 1], lp[l, P_HAIR + 2], lp[l, P_HAIR + 3],
+            lp[l, P_HAIR + 4], lp[l, P_HAIR + 5], lp[l, P_HAIR + 6],
+            hp[r, l, H_SIGMA], hp[r, l, H_SIGMA + 1], hp[r, l, H_SIGMA + 2],
             hp[r, l, H_HAIR], hp[r, l, H_HAIR + 1], hp[r, l, H_HAIR + 2],
             hp[r, l, H_HAIR + 3], hp[r, l, H_HAIR + 4], hp[r, l, H_HAIR + 5], wox, woy, woz, u0, u1, u_choice)
     else:
         wix, wiy, wiz, pdf = hair_sample(lp, hp, r, l, kind == HAIR_TRANSMISSION, wox, woy, woz, u0, u1)
         f0, f1, f2 = hp[r, l, H_COLOUR] * pdf, hp[r, l, H_COLOUR + 1] * pdf, hp[r, l, H_COLOUR + 2] * pdf
+        reflect = kind == HAIR_REFLECTION
     if not pdf > 0.0:
-        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, False
-    return wix, wiy, wiz, f0, f1, f2, pdf, True
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, False, reflect
+    return wix, wiy, wiz, f0, f1, f2, pdf, True, reflect
 
 
 @kernel
@@ -102,7 +121,8 @@ def hair_frames(lp, hp, tangent, ng, n, wo):
     Cycles takes it before normalising), its geometric normal facing the ray ``ng``, shading normal
     ``n`` and ``wo`` (N, 3, local): the unit tangent, then for Principled Hair Cycles' frame axis Y
     (Chiang) or X (Huang) and h, the offset across the strand the ray is seen at, then the shading
-    normal (Cycles' sd->N, which ``_cut`` compares the closure's normal with). (On a mesh
+    normal (Cycles' sd->N, which ``_cut`` compares the closure's normal with); for Principled Hair
+    also Cycles' albedo estimate at the hit (``H_HAIR_ALBEDO``, for ``hair_albedo``). (On a mesh
     Huang's projected radius is 1 and |h| reaches it only where wo grazes the surface: Cycles'
     transparent stand-in for a hit outside the radius is not made there.)"""
     for i in range(hp.shape[0]):
@@ -117,11 +137,32 @@ def hair_frames(lp, hp, tangent, ng, n, wo):
             else:
                 x = y = z = 0.0
             hp[i, l, H_HAIR], hp[i, l, H_HAIR + 1], hp[i, l, H_HAIR + 2] = x, y, z
+            sg0, sg1, sg2 = hp[i, l, H_SIGMA], hp[i, l, H_SIGMA + 1], hp[i, l, H_SIGMA + 2]
             if kind == HAIR_CHIANG:
                 yx, yy, yz, h = chiang_frame(x, y, z, ng[i, 0], ng[i, 1], ng[i, 2], wo[i, 0], wo[i, 1], wo[i, 2])
                 hp[i, l, H_HAIR + 3], hp[i, l, H_HAIR + 4], hp[i, l, H_HAIR + 5], hp[i, l, H_HAIR + 6] = yx, yy, yz, h
+                a0, a1, a2 = chiang_albedo(lp[l, P_HAIR], lp[l, P_HAIR + 4], sg0, sg1, sg2, h, x, y, z,
+                                           wo[i, 0], wo[i, 1], wo[i, 2])
+                hp[i, l, H_HAIR_ALBEDO], hp[i, l, H_HAIR_ALBEDO + 1], hp[i, l, H_HAIR_ALBEDO + 2] = a0, a1, a2
             elif kind == HAIR_HUANG:
                 frame = huang_frame(x, y, z, n[i, 0], n[i, 1], n[i, 2], wo[i, 0], wo[i, 1], wo[i, 2])
                 for k in range(7):
                     hp[i, l, H_HAIR + k] = frame[k]
+                a0, a1, a2 = huang_albedo(lp[l, P_HAIR + 2], sg0, sg1, sg2, frame[0], frame[1], frame[2], frame[3],
+                                          frame[4], frame[5], frame[6], wo[i, 0], wo[i, 1], wo[i, 2])
+                hp[i, l, H_HAIR_ALBEDO], hp[i, l, H_HAIR_ALBEDO + 1], hp[i, l, H_HAIR_ALBEDO + 2] = a0, a1, a2
             hp[i, l, H_HAIR + 7], hp[i, l, H_HAIR + 8], hp[i, l, H_HAIR + 9] = n[i, 0], n[i, 1], n[i, 2]
+
+
+@kernel(inline="always")
+def hair_albedo(lp, lt, hp, r, j, t, l):
+    """Cycles' bsdf_albedo of hair lobe l with its weight, RGB, as its passes show it (GlossCol or
+    TransCol, the denoising albedo): the Hair BSDF's is its weight, Principled Hair's its weight
+    times its model's estimate at the hit (``hair_frames``). The estimate is of the unblurred
+    lobe: the passes read first hits, and a hit after a blurry bounce is no longer
+    specular enough to wait for the denoising albedo (core.bsdf.passes)."""
+    kind = int(lp[l, P_KIND])
+    if kind == HAIR_CHIANG or kind == HAIR_HUANG:
+        s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
+        return s0 * hp[r, l, H_HAIR_ALBEDO], s1 * hp[r, l, H_HAIR_ALBEDO + 1], s2 * hp[r, l, H_HAIR_ALBEDO + 2]
+    return lobe_albedo(lp, lt, hp, r, j, t, l)

@@ -68,11 +68,12 @@ T = 17
 H_SCALE = 0  # (3) weight multiplier
 H_COLOUR = 3  # (3) diffuse / transparent / toon colour
 H_TINT_R = 6  # (3) glass reflection tint
+H_HAIR_ALBEDO = H_TINT_R  # (3) Principled Hair (no tint): Cycles' albedo estimate at this hit, for the passes
 H_TINT_T = 9  # (3) glass transmission tint
 H_F0 = 12  # (3) Fresnel colour
 H_NORMAL = 15  # (3) P_OWN_NORMAL: the lobe's normal in the local shading frame
 H_PLACE = 18  # (2) P_OWN_NORMAL, P_UNDER_OWN: ``tables.locate`` of wo's cosine to that normal (j, t)
-H_BLUR = 20  # Filter Glossy's least alpha for a reflect or glass lobe at this hit (core.bsdf.blur); 0: none
+H_BLUR = 20  # Filter Glossy's least alpha for a reflect, glass or Principled Hair lobe at this hit (core.bsdf.blur)
 H_HAIR = 21  # (10) hair: its tangent in the local frame, what its model derives per hit, the shading normal
 # (core.bsdf.hair_lobes.hair_frames)
 H_SIGMA = 31  # (3) Principled Hair: absorption coefficient

@@ -27,7 +27,7 @@ from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
 from .hair_lobes import hair_lobe_eval, hair_lobe_sample, is_hair
-from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
+from .layout import (DIFFUSE, H_NORMAL, HAIR_TRANSMISSION, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
                      SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
@@ -94,7 +94,7 @@ def needs_wo_above(lp, l, woz):
 
 @kernel(inline="always")
 def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, si, diffuse, unlit,
-               sx, sy, sz, model, dx, dy, dz):
+               sx, sy, sz, model, dx, dy, dz, skip):
     """BSDF times |cos| of every non-delta lobe toward wi, for light sampling.
 
     ``above``: wi is on wo's side of the surface (light sampling: of Cycles' sd->N, which the diffuse
@@ -103,9 +103,12 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     back of the surface. ``sel[si]``: the lobe choice (``selection``) at wo, for the ``diffuse``
     lobes a path may continue through (``slot``). ``unlit`` (``UNLIT_*`` bits): parts a light
     does not reach (the world's ray visibility): their BSDF is left out, their density kept, so
-    that the rays the lobes send weigh against this light sample as they would. (sx, sy, sz, model):
-    the smooth normal before a bump and its model of shadowing (``bump_shadowing``); (dx, dy, dz)
-    the diffuse lobes' normal (core.bsdf.diffuse_normal). Returns (the part
+    that the rays the lobes send weigh against this light sample as they would. A part is a side
+    of the surface, but for the hair lobes, which Cycles files by closure whatever side wi is on:
+    Principled Hair and Hair Reflection reflect, Hair Transmission transmits. ``skip``: a lobe
+    left out, BSDF and density (the sampled hair lobe whose own value ``sample_lobes`` keeps), -1:
+    none. (sx, sy, sz, model): the smooth normal before a bump and its model of shadowing
+    (``bump_shadowing``); (dx, dy, dz) the diffuse lobes' normal (core.bsdf.diffuse_normal). Returns (the part
     no ray continues through RGB: the diffuse lobes (Lambert, Oren-Nayar, translucent) left out
     of the choice, the part rays continue through RGB, density of continuing toward wi through
     the lobes of the choice).
@@ -162,11 +165,14 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
             fd2 += d2
             continue
         if is_hair(kind):
+            if l == skip:
+                continue
             f0, f1, f2, p = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
             s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
-            fn0 += s0 * f0 * lit
-            fn1 += s1 * f1 * lit
-            fn2 += s2 * f2 * lit
+            seen = 0.0 if unlit & (UNLIT_TRANSMISSION if kind == HAIR_TRANSMISSION else UNLIT_REFLECTION) else shade
+            fn0 += s0 * f0 * seen
+            fn1 += s1 * f1 * seen
+            fn2 += s2 * f2 * seen
             pdf += sel[si, slot(lp, l, diffuse)] * p
             continue
         if needs_wo_above(lp, l, woz):
@@ -235,13 +241,15 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
 
     Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
     the transparent lobe was taken, diffuse: a diffuse lobe was, crosses: wi leaves through the
-    surface (below the shading normal, but for a reflection about a lobe's own normal)). For non-delta lobes the weight
-    and pdf are those of the whole mixture of the choice (one-sample MIS over lobes), as multiple
-    importance sampling with light sampling requires.
+    surface (below the shading normal, but for a reflection about a lobe's own normal), the hair lobe
+    sampled (-1: none) and its own f |cos| RGB in the mixture's, which the light passes file by its
+    closure, transmits: Cycles' label of the sample, a transmission (``crosses``, but a hair lobe's
+    by its sample's lobe)). For non-delta lobes the weight and pdf are those of the whole mixture of the choice
+    (one-sample MIS over lobes), as multiple importance sampling with light sampling requires.
     """
     n = sel.shape[1]
     if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False, -1, 0.0, 0.0, 0.0, False
     count = 0
     acc = 0.0
     for k in range(n):
@@ -261,6 +269,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         while int(lp[l, P_SAMPLED]) != choice:
             l += 1
     kind = int(lp[l, P_KIND])
+    reflect = False  # a hair sample's label (hair_lobes.hair_lobe_sample)
     if kind == TOON_DIFFUSE:  # its weight is the mixture's, below, as the other diffuse lobes'
         wix, wiy, wiz = toon_cone_sample(lp, l, dx, dy, dz, u0, u1)
         w0 = w1 = w2 = 1.0
@@ -279,7 +288,8 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
         w0 = w1 = w2 = 1.0
         ok = True
     elif is_hair(kind):  # its sample's own value and density, which the mixture keeps (below)
-        wix, wiy, wiz, h0, h1, h2, h_pdf, ok = hair_lobe_sample(lp, hp, r, l, wox, woy, woz, u_re, u0, u1)
+        wix, wiy, wiz, h0, h1, h2, h_pdf, ok, reflect = hair_lobe_sample(lp, hp, r, l, wox, woy, woz, u_re, u0,
+                                                                          u1)
         w0, w1, w2 = h0 / max(h_pdf, TINY), h1 / max(h_pdf, TINY), h2 / max(h_pdf, TINY)
     else:
         wix, wiy, wiz, w0, w1, w2, ok = sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_re, u0, u1,
@@ -299,20 +309,22 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     else:
         crosses = wiz < 0.0 and not (kind == REFLECT and lp[l, P_OWN_NORMAL] != 0.0)
     above = side_of(wiz, crosses, diffuse_kind(kind), dx, dy)
+    transmits = (not reflect) if is_hair(kind) else crosses
+    own, o0, o1, o2 = -1, 0.0, 0.0, 0.0
     if valid and not delta:
-        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
-                                              sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz)
         if is_hair(kind):
-            # Cycles keeps a sampled hair closure's own value and density: the Hair BSDF's ignore
-            # the side of the surface wi leaves by, Huang's is its path's weight (its evaluation is a
-            # quadrature), and Cycles 5 cuts no sample by Principled Hair's own normal as it cuts
-            # their evaluation (hair_lobes.hair_lobe_eval)
+            own = l
+        _, _, _, f0, f1, f2, pdf = eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside,
+                                              sel, si, diffuse, 0, sx, sy, sz, model, dx, dy, dz, own)
+        if own >= 0:
+            # Cycles keeps a sampled hair closure's own value and density in place of its evaluation:
+            # the Hair BSDF's ignore the side of the surface wi leaves by, Huang's is its path's
+            # weight (its evaluation is a quadrature), and Cycles 5 cuts no sample by Principled
+            # Hair's own normal as it cuts their evaluation (hair_lobes.hair_lobe_eval)
             _, shade = bump_shadowing(sx, sy, sz, model, wix, wiy, wiz)
-            e0, e1, e2, e_pdf = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
-            f0 += s0 * shade * (h0 - e0)
-            f1 += s1 * shade * (h1 - e1)
-            f2 += s2 * shade * (h2 - e2)
-            pdf += p_choice * (h_pdf - e_pdf)
+            o0, o1, o2 = s0 * shade * h0, s1 * shade * h1, s2 * shade * h2
+            f0, f1, f2 = f0 + o0, f1 + o1, f2 + o2
+            pdf += p_choice * h_pdf
         if pdf > 0.0:
             w0, w1, w2 = f0 / max(pdf, TINY), f1 / max(pdf, TINY), f2 / max(pdf, TINY)
         else:
@@ -321,4 +333,5 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     w0 = w0 if np.isfinite(w0) else 0.0
     w1 = w1 if np.isfinite(w1) else 0.0
     w2 = w2 if np.isfinite(w2) else 0.0
-    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses, own, \
+        o0, o1, o2, transmits

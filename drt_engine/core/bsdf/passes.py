@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..base.jit import kernel
 from . import microfacet as mf
-from .hair_lobes import is_hair
+from .hair_lobes import hair_albedo, is_hair
 from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, HAIR_TRANSMISSION, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND,
                      P_REFRACT_ONLY, REFLECT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
@@ -36,8 +36,11 @@ def colours(lp, lt, hp, r, mu, mu_o):
             g1 += s1 * e1
             g2 += s2 * e2
         elif kind == TOON_GLOSSY or (is_hair(kind) and kind != HAIR_TRANSMISSION):
-            # Cycles' albedo of a closure without tables: its weight (Principled Hair's too, here)
-            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            # Cycles' albedo of a closure without tables: its weight (times Principled Hair's estimate)
+            if is_hair(kind):
+                a0, a1, a2 = hair_albedo(lp, lt, hp, r, j, t, l)
+            else:
+                a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
             g0 += a0
             g1 += a1
             g2 += a2
@@ -61,7 +64,7 @@ def transmission_colour(lp, lt, hp, r, mu, mu_o):
     c0 = c1 = c2 = 0.0
     for l in range(lp.shape[0]):
         if int(lp[l, P_KIND]) == HAIR_TRANSMISSION:
-            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            a0, a1, a2 = hair_albedo(lp, lt, hp, r, j, t, l)
             c0 += a0
             c1 += a1
             c2 += a2
@@ -104,6 +107,8 @@ def denoising_albedos(lp, lt, hp, r, mu, mu_o, inside):
             w0, w1, w2 = lobe_scale(lp, lt, hp, r, j, t, l)
             e0, e1, e2 = reflect_albedo(lp, lt, hp, r, j, t, l, True)
             a0, a1, a2 = w0 * e0, w1 * e1, w2 * e2
+        elif is_hair(kind):
+            a0, a1, a2 = hair_albedo(lp, lt, hp, r, j, t, l)
         else:
             a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         weight = (a0 + a1 + a2) / 3.0

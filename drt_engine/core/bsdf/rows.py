@@ -20,7 +20,7 @@ def selection_rows(lp, lt, hp, prow, mu, mu_o, out):
 def evaluate_rows(lp, lt, hp, prow, mu, wo, wi, above, inside, sel, f_diff, f_nd, pdf):
     for i in range(len(wo)):
         v = eval_lobes(lp, lt, hp, prow[i], mu, wo[i, 0], wo[i, 1], wo[i, 2], wi[i, 0], wi[i, 1], wi[i, 2],
-                       above[i], inside[i], sel, i, 0, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
+                       above[i], inside[i], sel, i, 0, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0, -1)
         f_diff[i, 0], f_diff[i, 1], f_diff[i, 2] = v[0], v[1], v[2]
         f_nd[i, 0], f_nd[i, 1], f_nd[i, 2] = v[3], v[4], v[5]
         pdf[i] = v[6]

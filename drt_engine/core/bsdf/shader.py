@@ -39,6 +39,10 @@ from .rows import (colours_rows, denoising_rows, evaluate_rows, sample_rows, sel
                    transparency_rows, weights_rows)
 
 
+BLURRED = ("reflect", "glass", "hair_chiang", "hair_huang")
+"""The lobe kinds Cycles' Filter Glossy blurs (bsdf_blur): microfacet ones and Principled Hair's."""
+
+
 @dataclass(eq=False)
 class Lobe:
     """One lobe as built from the closures; ``MaterialShader`` packs its lobes into the flat
@@ -747,16 +751,17 @@ class MaterialShader:
 
     @property
     def blurs(self) -> bool:
-        """It has lobes Filter Glossy blurs: GGX reflection and glass (core.bsdf.blur)."""
-        return any(lobe.kind in ("reflect", "glass") for lobe in self.lobes)
+        """It has lobes Filter Glossy blurs: GGX reflection and glass (core.bsdf.blur), Principled
+        Hair (core.bsdf.hair_lobes)."""
+        return any(lobe.kind in BLURRED for lobe in self.lobes)
 
     def blurred(self, roughness: np.ndarray) -> "MaterialShader":
-        """The shader bound to n hits (itself bound to them or constant) whose reflect and glass lobes
-        take at least alpha ``roughness`` (n,) at each (Filter Glossy, core.bsdf.blur)."""
+        """The shader bound to n hits (itself bound to them or constant) whose blurred lobes
+        (``BLURRED``) take at least roughness ``roughness`` (n,) at each (Filter Glossy)."""
         n = len(roughness)
         hp = self.hp.copy() if self.bound else np.repeat(self.hp, n, axis=0)
         for l, lobe in enumerate(self.lobes):
-            if lobe.kind in ("reflect", "glass"):
+            if lobe.kind in BLURRED:
                 hp[:, l, layout.H_BLUR] = roughness
         blurred = copy.copy(self)
         blurred.hp, blurred.bound = hp, True

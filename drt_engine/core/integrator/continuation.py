@@ -10,12 +10,13 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, selection, side_of
+from ..bsdf.layout import HAIR_TRANSMISSION, P_KIND
+from ..bsdf.mixture import UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, selection, side_of
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
 from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
 from .bounces import diffuse_bits
-from .lightpasses import eval_parts, share
+from .lightpasses import eval_parts, other_parts, share
 
 
 @kernel
@@ -78,7 +79,8 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
         passthrough[j], transmit[j], diffuse[j] = s[9], crosses, s[10]
         if len(first) and first[j] and not s[9]:
             pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, x, y, z, crosses, s[7], side_of(z, crosses, s[10], dn[j, 0],
-                        dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], shares)
+                        dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], s[12], s[13],
+                        s[14], s[15], shares)
         if len(bounces):
             next_bounces[j] = bounces[j]
             if s[9]:
@@ -87,15 +89,15 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
                 next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | DIFFUSE
                 next_bounces[j, DEPTH] += 1
                 next_bounces[j, TRANSMISSION_DEPTH if crosses else DIFFUSE_DEPTH] += 1
-            else:
-                next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | GLOSSY | (SINGULAR if s[7] else 0)
+            else:  # a hair lobe's by its sample's label (s[16]), not by the side it leaves by
+                next_bounces[j, KIND] = (TRANSMIT if s[16] else REFLECT) | GLOSSY | (SINGULAR if s[7] else 0)
                 next_bounces[j, DEPTH] += 1
-                next_bounces[j, TRANSMISSION_DEPTH if crosses else GLOSSY_DEPTH] += 1
+                next_bounces[j, TRANSMISSION_DEPTH if s[16] else GLOSSY_DEPTH] += 1
 
 
 @kernel(inline="always")
 def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, bits, sx, sy, sz, model, dx, dy,
-                dz, shares):
+                dz, own, o0, o1, o2, shares):
     """``shares[j]``: the diffuse, glossy and transmission weights of a path continued toward local
     (x, y, z) (on the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the
     diffuse lobes' normal (dx, dy, dz)).
@@ -106,7 +108,9 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
     weighs against light sampling (the other diffuse lobes' direct light is light sampling's alone,
     core.integrator.direct): Cycles' Direct passes hold each kind's own direct light. Each share is
     its own parts' evaluation, exactly 0 for a kind the BSDF has none of there (not what the others
-    leave of 1: that rounding would fill a pass nothing lights)."""
+    leave of 1: that rounding would fill a pass nothing lights). A sampled hair lobe ``own`` (-1:
+    none) counts with its sample's own value (o0, o1, o2), as the path's weight does
+    (core.bsdf.mixture.sample_lobes), filed by its closure."""
     for i in range(6):
         for c in range(3):
             shares[j, i, c] = 0.0
@@ -116,19 +120,33 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
         return
     # np.int64(0), not the literal 0: a literal argument would compile eval_parts a second time
     f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
-                   np.int64(0), sx, sy, sz, model, dx, dy, dz)
+                   np.int64(0), sx, sy, sz, model, dx, dy, dz, own)
     fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
-                    UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz)
-    for c in range(3):
-        shares[j, 0, c] = share(fd[c] + fd[3 + c], f[c] + f[3 + c])
-        shares[j, 3, c] = share(fd[3 + c], f[3 + c])
-    # the other lobes' reflection is glossy, their transmission transmission
-    kind = 1 if above else 2
-    fo = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
-                    UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION), sx, sy, sz, model, dx, dy, dz)
-    for c in range(3):
-        shares[j, kind, c] = share(fo[3 + c], f[c] + f[3 + c])
-        shares[j, 3 + kind, c] = share(fo[3 + c], f[3 + c])
+                    UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz, own)
+    # the other lobes' glossy and transmission parts, the sampled hair lobe's by its closure
+    fo = other_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+                     np.int64(0), sx, sy, sz, model, dx, dy, dz, own)
+    g0, g1, g2, t0, t1, t2 = fo
+    if own >= 0:
+        if int(lp[own, P_KIND]) == HAIR_TRANSMISSION:
+            t0, t1, t2 = t0 + o0, t1 + o1, t2 + o2
+        else:
+            g0, g1, g2 = g0 + o0, g1 + o1, g2 + o2
+    _channel_shares(shares, j, 0, fd[0] + fd[3], fd[3], g0, t0, f[0] + f[3] + o0, f[3] + o0)
+    _channel_shares(shares, j, 1, fd[1] + fd[4], fd[4], g1, t1, f[1] + f[4] + o1, f[4] + o1)
+    _channel_shares(shares, j, 2, fd[2] + fd[5], fd[5], g2, t2, f[2] + f[5] + o2, f[5] + o2)
+
+
+@kernel(inline="always")
+def _channel_shares(shares, j, c, diffuse, diffuse_continued, glossy, transmission, whole, continued):
+    """One channel of ``pass_shares``: each kind's part of the ``whole`` BSDF (Indirect rows) and of
+    the ``continued`` lobes' (Direct rows; the diffuse part of those is ``diffuse_continued``)."""
+    shares[j, 0, c] = share(diffuse, whole)
+    shares[j, 1, c] = share(glossy, whole)
+    shares[j, 2, c] = share(transmission, whole)
+    shares[j, 3, c] = share(diffuse_continued, continued)
+    shares[j, 4, c] = share(glossy, continued)
+    shares[j, 5, c] = share(transmission, continued)
 
 
 @kernel(inline="always")

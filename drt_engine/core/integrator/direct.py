@@ -20,7 +20,7 @@ from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_MIS, NO_SHADOW, UNRESTRICTED
 from .bounces import diffuse_bits
 from .clamp import clamped, limit_at
-from .lightpasses import add_split, add_weighted, eval_parts
+from .lightpasses import add_split, add_weighted, eval_parts, other_parts
 from .mis import power
 from .shadows import OPEN, SEE_THROUGH, enqueue, first_surface
 
@@ -164,7 +164,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             above = cd > 0  # the shading hemisphere decides, as in Cycles (of sd->N), not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
                            inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS)),
-                           sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
+                           sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], -1)
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
                 f_diff[k, j, 0], f_diff[k, j, 1], f_diff[k, j, 2] = d0, d1, d2
@@ -176,7 +176,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
                     rim_selected = True
                 every = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
                                    inside[j], sel_rim, 0, SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT, 0, sx, sy, sz, model,
-                                   dn[j, 0], dn[j, 1], dn[j, 2])
+                                   dn[j, 0], dn[j, 1], dn[j, 2], -1)
                 w = wd = power(cycles_pdf[k, j], every[6])
             mask = masks[k, j] if masking else shadow_mask
             c0 = throughput[j, 0] * v0 * (d0 * wd + n0 * w)
@@ -184,22 +184,23 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             c2 = throughput[j, 2] * v2 * (d2 * wd + n2 * w)
             if not _positive(c0, c1, c2):
                 continue
-            e0 = e1 = e2 = h0 = h1 = h2 = 0.0  # the diffuse and the other parts, at a first hit
+            e0 = e1 = e2 = h0 = h1 = h2 = t0 = t1 = t2 = 0.0  # diffuse, glossy, transmission, at a first hit
             if first:
                 unlit = unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS))
                 fd = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
                                 inside[j], sel, bits, unlit | UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model,
-                                dn[j, 0], dn[j, 1], dn[j, 2])
+                                dn[j, 0], dn[j, 1], dn[j, 2], np.int64(-1))
                 e0 = throughput[j, 0] * v0 * (fd[0] * wd + fd[3] * w)
                 e1 = throughput[j, 1] * v1 * (fd[1] * wd + fd[4] * w)
                 e2 = throughput[j, 2] * v2 * (fd[2] * wd + fd[5] * w)
-                # the other lobes' reflection (glass's on its reflected side) is glossy, their transmission
-                # transmission: each its own evaluation, exactly 0 where the BSDF has none
-                fo = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                inside[j], sel, bits,
-                                unlit | UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION), sx, sy,
-                                sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
-                h0, h1, h2 = throughput[j, 0] * v0 * fo[3] * w, throughput[j, 1] * v1 * fo[4] * w, \
+                # the other lobes' glossy and transmission parts, each its own evaluation, exactly 0
+                # where the BSDF has none
+                fo = other_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
+                                 inside[j], sel, bits, unlit, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2],
+                                 np.int64(-1))
+                h0, h1, h2 = throughput[j, 0] * v0 * fo[0] * w, throughput[j, 1] * v1 * fo[1] * w, \
+                    throughput[j, 2] * v2 * fo[2] * w
+                t0, t1, t2 = throughput[j, 0] * v0 * fo[3] * w, throughput[j, 1] * v1 * fo[4] * w, \
                     throughput[j, 2] * v2 * fo[5] * w
             ox, oy, oz = shadow_origin(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1], ng[j, 2], wx, wy, wz, cd,
                                        hx, hy, hz, scale[j])
@@ -241,12 +242,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
                     grouped[path[j], g, 0] += c0
                     grouped[path[j], g, 1] += c1
                     grouped[path[j], g, 2] += c2
-                if first and above:
-                    add_split(split, path[j], e0 * cut, e1 * cut, e2 * cut, h0 * cut, h1 * cut, h2 * cut, 0.0, 0.0,
-                              0.0, 0)
-                elif first:
-                    add_split(split, path[j], e0 * cut, e1 * cut, e2 * cut, 0.0, 0.0, 0.0, h0 * cut, h1 * cut,
-                              h2 * cut, 0)
+                if first:
+                    add_split(split, path[j], e0 * cut, e1 * cut, e2 * cut, h0 * cut, h1 * cut, h2 * cut, t0 * cut,
+                              t1 * cut, t2 * cut, 0)
                 elif splitting:
                     add_weighted(split, weights, path[j], c0, c1, c2)
         p = path[j]

@@ -3,7 +3,8 @@ writes them (kernel/film/light_passes.h).
 
 Every contribution to Combined after the camera's own first hit is split by the BSDF of that hit:
 a light sample there by its evaluation toward the light (the diffuse lobes' share to Diffuse, the
-other lobes' reflection to Glossy, the rest to Transmission; Cycles' bsdf_eval_pass_*_weight), and
+other lobes' reflection to Glossy, the rest to Transmission, but a hair lobe's light by its closure,
+as Cycles files it; Cycles' bsdf_eval_pass_*_weight), and
 what the path finds after its first bounce by the shares of the bounce's direction (the ray's
 pass weights, set once at that bounce and kept). Direct: the light samples at the first hit and the
 emission (lights, emissive surfaces, the world, suns) its bounce ray finds, MIS-weighted; Indirect:
@@ -21,7 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..base.jit import kernel
-from ..bsdf.mixture import eval_lobes
+from ..bsdf.hair_lobes import has_hair
+from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes
 from ..settings import LIGHT_PASSES
 
 SHADOWS_LEFT_OUT = ("light passes: light that reaches a surface through transparent surfaces (transparent "
@@ -105,8 +107,30 @@ def share(part, total):
 
 @kernel
 def eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, unlit, sx, sy, sz, model,
-               dx, dy, dz):
-    """core.bsdf.mixture.eval_lobes with the parts ``unlit`` leaves out: a call, not inlined, so the
-    kernels that split contributions by lobe kind hold one more copy of the mixture, not one per use."""
+               dx, dy, dz, skip):
+    """core.bsdf.mixture.eval_lobes with the parts ``unlit`` leaves out (and lobe ``skip``, -1: none): a
+    call, not inlined, so the kernels that split contributions by lobe kind hold one more copy of the
+    mixture, not one per use."""
     return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, 0, bits, unlit, sx, sy, sz,
-                      model, dx, dy, dz)
+                      model, dx, dy, dz, skip)
+
+
+@kernel(inline="always")
+def other_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, unlit, sx, sy, sz, model,
+                dx, dy, dz, skip):
+    """(Glossy RGB, Transmission RGB): the non-diffuse lobes' BSDF times |cos| toward wi without the
+    parts ``unlit`` leaves out, each its own evaluation. A lobe's light on wo's side (``above``) is
+    glossy, through the surface transmission; a hair lobe's goes by its closure whatever the side
+    (core.bsdf.mixture.eval_lobes), so the other side's part is evaluated where the mixture has hair."""
+    near = unlit | UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION)
+    f = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, near, sx, sy, sz,
+                   model, dx, dy, dz, skip)
+    o0 = o1 = o2 = 0.0
+    if has_hair(lp):
+        far = unlit | UNLIT_DIFFUSE | (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION)
+        o = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, far, sx, sy, sz,
+                       model, dx, dy, dz, skip)
+        o0, o1, o2 = o[3], o[4], o[5]
+    if above:
+        return f[3], f[4], f[5], o0, o1, o2
+    return o0, o1, o2, f[3], f[4], f[5]
