@@ -474,7 +474,7 @@ def test_material_slots_map_to_scene_materials():
     mesh.materials.append(blue)
     for face, slot in zip(mesh.polygons, [0, 1, 2, 2, 7, 0]):  # 7: past the last slot, clamped
         face.material_index = slot
-    plain = add_object(scene, "Plain", mesh)
+    add_object(scene, "Plain", mesh)
     twin = add_object(scene, "Twin", mesh, location=(3, 0, 0))  # linked duplicate
     add_object(scene, "Bare", cube_mesh("Bare"), location=(-3, 0, 0))
     data = render_export(scene)
@@ -805,7 +805,7 @@ def test_view_layer_material_and_world_overrides():
 
 
 def test_unsupported_shader_node_renders_default_grey_with_one_warning():
-    scene = empty_scene()
+    empty_scene()
     material, tree, output = _new_node_material("Portal")
     tree.links.new(tree.nodes.new("ShaderNodeBsdfRayPortal").outputs[0], output.inputs["Surface"])
     data = render_export(_material_scene(material))

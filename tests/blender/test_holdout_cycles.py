@@ -11,7 +11,6 @@ Cycles' own seed-0-against-seed-1 worst plus 0.002. Measured (48 x 48, 128 sampl
 from __future__ import annotations
 
 import bpy
-import numpy as np
 import pytest
 
 from tests.support import procedural_scenes as ps

@@ -55,7 +55,7 @@ def linking_scene():
     scene = ps.dark_scene(SIZE, (0.0, -6.0, 5.0), 40.0, False)
     ground = _add("Ground", _diffuse("Ground", (0.8, 0.8, 0.8)), "plane", (0, 0, 0), 5.0)
     left = _add("Left", _diffuse("White", (0.8, 0.8, 0.8)), "cube", (-0.9, 0.0, 0.5), 1.0, (0.0, 0.0, 0.4))
-    right = _add("Right", bpy.data.materials["White"], "cube", (0.9, 0.3, 0.5), 1.0, (0.0, 0.0, -0.3))
+    _add("Right", bpy.data.materials["White"], "cube", (0.9, 0.3, 0.5), 1.0, (0.0, 0.0, -0.3))
     red = add_light(scene, "AREA", location=(-1.0, -1.0, 3.0), energy=150.0, size=1.0, color=(1.0, 0.2, 0.1))
     blue = add_light(scene, "AREA", location=(1.0, -0.5, 3.0), energy=150.0, size=1.0, color=(0.1, 0.3, 1.0))
     glow = _add("Glow", _diffuse("Glow", (0.0, 0.0, 0.0), emission=(0.2, 1.0, 0.3)), "plane", (0.0, 1.6, 1.0), 0.8,

@@ -3,7 +3,7 @@ flattened tables they replaced, and the geometry's memory grows with instances, 
 import numpy as np
 
 from drt_engine.core.geometry.accel import Geometry
-from drt_engine.core.scene import Camera, Closure, Instance, Material, Mesh, SceneData
+from drt_engine.core.scene import Camera, Closure, Instance, Material, SceneData
 from tests.support.scenes import look_at, translation, uv_sphere
 
 

@@ -5,7 +5,6 @@ raised normal and its diffuse lobes take the mesh's (core.bsdf.diffuse_normal). 
 geometric normal for both: a smooth-shaded 8-sided cylinder's rim was 0.19 off Cycles in its worst
 4x4 block, within the limit now (tests/blender/test_smooth_rims_cycles.py)."""
 import numpy as np
-import pytest
 
 from drt_engine.core.bsdf.specular_normal import valid_specular_reflection
 from drt_engine.core.geometry.accel import Geometry

@@ -29,7 +29,8 @@ class Issues:
         if not self.items:
             return None
         details = "; ".join(sorted(self.items))
-        return f"{owner} uses what DRT cannot evaluate yet ({details}): default values used"
+        return (f"{owner} uses what DRT cannot evaluate yet ({details}): each takes its default value unless "
+                "its note says how it is rendered")
 
 
 def find_input(node, *names):

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..bsdf.shader import DIFFUSE_KINDS, see_through
 from ..geometry.motion import Motion, deforms, moves
 from ..shading.occlusion import traces
