@@ -312,8 +312,9 @@ PRINCIPLED_HAIR_MATCHED_FROM = (5, 0)
 node is named in the warning."""
 VERSION_PRINCIPLED_HAIR = "Principled Hair BSDF: rendered as Cycles 5.0 computes it"
 HUANG_NOTE = ("Huang hair model (rendered as Cycles computes it, but Cycles' own evaluation and sampling of it "
-              "disagree in energy, so its image depends on how it weighs light samples: measured up to 9% darker "
-              "than Cycles under an area light, equal under a point light)")
+              "disagree in energy, so its image depends on how it picks and weighs light samples: measured equal "
+              "to Cycles under a point light alone, up to 7% darker under an area light alone, up to 13% darker "
+              "under both)")
 """Named wherever the Principled Hair BSDF's Huang model is used: its parity passes the noise limit, its
 image means do not (tests/blender/test_hair_cycles.py)."""
 
