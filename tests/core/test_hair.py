@@ -261,3 +261,28 @@ def test_filter_glossy_raises_principled_hair_roughness(model):
     shade = blurred.pdf > 0  # Cycles 5 cuts by the closure's own normal: nothing there, blurred or not
     np.testing.assert_allclose(blurred.glossy[shade], want[shade], rtol=1e-9, atol=1e-15)
     assert np.abs(blurred.glossy - plain.glossy).max() > 1e-3
+
+
+def test_a_hair_sample_is_labelled_by_its_lobe_not_its_side():
+    """Cycles labels a Chiang sample reflect for its R lobe and transmit otherwise, whatever side of the
+    surface it leaves by; Light Path and the bounce depths read the label (sample_lobes' last value),
+    which differs from the side (``crosses``) for some samples."""
+    from drt_engine.core.bsdf import hair_chiang, mixture
+    n = 300
+    wo = _view(n)
+    shader = _principled("CHIANG", wo)
+    lp, hp = shader.lp, shader.hp
+    c = lp[0, layout.P_HAIR:layout.P_HAIR + 5]
+    sel = np.ones((1, 1))
+    u = RNG.random((n, 3))
+    differs = 0
+    for i in range(n):
+        s = mixture.sample_lobes(lp, shader.lt, hp, i, shader.mu, *wo[i], u[i, 0], u[i, 1], u[i, 2], False, sel, 0, 0,
+                                 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
+        sigma, frame = hp[i, 0, layout.H_SIGMA:layout.H_SIGMA + 3], hp[i, 0, layout.H_HAIR:layout.H_HAIR + 7]
+        *_, reflect = hair_chiang.chiang_sample(*c, *sigma, frame[6], *frame[:6], *wo[i], u[i, 1], u[i, 2], u[i, 0])
+        if not s[8]:
+            continue
+        assert s[16] == (not reflect) and s[12] == 0
+        differs += s[16] != s[11]
+    assert differs > 0
