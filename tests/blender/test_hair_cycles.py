@@ -111,8 +111,10 @@ def test_hair_passes_match_cycles(drt, tmp_path, node):
     scene = hair_scene(node)
     drt_r, cycles0, cycles1 = [rh.render(scene, engine, 64, seed, tmp_path, passes=PASSES, name="hair_passes")
                                for engine, seed in ps.RUNS]
-    compared = ("GlossCol", "GlossDir") + (("TransCol", "TransDir") if node == "ShaderNodeBsdfHair" else ())
-    for name in compared if node != "HUANG" else ("GlossCol",):  # Huang's light is named (HUANG_NOTE)
+    compared = {"ShaderNodeBsdfHair": ("GlossCol", "GlossDir", "TransCol", "TransDir"),
+                "CHIANG": ("GlossCol", "GlossDir"),
+                "HUANG": ("GlossCol",)}[node]  # Huang's light is named (HUANG_NOTE)
+    for name in compared:
         figures = ps.parity(drt_r.passes[name], cycles0.passes[name], cycles1.passes[name])
         print(node, name, figures)
         assert figures["ok"], ps.message(name, figures)
