@@ -10,6 +10,7 @@ import numba
 import numpy as np
 import pytest
 
+from drt_engine.core.lights.emitter_tree import emitter_tree
 from drt_engine.core.lights.spherical_triangle import MIN_SOLID_ANGLE, subtended
 from drt_engine.core.lights.triangles import pdf_emissive_batch, sample_triangle, unoccluded_triangles_batch
 
@@ -17,19 +18,21 @@ TRIANGLE = np.array([[0.0, 0.0, 1.0], [2.0, 0.0, 1.5], [0.0, 1.5, 2.0]])
 
 
 def tables(verts):
-    """(vertices, triangles, ng, area, prob) of one emissive triangle, as lights.collection keeps them."""
+    """(vertices, triangles, ng, area, tree, rank) of one emissive triangle, as lights.collection keeps them."""
     e = np.cross(verts[1] - verts[0], verts[2] - verts[0])
     norm = np.linalg.norm(e)
+    tree, _, rank = emitter_tree(np.asarray(verts, np.float64)[None], np.array([1.0]))
     return (np.ascontiguousarray(verts, np.float64), np.array([[0, 1, 2]], np.int64), (e / norm)[None],
-            np.array([0.5 * norm]), np.array([1.0]))
+            np.array([0.5 * norm]), tree, rank)
 
 
 @numba.njit
-def samples(verts, tris, ng, area, prob, p, u):
-    """sample_triangle's (wx, wy, wz, dist, pdf, b0, b1, cos_l) for each row of u."""
+def samples(verts, tris, ng, area, tree, rank, p, u):
+    """sample_triangle's (wx, wy, wz, dist, pdf, b0, b1, cos_l) for each row of u (the one
+    triangle picked for sure)."""
     out = np.zeros((len(u), 8))
     for j in range(len(u)):
-        r = sample_triangle(verts, tris, ng, area, prob, 0, p[0], p[1], p[2], u[j, 0], u[j, 1])
+        r = sample_triangle(verts, tris, ng, area, 1.0, 0, p[0], p[1], p[2], u[j, 0], u[j, 1])
         for k in range(8):
             out[j, k] = r[k]
     return out

@@ -15,7 +15,8 @@ import pytest
 from drt_engine.core.lights.table import light_table
 from drt_engine.core.lights.collection import _sample_batch, closed_forms, unoccluded_batch
 from drt_engine.core.scene import Light
-from drt_engine.core.lights.triangles import pick_triangle, sample_triangle, unoccluded_triangles_batch
+from drt_engine.core.lights.emitter_tree import emitter_tree, pick_emitter
+from drt_engine.core.lights.triangles import sample_triangle, unoccluded_triangles_batch
 
 REL = 1e-6
 _X, _W = np.polynomial.legendre.leggauss(10)
@@ -466,17 +467,16 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
     assert np.allclose(out[0], want[0] * emission[0] + want[1] * emission[1], rtol=REL, atol=0)
     if clipped:
         assert abs(triangle_reference(0, p, n, clip=False) - want[0]) > 1e-3 * want[0]
-    # the emissive strategy's samples (chosen by power, two-sided) have the same mean
+    # the emissive strategy's samples (chosen down the emitter tree, two-sided) have the same mean
     area = 0.5 * np.linalg.norm(np.cross(verts[tris[:, 1]] - verts[tris[:, 0]], verts[tris[:, 2]] - verts[tris[:, 0]]),
                                 axis=1)
-    power = emission.mean(axis=1) * area
-    prob = power / power.sum()
+    tree, order, _ = emitter_tree(verts[tris], emission.mean(axis=1) * area)
     ng = np.array([unit(np.cross(verts[t[1]] - verts[t[0]], verts[t[2]] - verts[t[0]])) for t in tris])
     rng, means = np.random.default_rng(9), []
     for _ in range(32):
         u = stratified(64, rng)
-        wi, value = _emissive_samples(verts, tris, ng, area, np.cumsum(prob), prob, emission,
-                                      np.asarray(p, float), u, rng.random(len(u)))
+        wi, value = _emissive_samples(verts, tris, ng, area, tree, order, emission, np.asarray(p, float), u,
+                                      rng.random(len(u)))
         means.append((value * np.maximum(wi @ unit(n), 0.0)[:, None]).mean(axis=0))
     means = np.array(means)
     err = means.std(axis=0, ddof=1) / math.sqrt(len(means))
@@ -484,13 +484,14 @@ def test_emissive_triangles_match_area_cubature_and_their_sampler(p, n, clipped)
 
 
 @numba.njit
-def _emissive_samples(verts, tris, ng, area, cdf, prob, emission, p, u, u_pick):
+def _emissive_samples(verts, tris, ng, area, tree, order, emission, p, u, u_pick):
     """Directions and values (emission / pdf where the triangle faces p) of the emissive strategy's
     samples at p, as lights.strategies draws them."""
     wi, value = np.zeros((len(u), 3)), np.zeros((len(u), 3))
     for j in range(len(u)):
-        i = pick_triangle(cdf, u_pick[j])
-        wx, wy, wz, _, pdf, _, _, cos_l = sample_triangle(verts, tris, ng, area, prob, i, p[0], p[1], p[2], u[j, 0],
+        leaf, chance = pick_emitter(tree, p[0], p[1], p[2], u_pick[j])
+        i = order[leaf]
+        wx, wy, wz, _, pdf, _, _, cos_l = sample_triangle(verts, tris, ng, area, chance, i, p[0], p[1], p[2], u[j, 0],
                                                           u[j, 1])
         wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
         if cos_l > 0:

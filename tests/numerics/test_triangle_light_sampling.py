@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from drt_engine.core.lights.emitter_tree import emitter_tree
 from drt_engine.core.lights.triangles import pdf_emissive_batch
 from tests.core.test_spherical_triangle import omega_at, samples, tables
 
@@ -38,7 +39,8 @@ def test_samples_are_finite_on_the_triangle_with_pdf_emissives_density(name):
     with np.errstate(divide="ignore", invalid="ignore"):
         e = np.cross(verts[1] - verts[0], verts[2] - verts[0])
         n = e / np.linalg.norm(e) if np.linalg.norm(e) > 0 else np.array([0.0, 0.0, 1.0])
-    t = (verts, np.array([[0, 1, 2]], np.int64), n[None], np.array([0.5 * np.linalg.norm(e)]), np.array([1.0]))
+    tree, _, rank = emitter_tree(verts[None], np.array([1.0]))
+    t = (verts, np.array([[0, 1, 2]], np.int64), n[None], np.array([0.5 * np.linalg.norm(e)]), tree, rank)
     u = np.concatenate([EDGES, np.random.default_rng(6).random((400, 2))])
     s = samples(*t, p, u)
     assert np.isfinite(s).all(), name

@@ -33,6 +33,7 @@ from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_pa
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from . import programs
 from .choice import pick_probability
+from .emitter_tree import emitter_tree
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .linking import lights as links
@@ -207,8 +208,9 @@ class Lights:
 
     def _emitters(self, geometry, scene: SceneData) -> None:
         """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
-        each picked by its power (``emissive_cdf``, ``emissive_prob``), with its world corners,
-        normal, area and emission at mid-shutter in ``emitters`` (the kernels' order). Triangles
+        each picked per shading point down ``emitter_tree`` (lights.emitter_tree's tree, order,
+        rank), with its world corners, normal, area and emission at mid-shutter in ``emitters``
+        (the kernels' order). Triangles
         of objects no BSDF ray sees light nothing, and are left out (Cycles' usable_as_light)."""
         tris = geometry.triangles_with(np.flatnonzero(self.glows))
         lighting = np.array([i.visible_diffuse or i.visible_glossy or i.visible_transmission for i in scene.instances],
@@ -223,9 +225,7 @@ class Lights:
         power = estimate @ LUMINANCE * area
         keep = np.flatnonzero(power > 0)
         self.emissive = tris[keep]
-        cdf = np.cumsum(power[keep])
-        self.emissive_cdf = cdf / cdf[-1] if len(keep) else cdf
-        self.emissive_prob = power[keep] / cdf[-1] if len(keep) else cdf
+        self.emitter_tree = emitter_tree(corners[keep], power[keep])
         self.emitters = (np.ascontiguousarray(corners[keep].reshape(-1, 3)),
                          np.arange(3 * len(keep), dtype=np.int64).reshape(-1, 3), np.ascontiguousarray(ng[keep]),
                          area[keep], np.ascontiguousarray(self.emission[mats[keep]]))
@@ -391,8 +391,9 @@ class Lights:
         g = self.geometry
         world = NO_WORLD if self.world is None else UNIFORM_WORLD if self.environment is None else MAP_WORLD
         vertices, triangles, ng, area, emission = self.emitters
+        tree, order, _ = self.emitter_tree
         sample_strategies(self.table, self.light_slots, self.selecting, vertices, triangles, ng, area, self.emissive,
-                          self.emissive_cdf, self.emissive_prob, emission, g.tables,
+                          tree, order, emission, g.tables,
                           world, self._world_radiance, self._map_share, *self._map, pos, normal, u, out.wi, out.dist,
                           out.value, out.pdf, out.cycles_pdf, out.stop, pick, chosen, bary, lit)
         if time is not None and self.motions:
@@ -575,7 +576,8 @@ class Lights:
         found = found[self.emissive[e[found]] == prim[found]]
         if len(found):
             vertices, triangles, ng, area, _ = self.emitters
-            out[found] = pdf_emissive_batch(vertices, triangles, ng, area, self.emissive_prob, e[found],
+            tree, _, rank = self.emitter_tree
+            out[found] = pdf_emissive_batch(vertices, triangles, ng, area, tree, rank, e[found],
                                             np.ascontiguousarray(origins[found], np.float64), dirs[found],
                                             np.asarray(t, np.float64)[found])
         return out

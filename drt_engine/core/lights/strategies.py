@@ -15,7 +15,8 @@ from ..base.jit import kernel
 from ..geometry.accel import offset_scale
 from .choice import pick_light
 from .kinds import sample_light
-from .triangles import pick_triangle, sample_triangle
+from .emitter_tree import pick_emitter
+from .triangles import sample_triangle
 from .environment import map_pdf
 from .world import cosine_direction, sample_world_direction
 
@@ -90,13 +91,14 @@ class LightSamples:
 
 
 @kernel
-def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, cdf, prob, emission,
+def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, tree, order, emission,
                       geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, sun, pos, normal, u, wi, dist,
                       value, pdf, cycles_pdf, stop, pick, chosen, bary, lit):
     """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
     hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
     expected picks of it), emissive triangles when there are (``emissive``: their global ids,
-    picked by power; ``vertices`` to ``emission`` and ``prob`` are per emissive triangle),
+    each picked down lights.emitter_tree's ``tree``, whose leaves are ``order``; ``vertices`` to
+    ``emission`` are per emissive triangle),
     the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``, MAP_WORLD: directions from the
     map (and its sun cone, ``sun``) with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
     the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
@@ -118,8 +120,9 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
             pick[k, j], chosen[k, j] = i, c
         k = slots
         if len(emissive):
-            i = pick_triangle(cdf, u[j, k, 1, 0])
-            wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, prob, i, px, py, pz,
+            leaf, c = pick_emitter(tree, px, py, pz, u[j, k, 1, 0])
+            i = order[leaf]
+            wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, c, i, px, py, pz,
                                                               u[j, k, 0, 0], u[j, k, 0, 1])
             wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, d, p
             cycles_pdf[k, j] = p

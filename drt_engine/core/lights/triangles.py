@@ -1,10 +1,10 @@
 """Emissive triangles, together one next-event strategy: pick, sample, pdf and closed form.
 
-A triangle is picked by its emitted power (``pick_triangle`` over a cdf lights.collection
-builds), then a point on it uniformly in the solid angle it subtends where that is large
+A triangle is picked per shading point down lights.emitter_tree (by power over distance), then
+a point on it uniformly in the solid angle it subtends where that is large
 (lights.spherical_triangle), else uniformly by area; both sides emit, and the solid-angle pdf
-includes the chance of the pick. Batch loops over a wave's points, since the triangles are not rows of
-the light table. The closed form (``unoccluded_triangles``) sums each triangle's projected
+includes the chance of the pick. Batch loops over a wave's points, since the triangles are not
+rows of the light table. The closed form (``unoccluded_triangles``) sums each triangle's projected
 solid angle (Lambert's edge integral, lights.solid_angle) times its constant emission: O(number
 of triangles) per point.
 """
@@ -16,21 +16,16 @@ import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
+from .emitter_tree import leaf_chance
 from .solid_angle import polygon4
 from .spherical_triangle import barycentrics_along, sample_direction, subtended
 
 
 # -- sampling --------------------------------------------------------------------------------------
 @kernel(inline="always")
-def pick_triangle(cdf, u):
-    """The index of an emissive triangle chosen by power (``cdf`` over the emissive triangles)."""
-    return min(np.searchsorted(cdf, u, side="right"), len(cdf) - 1)
-
-
-@kernel(inline="always")
-def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
+def sample_triangle(vertices, triangles, ng, area, chance, i, px, py, pz, u0, u1):
     """A point on triangle i seen from p: (wx, wy, wz, dist, pdf, b0, b1, cos_l), pdf in solid
-    angle including the chance ``prob[i]`` of picking the triangle, two-sided. Uniform in the
+    angle including the ``chance`` of picking the triangle, two-sided. Uniform in the
     solid angle where lights.spherical_triangle chooses so, else uniform by area."""
     a, b, c = triangles[i, 0], triangles[i, 1], triangles[i, 2]
     nx, ny, nz = ng[i, 0], ng[i, 1], ng[i, 2]
@@ -51,26 +46,29 @@ def sample_triangle(vertices, triangles, ng, area, prob, i, px, py, pz, u0, u1):
     wx, wy, wz = tx * inv, ty * inv, tz * inv
     cos_l = abs(wx * nx + wy * ny + wz * nz)
     if omega > 0:
-        pdf = prob[i] / omega
+        pdf = chance / omega
     else:
-        pdf = dist * dist / max(cos_l, TINY) * (prob[i] / area[i])
+        pdf = dist * dist / max(cos_l, TINY) * (chance / area[i])
     return wx, wy, wz, dist, pdf, b0, b1, cos_l
 
 
 @kernel
-def pdf_emissive_batch(vertices, triangles, ng, area, prob, prim, origins, dirs, t):
-    """``sample_triangle``'s pdf of directions ``dirs`` from ``origins`` that reach emissive
-    triangles ``prim`` (their indices among the emitters) at distances ``t``."""
+def pdf_emissive_batch(vertices, triangles, ng, area, tree, rank, prim, origins, dirs, t):
+    """The emissive strategy's pdf of directions ``dirs`` from ``origins`` that reach emissive
+    triangles ``prim`` (their indices among the emitters) at distances ``t``: ``sample_triangle``'s
+    with the chance lights.emitter_tree's walk takes the triangle (its leaf ``rank``) there."""
     out = np.empty(len(prim))
     for j in range(len(prim)):
         i = prim[j]
+        ox, oy, oz = origins[j, 0], origins[j, 1], origins[j, 2]
+        c = leaf_chance(tree, rank[i], ox, oy, oz)
         omega = subtended(vertices, triangles[i, 0], triangles[i, 1], triangles[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
-                          origins[j, 0], origins[j, 1], origins[j, 2])
+                          ox, oy, oz)
         if omega > 0:
-            out[j] = prob[i] / omega
+            out[j] = c / omega
         else:
             cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
-            out[j] = prob[i] / area[i] * t[j] * t[j] / cos_l
+            out[j] = c / area[i] * t[j] * t[j] / cos_l
     return out
 
 
