@@ -32,6 +32,14 @@ def is_hair(kind):
 
 
 @kernel(inline="always")
+def files_as_transmission(lp, l):
+    """Where Cycles files hair lobe l's light and colour: Hair Transmission under Transmission, every
+    other hair lobe (Hair Reflection, Principled Hair) under Glossy, whatever side the light comes
+    from (its closure type, CLOSURE_IS_BSDF_TRANSMISSION or _GLOSSY)."""
+    return int(lp[l, P_KIND]) == HAIR_TRANSMISSION
+
+
+@kernel(inline="always")
 def has_hair(lp):
     """The mixture has a hair lobe."""
     for l in range(lp.shape[0]):

@@ -26,8 +26,8 @@ from .bump_shadowing import bump_shadowing, own_normal_shadowing
 from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
-from .hair_lobes import hair_lobe_eval, hair_lobe_sample, is_hair
-from .layout import (DIFFUSE, H_NORMAL, HAIR_TRANSMISSION, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
+from .hair_lobes import files_as_transmission, hair_lobe_eval, hair_lobe_sample, is_hair
+from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
                      SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
@@ -169,7 +169,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
                 continue
             f0, f1, f2, p = hair_lobe_eval(lp, hp, r, l, wox, woy, woz, wix, wiy, wiz)
             s0, s1, s2 = lobe_scale(lp, lt, hp, r, j, t, l)
-            seen = 0.0 if unlit & (UNLIT_TRANSMISSION if kind == HAIR_TRANSMISSION else UNLIT_REFLECTION) else shade
+            seen = 0.0 if unlit & (UNLIT_TRANSMISSION if files_as_transmission(lp, l) else UNLIT_REFLECTION) else shade
             fn0 += s0 * f0 * seen
             fn1 += s1 * f1 * seen
             fn2 += s2 * f2 * seen

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from ..base.jit import kernel
 from . import microfacet as mf
-from .hair_lobes import hair_albedo, is_hair
-from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, HAIR_TRANSMISSION, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND,
+from .hair_lobes import files_as_transmission, hair_albedo, is_hair
+from .layout import (DIFFUSE, GLASS, H_TINT_R, H_TINT_T, OREN_NAYAR, P_ALPHA, P_ETA, P_KIND,
                      P_REFRACT_ONLY, REFLECT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .tables import lobe_albedo, lobe_scale, locate, reflect_albedo
 
@@ -35,7 +35,7 @@ def colours(lp, lt, hp, r, mu, mu_o):
             g0 += s0 * e0
             g1 += s1 * e1
             g2 += s2 * e2
-        elif kind == TOON_GLOSSY or (is_hair(kind) and kind != HAIR_TRANSMISSION):
+        elif kind == TOON_GLOSSY or (is_hair(kind) and not files_as_transmission(lp, l)):
             # Cycles' albedo of a closure without tables: its weight (times Principled Hair's estimate)
             if is_hair(kind):
                 a0, a1, a2 = hair_albedo(lp, lt, hp, r, j, t, l)
@@ -63,7 +63,7 @@ def transmission_colour(lp, lt, hp, r, mu, mu_o):
     j, t = locate(mu, mu_o)
     c0 = c1 = c2 = 0.0
     for l in range(lp.shape[0]):
-        if int(lp[l, P_KIND]) == HAIR_TRANSMISSION:
+        if files_as_transmission(lp, l):
             a0, a1, a2 = hair_albedo(lp, lt, hp, r, j, t, l)
             c0 += a0
             c1 += a1

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.layout import HAIR_TRANSMISSION, P_KIND
+from ..bsdf.hair_lobes import files_as_transmission
 from ..bsdf.mixture import UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, selection, side_of
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
@@ -128,7 +128,7 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
                      np.int64(0), sx, sy, sz, model, dx, dy, dz, own)
     g0, g1, g2, t0, t1, t2 = fo
     if own >= 0:
-        if int(lp[own, P_KIND]) == HAIR_TRANSMISSION:
+        if files_as_transmission(lp, own):
             t0, t1, t2 = t0 + o0, t1 + o1, t2 + o2
         else:
             g0, g1, g2 = g0 + o0, g1 + o1, g2 + o2
