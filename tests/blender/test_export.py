@@ -19,7 +19,7 @@ from drt_engine.blender.export.materials import HUANG_NOTE, PRINCIPLED_HAIR_MATC
 from drt_engine.core.errors import SceneError
 from drt_engine.core.scene import DEFAULT_MATERIAL
 
-from tests.support.datablocks import new_material, new_world
+from tests.support.datablocks import new_material, new_world, with_nodes
 from tests.support.export_helpers import add_object, cube_mesh, empty_scene, render_export, total_area
 
 # ---------------------------------------------------------------- geometry
@@ -963,8 +963,7 @@ def test_thin_film_over_a_physical_conductor_is_named():
 def test_light_node_tree_emission_scales_the_strength():
     scene = empty_scene()
     lamp = _light(scene, "POINT", energy=10.0)
-    if lamp.data.node_tree is None:  # Blender 5.2 gives every light a node tree and deprecates the switch
-        lamp.data.use_nodes = True
+    with_nodes(lamp.data)
     emission = next(n for n in lamp.data.node_tree.nodes if n.bl_idname == "ShaderNodeEmission")
     emission.inputs["Strength"].default_value = 3.0
     emission.inputs["Color"].default_value = (1.0, 0.5, 0.0, 1.0)

@@ -1,4 +1,4 @@
-"""New materials and worlds with the node trees Blender 5.0 gives them, and a compositor node tree,
+"""New materials, worlds and lights with the node trees Blender 5.0 gives them, and a compositor node tree,
 in every Blender the tests run under (``make test-versions``).
 
 Blender 5.0 gives a new material a Principled BSDF node tree and a new world a Background one, and
@@ -8,18 +8,20 @@ tests build their scenes through these so that each version renders the same sce
 import bpy
 
 
-def _with_nodes(idblock):
+def with_nodes(idblock):
+    """``idblock`` (a material, world or light) with its node tree, switching ``use_nodes`` on only
+    where it has none (Blender 5.2 deprecates the switch for lights too)."""
     if idblock.node_tree is None:
         idblock.use_nodes = True
     return idblock
 
 
 def new_material(name: str) -> bpy.types.Material:
-    return _with_nodes(bpy.data.materials.new(name))
+    return with_nodes(bpy.data.materials.new(name))
 
 
 def new_world(name: str) -> bpy.types.World:
-    return _with_nodes(bpy.data.worlds.new(name))
+    return with_nodes(bpy.data.worlds.new(name))
 
 
 def new_compositor(scene) -> bpy.types.NodeTree:

@@ -11,14 +11,14 @@ import mathutils
 
 from tests.support import procedural_scenes as ps
 from tests.support.ies_profiles import ASYMMETRIC, QUADRANT, TYPE_B
-from tests.support.datablocks import new_material
+from tests.support.datablocks import new_material, with_nodes
 
 
 def _ies_tree(light, node_mode, source, strength=None, scale=None):
     """The light's node tree: an IES Texture (``node_mode`` INTERNAL with a Text of ``source``,
     EXTERNAL with ``source`` a file path) into its Emission's Strength, through Math Multiply by
     ``scale`` when given; the IES node's Strength ``strength`` when given."""
-    light.data.use_nodes = True
+    with_nodes(light.data)
     tree = light.data.node_tree
     node = tree.nodes.new("ShaderNodeTexIES")
     node.mode = node_mode
@@ -96,7 +96,7 @@ def ies_scene(size=48):
     area = _light(scene, "IES area", "AREA", 2.0, (0.0, -1.8, 1.3), (0.0, 0.0, 0.0), radius=0.4)
     _ies_tree(area, "INTERNAL", ASYMMETRIC, scale=0.5)
     falloff = _light(scene, "Falloff point", "POINT", 3.0, (-1.2, -1.5, 0.8), (0.0, 0.0, 0.0))
-    falloff.data.use_nodes = True
+    with_nodes(falloff.data)
     tree = falloff.data.node_tree
     node = tree.nodes.new("ShaderNodeLightFalloff")
     node.inputs["Strength"].default_value, node.inputs["Smooth"].default_value = 0.6, 0.5
