@@ -60,10 +60,7 @@ def _tilted_coat():
 
 
 def coat_normal_scene():
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
+    scene = ps.sphere_pair_stage(WIDTH, HEIGHT)
     ps.add_light(scene, "Area", "AREA", 200.0, (1.5, -3.0, 3.0), size=1.5)
     ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     ps.smooth_sphere("Banded", -1.1, _banded_coat())

@@ -33,45 +33,9 @@ from drt_engine.blender.export.materials import HUANG_NOTE, PRINCIPLED_HAIR_MATC
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
 from tests.support.export_helpers import render_export
+from tests.support.hair_scenes import hair_scene
 
-WIDTH, HEIGHT = 96, 48
 SAMPLES = 128
-
-
-def _hair_bsdf(name, component, colour):
-    material, node = ps.closure_material(name, "ShaderNodeBsdfHair", Color=colour)
-    node.component = component
-    return material
-
-
-def _principled_hair(name, model, parametrization, **inputs):
-    material, node = ps.closure_material(name, "ShaderNodeBsdfHairPrincipled")
-    node.model, node.parametrization = model, parametrization  # before the inputs they enable
-    for socket, value in inputs.items():
-        node.inputs[socket].default_value = value
-    return material
-
-
-def hair_scene(node):
-    """Two spheres of ``node``'s closure, lit by an area and a point light over a black world."""
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
-    ps.add_light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
-    ps.add_light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
-    if node == "ShaderNodeBsdfHair":
-        left = _hair_bsdf("Reflection", "Reflection", (0.9, 0.6, 0.3, 1.0))
-        right = _hair_bsdf("Transmission", "Transmission", (0.6, 0.8, 0.9, 1.0))
-    elif node == "CHIANG":
-        left = _principled_hair("Coloured", "CHIANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))
-        right = _principled_hair("Melanin", "CHIANG", "MELANIN", Melanin=0.5, Coat=0.3)
-    else:
-        left = _principled_hair("Coloured", "HUANG", "COLOR", Color=(0.6, 0.3, 0.15, 1.0))
-        right = _principled_hair("Melanin", "HUANG", "MELANIN", Melanin=0.5, **{"Aspect Ratio": 0.6})
-    ps.smooth_sphere("Left", -1.1, left)
-    ps.smooth_sphere("Right", 1.1, right)
-    return scene
 
 
 @pytest.mark.parametrize("node", ["ShaderNodeBsdfHair", "CHIANG", "HUANG"])

@@ -24,10 +24,7 @@ SAMPLES = 256
 
 
 def sheen_scene(floor=False):
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
+    scene = ps.sphere_pair_stage(WIDTH, HEIGHT)
     ps.add_light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
     ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     for name, x, rough, colour in (("Fine sheen", -1.1, 0.2, (0.9, 0.7, 0.5, 1.0)),
@@ -60,10 +57,7 @@ def test_sheen_bsdf_with_diffuse_bounces_matches_cycles(drt, tmp_path):
 
 
 def principled_sheen_scene():
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
+    scene = ps.sphere_pair_stage(WIDTH, HEIGHT)
     ps.add_light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
     ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
     for name, x, coat, tint in (("Velvet", -1.1, 0.0, (1.0, 0.6, 0.8, 1.0)), ("Coated velvet", 1.1, 1.0,

@@ -56,10 +56,7 @@ def _floor():
 
 
 def toon_scene(floor=False):
-    scene = ps._scene(WIDTH, HEIGHT)
-    ps.aim(scene.camera, (0.0, -7.0, 1.5))
-    scene.camera.data.lens = 50.0
-    ps.black_world(scene)
+    scene = ps.sphere_pair_stage(WIDTH, HEIGHT)
     ps.add_light(scene, "Area", "AREA", 150.0, (1.5, -3.0, 3.0), size=2.0)
     ps.add_light(scene, "Point", "POINT", 400.0, (-3.0, -2.5, 1.0))
     ps.smooth_sphere("Diffuse toon", -1.1,

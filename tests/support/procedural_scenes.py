@@ -252,6 +252,16 @@ def add_primitive(op, mat, name=None, **kw):
     return obj
 
 
+def sphere_pair_stage(width: int, height: int):
+    """The closure tests' stage for two ``smooth_sphere``s at x = -1.1 and 1.1: the camera 7 units in
+    front, a 50 mm lens, a black world; the caller adds the lights."""
+    scene = _scene(width, height)
+    aim(scene.camera, (0.0, -7.0, 1.5))
+    scene.camera.data.lens = 50.0
+    black_world(scene)
+    return scene
+
+
 def smooth_sphere(name, x, material) -> None:
     """A smooth-shaded unit UV sphere at (x, 0, 0) with ``material``."""
     add_primitive(bpy.ops.mesh.primitive_uv_sphere_add, material, name, radius=1.0, location=(x, 0.0, 0.0),
