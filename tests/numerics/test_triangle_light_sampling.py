@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drt_engine.core.lights.triangles import emitters, pdf_emissive_batch
+from drt_engine.core.lights.emitter_tree import emitter_tree
+from drt_engine.core.lights.triangles import pdf_emissive_batch
 from tests.core.test_spherical_triangle import omega_at, samples, tables
 
 BASE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.2, 0.9, 0.0]])
@@ -38,25 +39,25 @@ def test_samples_are_finite_on_the_triangle_with_pdf_emissives_density(name):
     with np.errstate(divide="ignore", invalid="ignore"):
         e = np.cross(verts[1] - verts[0], verts[2] - verts[0])
         n = e / np.linalg.norm(e) if np.linalg.norm(e) > 0 else np.array([0.0, 0.0, 1.0])
-    t = emitters(np.zeros(1, np.int64), verts[None], n[None], np.array([0.5 * np.linalg.norm(e)]), np.ones((1, 3)),
-                 np.array([1.0]))
+    tree, _, rank = emitter_tree(verts[None], np.array([1.0]))
+    t = (verts, np.array([[0, 1, 2]], np.int64), n[None], np.array([0.5 * np.linalg.norm(e)]), tree, rank)
     u = np.concatenate([EDGES, np.random.default_rng(6).random((400, 2))])
-    s = samples(t, p, u)
+    s = samples(*t, p, u)
     assert np.isfinite(s).all(), name
-    assert np.isfinite(omega_at(t, p))
+    assert np.isfinite(omega_at(t[0], t[1], t[2], p))
     b = np.column_stack([s[:, 5], s[:, 6], 1.0 - s[:, 5] - s[:, 6]])
     assert (b >= -1e-12).all() and (b <= 1 + 1e-12).all()
     scale = np.abs(verts - p).max()
     on = b @ verts
     assert np.allclose(on, p + s[:, :3] * s[:, 3:4], atol=1e-9 * scale)
-    pdf = pdf_emissive_batch(t, np.zeros(len(s), np.int64), np.tile(p, (len(s), 1)), s[:, :3], s[:, 3])
+    pdf = pdf_emissive_batch(*t, np.zeros(len(s), np.int64), np.tile(p, (len(s), 1)), s[:, :3], s[:, 3])
     assert np.allclose(pdf, s[:, 4], rtol=1e-12, atol=0)
     lit = s[:, 7] > 0
     assert (s[lit, 4] > 0).all()
 
 
 def test_the_cases_use_both_samplers():
-    used = {name: omega_at(tables(np.asarray(v, float)), np.array(p)) > 0 for name, (v, p) in CASES.items()
+    used = {name: omega_at(*tables(np.asarray(v, float))[:3], np.array(p)) > 0 for name, (v, p) in CASES.items()
 }
     assert used["above"] and used["huge (1e6)"] and used["far from the origin (1e7)"] and used["tiny (1e-8) and near"]
     assert not used["in the plane, outside"] and not used["tiny (1e-8) and far"]

@@ -31,7 +31,6 @@ from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMP
                      SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
-from .records import LobeSample
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
 from .sheen import sheen_eval, sheen_sample
 from .tables import lobe_albedo, lobe_scale, locate, ms_factor
@@ -240,14 +239,17 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     (about the diffuse lobes' normal (dx, dy, dz)); (sx, sy, sz, model) the smooth normal as
     ``eval_lobes`` takes it.
 
-    Returns a core.bsdf.records.LobeSample. For non-delta lobes its weight and pdf are those of the
-    whole mixture of the choice (one-sample MIS over lobes), as multiple importance sampling with
-    light sampling requires.
+    Returns (wi, weight = f |cos| / pdf RGB, pdf (0 for delta), delta, valid, pass-through:
+    the transparent lobe was taken, diffuse: a diffuse lobe was, crosses: wi leaves through the
+    surface (below the shading normal, but for a reflection about a lobe's own normal), the hair lobe
+    sampled (-1: none) and its own f |cos| RGB in the mixture's, which the light passes file by its
+    closure, transmits: Cycles' label of the sample, a transmission (``crosses``, but a hair lobe's
+    by its sample's lobe)). For non-delta lobes the weight and pdf are those of the whole mixture of the choice
+    (one-sample MIS over lobes), as multiple importance sampling with light sampling requires.
     """
     n = sel.shape[1]
     if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
-        return LobeSample(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False, -1, 0.0, 0.0, 0.0,
-                          False)
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False, -1, 0.0, 0.0, 0.0, False
     count = 0
     acc = 0.0
     for k in range(n):
@@ -331,5 +333,5 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     w0 = w0 if np.isfinite(w0) else 0.0
     w1 = w1 if np.isfinite(w1) else 0.0
     w2 = w2 if np.isfinite(w2) else 0.0
-    return LobeSample(wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses,
-                      own, o0, o1, o2, transmits)
+    return wix, wiy, wiz, w0, w1, w2, pdf, delta, valid, kind == TRANSPARENT, diffuse_kind(kind), crosses, own, \
+        o0, o1, o2, transmits

@@ -34,9 +34,9 @@ def sample_rows(lp, lt, hp, prow, mu, wo, u_select, u2, inside, wi, weight, pdf,
         selection(lp, lt, hp, prow[i], mu, wo[i, 2], sel, 0, 0)
         v = sample_lobes(lp, lt, hp, prow[i], mu, wo[i, 0], wo[i, 1], wo[i, 2], u_select[i], u2[i, 0], u2[i, 1],
                          inside[i], sel, 0, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
-        wi[i, 0], wi[i, 1], wi[i, 2] = v.x, v.y, v.z
-        weight[i, 0], weight[i, 1], weight[i, 2] = v.w0, v.w1, v.w2
-        pdf[i], delta[i], valid[i], passthrough[i] = v.pdf, v.delta, v.valid, v.passthrough
+        wi[i, 0], wi[i, 1], wi[i, 2] = v[0], v[1], v[2]
+        weight[i, 0], weight[i, 1], weight[i, 2] = v[3], v[4], v[5]
+        pdf[i], delta[i], valid[i], passthrough[i] = v[6], v[7], v[8], v[9]
 
 
 @kernel

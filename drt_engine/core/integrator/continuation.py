@@ -53,52 +53,54 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
                          inside[j], sel, 0, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
-        t0, t1, t2 = throughput[j, 0] * s.w0, throughput[j, 1] * s.w1, throughput[j, 2] * s.w2
+        t0, t1, t2 = throughput[j, 0] * s[3], throughput[j, 1] * s[4], throughput[j, 2] * s[5]
         peak = np.maximum(np.maximum(t0, t1), t2)
         go[j] = False
-        if not (s.valid and peak > 0):
+        if not (s[8] and peak > 0):
             continue
-        x, y, z = s.x, s.y, s.z
+        x, y, z = s[0], s[1], s[2]
         wx = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
         wy = x * frame[j, 0, 1] + y * frame[j, 1, 1] + z * frame[j, 2, 1]
         wz = x * frame[j, 0, 2] + y * frame[j, 1, 2] + z * frame[j, 2, 2]
         # a sampled direction on the wrong side of the geometric surface would leak light
-        crosses = s.crosses
+        crosses = s[11]
         if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0) != crosses:
             continue
         chance[j] = 1.0
         if min_bounces[0] >= 0 and len(bounces):
-            p = roulette(bounces, j, s.passthrough, peak, min_bounces)
+            p = roulette(bounces, j, s[9], peak, min_bounces)
             chance[j] = p if u_roulette[j] < p else 0.0
         go[j] = True
         origin[j, 0], origin[j, 1], origin[j, 2] = spawn_point(pos[j, 0], pos[j, 1], pos[j, 2], ng[j, 0], ng[j, 1],
                                                                ng[j, 2], wx, wy, wz, scale[j])
         wi[j, 0], wi[j, 1], wi[j, 2] = wx, wy, wz
         weight[j, 0], weight[j, 1], weight[j, 2] = t0, t1, t2
-        prev_pdf[j] = np.inf if s.delta else s.pdf
-        passthrough[j], transmit[j], diffuse[j] = s.passthrough, crosses, s.diffuse
-        if len(first) and first[j] and not s.passthrough:
-            pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, s, side_of(z, crosses, s.diffuse, dn[j, 0], dn[j, 1]),
-                        inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], shares)
+        prev_pdf[j] = np.inf if s[7] else s[6]
+        passthrough[j], transmit[j], diffuse[j] = s[9], crosses, s[10]
+        if len(first) and first[j] and not s[9]:
+            pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, x, y, z, crosses, s[7], side_of(z, crosses, s[10], dn[j, 0],
+                        dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], s[12], s[13],
+                        s[14], s[15], shares)
         if len(bounces):
             next_bounces[j] = bounces[j]
-            if s.passthrough:
+            if s[9]:
                 next_bounces[j, TRANSPARENT_DEPTH] += 1
-            elif s.diffuse:
+            elif s[10]:
                 next_bounces[j, KIND] = (TRANSMIT if crosses else REFLECT) | DIFFUSE
                 next_bounces[j, DEPTH] += 1
                 next_bounces[j, TRANSMISSION_DEPTH if crosses else DIFFUSE_DEPTH] += 1
-            else:  # a hair lobe's by its sample's label (s.transmits), not by the side it leaves by
-                next_bounces[j, KIND] = (TRANSMIT if s.transmits else REFLECT) | GLOSSY | (SINGULAR if s.delta else 0)
+            else:  # a hair lobe's by its sample's label (s[16]), not by the side it leaves by
+                next_bounces[j, KIND] = (TRANSMIT if s[16] else REFLECT) | GLOSSY | (SINGULAR if s[7] else 0)
                 next_bounces[j, DEPTH] += 1
-                next_bounces[j, TRANSMISSION_DEPTH if s.transmits else GLOSSY_DEPTH] += 1
+                next_bounces[j, TRANSMISSION_DEPTH if s[16] else GLOSSY_DEPTH] += 1
 
 
 @kernel(inline="always")
-def pass_shares(lp, lt, hp, r, mu, wo_l, j, s, above, inside, sel, bits, sx, sy, sz, model, dx, dy, dz, shares):
-    """``shares[j]``: the diffuse, glossy and transmission weights of a path continued as the
-    core.bsdf.records.LobeSample ``s`` (on the side ``above`` as the sampling weighed it,
-    core.bsdf.mixture.side_of; the diffuse lobes' normal (dx, dy, dz)).
+def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, bits, sx, sy, sz, model, dx, dy,
+                dz, own, o0, o1, o2, shares):
+    """``shares[j]``: the diffuse, glossy and transmission weights of a path continued toward local
+    (x, y, z) (on the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the
+    diffuse lobes' normal (dx, dy, dz)).
     Rows 0-2, for what the path brings from further on (Indirect): the shares of the whole mixture's
     BSDF there, the diffuse lobes no ray continues through (no diffuse bounce left) included, as
     Cycles' bsdf_eval of a sampled direction sums every closure (closure MIS). Rows 3-5, for the
@@ -106,16 +108,15 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, s, above, inside, sel, bits, sx, sy,
     weighs against light sampling (the other diffuse lobes' direct light is light sampling's alone,
     core.integrator.direct): Cycles' Direct passes hold each kind's own direct light. Each share is
     its own parts' evaluation, exactly 0 for a kind the BSDF has none of there (not what the others
-    leave of 1: that rounding would fill a pass nothing lights). A sampled hair lobe (``s.own``)
-    counts with its sample's own value, as the path's weight does (core.bsdf.mixture.sample_lobes),
-    filed by its closure."""
-    x, y, z, own, o0, o1, o2 = s.x, s.y, s.z, s.own, s.o0, s.o1, s.o2
+    leave of 1: that rounding would fill a pass nothing lights). A sampled hair lobe ``own`` (-1:
+    none) counts with its sample's own value (o0, o1, o2), as the path's weight does
+    (core.bsdf.mixture.sample_lobes), filed by its closure."""
     for i in range(6):
         for c in range(3):
             shares[j, i, c] = 0.0
-    if s.delta:  # a mirror or glass's sharp reflection is glossy, its refraction transmission
+    if delta:  # a mirror or glass's sharp reflection is glossy, its refraction transmission
         for c in range(3):
-            shares[j, 2 if s.crosses else 1, c] = shares[j, 5 if s.crosses else 4, c] = 1.0
+            shares[j, 2 if crosses else 1, c] = shares[j, 5 if crosses else 4, c] = 1.0
         return
     # np.int64(0), not the literal 0: a literal argument would compile eval_parts a second time
     f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,

@@ -33,13 +33,14 @@ from ..shading.lightpath import BACKGROUND_LENGTH, KIND, RayPath, reads_light_pa
 from ..shading.surface import SurfaceAttributes, SurfaceContext
 from . import programs
 from .choice import pick_probability
+from .emitter_tree import emitter_tree
 from .environment import Environment
 from .kinds import closed_form, hit_light, light_pdf, sample_light, sun_seen, unoccluded
 from .linking import lights as links
 from .strategies import (MAP_WORLD, NO_MIS, NO_SHADOW, NO_WORLD, UNIFORM_WORLD, UNRESTRICTED, LightSamples,
                          sample_strategies)
 from .table import light_row, light_table
-from .triangles import emitters, pdf_emissive_batch
+from .triangles import pdf_emissive_batch
 from .world import lights_shown_batch, pdf_world_batch, world_shown_batch
 
 
@@ -206,9 +207,10 @@ class Lights:
         return le
 
     def _emitters(self, geometry, scene: SceneData) -> None:
-        """The emissive triangles as one light strategy, ``emitters`` (lights.triangles.Emitters:
-        their global ids, world corners, normals, areas and emission at mid-shutter, and the tree
-        that picks one per shading point by power over distance). Triangles
+        """The emissive triangles as one light strategy: ``emissive`` (their global ids, ascending),
+        each picked per shading point down ``emitter_tree`` (lights.emitter_tree's tree, order,
+        rank), with its world corners, normal, area and emission at mid-shutter in ``emitters``
+        (the kernels' order). Triangles
         of objects no BSDF ray sees light nothing, and are left out (Cycles' usable_as_light)."""
         tris = geometry.triangles_with(np.flatnonzero(self.glows))
         lighting = np.array([i.visible_diffuse or i.visible_glossy or i.visible_transmission for i in scene.instances],
@@ -222,8 +224,11 @@ class Lights:
             estimate[mats == m] = self._textured_estimate(tris[mats == m], corners[mats == m], ng[mats == m])
         power = estimate @ LUMINANCE * area
         keep = np.flatnonzero(power > 0)
-        self.emitters = emitters(tris[keep], corners[keep], ng[keep], area[keep], self.emission[mats[keep]],
-                                 power[keep])
+        self.emissive = tris[keep]
+        self.emitter_tree = emitter_tree(corners[keep], power[keep])
+        self.emitters = (np.ascontiguousarray(corners[keep].reshape(-1, 3)),
+                         np.arange(3 * len(keep), dtype=np.int64).reshape(-1, 3), np.ascontiguousarray(ng[keep]),
+                         area[keep], np.ascontiguousarray(self.emission[mats[keep]]))
 
     def _excludes(self, scene: SceneData, geometry) -> None:
         """What each light's and each emissive triangle's samples leave out (``LightSamples.exclude``
@@ -308,11 +313,6 @@ class Lights:
     def moving(self) -> bool:
         return bool(self.motions)
 
-    @property
-    def emissive(self) -> np.ndarray:
-        """The emissive triangles' global ids, ascending (``emitters.ids``)."""
-        return self.emitters.ids
-
     # -- emission that varies over a surface ----------------------------------------
     _ESTIMATE_POINTS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1 / 3, 1 / 3, 1 / 3]], float)
 
@@ -390,8 +390,11 @@ class Lights:
         bary, lit = np.zeros((n, 3)), np.zeros((strategies, n), np.bool_)
         g = self.geometry
         world = NO_WORLD if self.world is None else UNIFORM_WORLD if self.environment is None else MAP_WORLD
-        sample_strategies(self.table, self.light_slots, self.selecting, self.emitters, g.tables, world,
-                          self._world_radiance, self._map_share, self._map, pos, normal, u, out.wi, out.dist,
+        vertices, triangles, ng, area, emission = self.emitters
+        tree, order, _ = self.emitter_tree
+        sample_strategies(self.table, self.light_slots, self.selecting, vertices, triangles, ng, area, self.emissive,
+                          tree, order, emission, g.tables,
+                          world, self._world_radiance, self._map_share, *self._map, pos, normal, u, out.wi, out.dist,
                           out.value, out.pdf, out.cycles_pdf, out.stop, pick, chosen, bary, lit)
         if time is not None and self.motions:
             self._moving_samples(out, pick, chosen, pos, u, time)
@@ -572,7 +575,9 @@ class Lights:
         found = np.flatnonzero(e < len(self.emissive))
         found = found[self.emissive[e[found]] == prim[found]]
         if len(found):
-            out[found] = pdf_emissive_batch(self.emitters, e[found],
+            vertices, triangles, ng, area, _ = self.emitters
+            tree, _, rank = self.emitter_tree
+            out[found] = pdf_emissive_batch(vertices, triangles, ng, area, tree, rank, e[found],
                                             np.ascontiguousarray(origins[found], np.float64), dirs[found],
                                             np.asarray(t, np.float64)[found])
         return out

@@ -30,20 +30,25 @@ def emitter_tree(corners: np.ndarray, power: np.ndarray):
     n = len(power)
     size = 1 << max(n - 1, 0).bit_length()
     order = np.argsort(_morton(corners.mean(axis=1)), kind="stable") if n > 1 else np.arange(n)
-    low, high = np.full((2 * size, 3), np.inf), np.full((2 * size, 3), -np.inf)  # empty: merge as nothing
+    low, high = np.zeros((2 * size, 3)), np.zeros((2 * size, 3))
     tree = np.zeros((2 * size, 5))
     leaves = slice(size, size + n)
     low[leaves], high[leaves] = corners[order].min(axis=1), corners[order].max(axis=1)
     tree[leaves, POWER] = power[order]
+    empty = np.ones(2 * size, bool)
+    empty[leaves] = False
     level = size
     while level > 1:  # each parent from its two children, a level at a time
         parents = np.arange(level // 2, level)
-        low[parents] = np.minimum(low[2 * parents], low[2 * parents + 1])
-        high[parents] = np.maximum(high[2 * parents], high[2 * parents + 1])
-        tree[parents, POWER] = tree[2 * parents, POWER] + tree[2 * parents + 1, POWER]
+        left, right = 2 * parents, 2 * parents + 1
+        both = ~empty[left] & ~empty[right]
+        low[parents] = np.where(both[:, None], np.minimum(low[left], low[right]), np.where(empty[left, None],
+                                                                                            low[right], low[left]))
+        high[parents] = np.where(both[:, None], np.maximum(high[left], high[right]), np.where(empty[left, None],
+                                                                                               high[right], high[left]))
+        tree[parents, POWER] = tree[left, POWER] + tree[right, POWER]
+        empty[parents] = empty[left] & empty[right]
         level //= 2
-    empty = np.isinf(low[:, 0])  # row 0 and the nodes over no triangle: no power, never taken
-    low[empty], high[empty] = 0.0, 0.0
     tree[:, :3] = 0.5 * (low + high)
     tree[:, RADIUS2] = (0.25 * (high - low) ** 2).sum(axis=1)
     rank = np.empty(n, np.int64)

@@ -91,14 +91,16 @@ class LightSamples:
 
 
 @kernel
-def sample_strategies(table, slots, selecting, em, geo, world, radiance, share, world_map, pos, normal, u, wi, dist,
+def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area, emissive, tree, order, emission,
+                      geo, world, radiance, share, row_cdf, col_cdf, cell, cell_area, sun, pos, normal, u, wi, dist,
                       value, pdf, cycles_pdf, stop, pick, chosen, bary, lit):
     """Strategies in order: ``slots`` table lights (light k, or with ``selecting`` one picked per
     hit by contribution, its value and pdf the slot's: divided and multiplied by ``chosen``, the
-    expected picks of it), emissive triangles when there are (``em``, lights.triangles.Emitters:
-    each picked down its tree), the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``,
-    MAP_WORLD: directions from ``world_map``, the environment's (row_cdf, col_cdf, cell, cell_area,
-    sun), with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
+    expected picks of it), emissive triangles when there are (``emissive``: their global ids,
+    each picked down lights.emitter_tree's ``tree``, whose leaves are ``order``; ``vertices`` to
+    ``emission`` are per emissive triangle),
+    the world (``world``: NO_WORLD, UNIFORM_WORLD of ``radiance``, MAP_WORLD: directions from the
+    map (and its sun cone, ``sun``) with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
     the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
     light or triangle sampled, ``bary`` the triangle's barycentrics, ``lit`` where the caller's
     value applies (a triangle's front seen, a map direction above the normal)."""
@@ -117,20 +119,19 @@ def sample_strategies(table, slots, selecting, em, geo, world, radiance, share, 
             cycles_pdf[k, j] = p
             pick[k, j], chosen[k, j] = i, c
         k = slots
-        if len(em.ids):
-            leaf, c = pick_emitter(em.tree, px, py, pz, u[j, k, 1, 0])
-            i = em.order[leaf]
-            wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(em.vertices, em.triangles, em.ng, em.area, c, i, px, py,
-                                                              pz, u[j, k, 0, 0], u[j, k, 0, 1])
+        if len(emissive):
+            leaf, c = pick_emitter(tree, px, py, pz, u[j, k, 1, 0])
+            i = order[leaf]
+            wx, wy, wz, d, p, b0, b1, cos_l = sample_triangle(vertices, triangles, tri_ng, area, c, i, px, py, pz,
+                                                              u[j, k, 0, 0], u[j, k, 0, 1])
             wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, d, p
             cycles_pdf[k, j] = p
-            pick[k, j], lit[k, j] = em.ids[i], cos_l > 0
+            pick[k, j], lit[k, j] = emissive[i], cos_l > 0
             bary[j, 0], bary[j, 1], bary[j, 2] = b0, b1, 1.0 - b0 - b1
             if cos_l > 0:
                 s = 1.0 / max(p, TINY)
-                e = em.emission
-                value[k, j, 0], value[k, j, 1], value[k, j, 2] = e[i, 0] * s, e[i, 1] * s, e[i, 2] * s
-            stop[k, j] = offset_scale(geo, em.ids[i], px + wx * d, py + wy * d, pz + wz * d)
+                value[k, j, 0], value[k, j, 1], value[k, j, 2] = emission[i, 0] * s, emission[i, 1] * s, emission[i, 2] * s
+            stop[k, j] = offset_scale(geo, emissive[i], px + wx * d, py + wy * d, pz + wz * d)
             k += 1
         if world == NO_WORLD:
             continue
@@ -143,7 +144,6 @@ def sample_strategies(table, slots, selecting, em, geo, world, radiance, share, 
                 s = 1.0 / max(p, TINY)
                 value[k, j, 0], value[k, j, 1], value[k, j, 2] = radiance[0] * s, radiance[1] * s, radiance[2] * s
         else:
-            row_cdf, col_cdf, cell, cell_area, sun = world_map
             wx, wy, wz, p = sample_world_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1], share, row_cdf, col_cdf,
                                                    cell, cell_area, sun)
             lit[k, j] = nx * wx + ny * wy + nz * wz > 0 and p > 0

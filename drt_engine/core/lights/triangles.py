@@ -11,44 +11,14 @@ of triangles) per point.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 
 from ..base.constants import TINY
 from ..base.jit import kernel
-from .emitter_tree import emitter_tree, leaf_chance
+from .emitter_tree import leaf_chance
 from .solid_angle import polygon4
 from .spherical_triangle import barycentrics_along, sample_direction, subtended
-
-
-class Emitters(NamedTuple):
-    """The emissive triangles as the kernels take them, one record (built by ``emitters``)."""
-    ids: np.ndarray
-    """(n,) their global triangle ids, ascending: the strategy's picks."""
-    vertices: np.ndarray
-    """(3 n, 3) their world corners at mid-shutter, triangle i's at rows ``triangles[i]``."""
-    triangles: np.ndarray
-    ng: np.ndarray
-    """(n, 3) unit geometric normals."""
-    area: np.ndarray
-    emission: np.ndarray
-    """(n, 3) constant emission (a textured one's is the shader program's, applied after)."""
-    tree: np.ndarray
-    """lights.emitter_tree's tree over them; leaf k is triangle ``order[k]``, triangle i leaf ``rank[i]``."""
-    order: np.ndarray
-    rank: np.ndarray
-
-
-def emitters(ids: np.ndarray, corners: np.ndarray, ng: np.ndarray, area: np.ndarray, emission: np.ndarray,
-             power: np.ndarray) -> Emitters:
-    """The record of emissive triangles ``ids`` with world ``corners`` (n, 3, 3) and ``power`` (> 0)."""
-    n = len(ids)
-    tree, order, rank = emitter_tree(corners, power)
-    return Emitters(np.asarray(ids, np.int64), np.ascontiguousarray(corners.reshape(-1, 3), np.float64),
-                    np.arange(3 * n, dtype=np.int64).reshape(-1, 3), np.ascontiguousarray(ng, np.float64),
-                    np.ascontiguousarray(area, np.float64), np.ascontiguousarray(emission, np.float64), tree, order,
-                    rank)
 
 
 # -- sampling --------------------------------------------------------------------------------------
@@ -83,22 +53,22 @@ def sample_triangle(vertices, triangles, ng, area, chance, i, px, py, pz, u0, u1
 
 
 @kernel
-def pdf_emissive_batch(em, prim, origins, dirs, t):
-    """The emissive strategy's pdf of directions ``dirs`` from ``origins`` that reach the triangles
-    ``prim`` of ``em`` (Emitters; indices among them) at distances ``t``: ``sample_triangle``'s with
-    the chance lights.emitter_tree's walk takes the triangle there."""
+def pdf_emissive_batch(vertices, triangles, ng, area, tree, rank, prim, origins, dirs, t):
+    """The emissive strategy's pdf of directions ``dirs`` from ``origins`` that reach emissive
+    triangles ``prim`` (their indices among the emitters) at distances ``t``: ``sample_triangle``'s
+    with the chance lights.emitter_tree's walk takes the triangle (its leaf ``rank``) there."""
     out = np.empty(len(prim))
-    vertices, tris, ng = em.vertices, em.triangles, em.ng
     for j in range(len(prim)):
         i = prim[j]
         ox, oy, oz = origins[j, 0], origins[j, 1], origins[j, 2]
-        c = leaf_chance(em.tree, em.rank[i], ox, oy, oz)
-        omega = subtended(vertices, tris[i, 0], tris[i, 1], tris[i, 2], ng[i, 0], ng[i, 1], ng[i, 2], ox, oy, oz)
+        c = leaf_chance(tree, rank[i], ox, oy, oz)
+        omega = subtended(vertices, triangles[i, 0], triangles[i, 1], triangles[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
+                          ox, oy, oz)
         if omega > 0:
             out[j] = c / omega
         else:
             cos_l = max(abs(dirs[j, 0] * ng[i, 0] + dirs[j, 1] * ng[i, 1] + dirs[j, 2] * ng[i, 2]), TINY)
-            out[j] = c / em.area[i] * t[j] * t[j] / cos_l
+            out[j] = c / area[i] * t[j] * t[j] / cos_l
     return out
 
 
