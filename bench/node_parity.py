@@ -3,8 +3,9 @@
 Renders the scenes tests/blender/test_node_parity.py holds DRT to (the grid of node cases, the
 spheres of the nodes that see the view, the closures' squares, and the scenes compared whole:
 Pointiness, attributes, Object Info, Light Path, Light Falloff, Wireframe, displacement, IES, the
-mirror-ball environment, Principled Hair's Huang model under an area and a point light, each sky model this Blender offers, the Ambient Occlusion and Bevel nodes' cases) with DRT (seed 0) and Cycles (seeds
-0 and 1), writes docs/node_parity.json, and replaces the page's block between the markers below
+mirror-ball environment, Principled Hair's Huang model under an area and a point light, each sky
+model this Blender offers, the Ambient Occlusion and Bevel nodes' cases) with DRT (seed 0) and
+Cycles (seeds 0 and 1), writes docs/node_parity.json, and replaces the page's block between the markers below
 with each case's worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
 A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
 Run from the repository root: .venv/bin/python bench/node_parity.py (``make node-parity``).
