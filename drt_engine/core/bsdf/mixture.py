@@ -83,6 +83,26 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 
 
 @kernel(inline="always")
+def diffuse_selection(lp, lt, hp, r, mu, mu_o, sel, si):
+    """Fill ``sel[si]`` (a slot per lobe, as ``selection`` with any ``diffuse`` bits) with the
+    chance of sampling each diffuse-type lobe (passes.diffuse_kind) by its albedo's largest
+    channel, 0 for every other lobe; whether any has weight (core.integrator.world_lobes)."""
+    j, t = locate(mu, mu_o)
+    total = 0.0
+    for l in range(lp.shape[0]):
+        sel[si, l] = 0.0
+        if diffuse_kind(int(lp[l, P_KIND])):
+            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
+            sel[si, l] = max(max(a0, a1), a2)
+            total += sel[si, l]
+    if not total > 0.0:
+        return False
+    for l in range(lp.shape[0]):
+        sel[si, l] = sel[si, l] / total
+    return True
+
+
+@kernel(inline="always")
 def needs_wo_above(lp, l, woz):
     """Lobe l (not diffuse) gives nothing toward or from wo (z its cosine to the shading normal): a
     GGX reflection, glass or toon glossy lobe about the shading normal with wo not above it (a hair

@@ -17,12 +17,13 @@ from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DE
 from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
 from .bounces import diffuse_bits
 from .lightpasses import eval_parts, other_parts, share
+from .world_lobes import COSINE, world_density
 
 
 @kernel
 def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, inside, u_select, u2, throughput, pos, ng,
                    scale, bounces, diffuse_limit, u_roulette, min_bounces, go, origin, wi, weight, prev_pdf,
-                   passthrough, transmit, next_bounces, diffuse, first, shares, chance):
+                   passthrough, transmit, next_bounces, diffuse, first, shares, chance, world_pdf):
     """Per hit j: ``go[j]`` whether its path goes on; where it does, the next ray's ``origin`` and
     world direction ``wi``, the path's new throughput ``weight``, the density that sampled the
     direction (``prev_pdf``, inf for a delta lobe), whether the transparent lobe was taken, whether
@@ -39,6 +40,8 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     still goes and what it finds (lights, world, emission) counts at the undivided ``weight``;
     ``chance[j]`` is p for a path that survives (its hit divides the throughput by it before direct
     light and the next bounce), 0 for one that ends at that hit; 1 without roulette.
+    Where ``world_pdf`` has rows (a world that does not vary), ``world_pdf[j]`` the density its
+    light sample has toward the new direction (core.integrator.world_lobes).
     Where ``first[j]`` (empty: no light passes) and the path bounces (not through a transparent
     lobe), ``shares[j]`` its light passes' weights (core.integrator.lightpasses, ``pass_shares``): the
     diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
@@ -46,6 +49,7 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     Shader and hits as core.integrator.direct has them."""
     sel_nd = np.empty((1, max(n_sampled, 1)))
     sel_all = np.empty((1, max(lp.shape[0], 1)))
+    sel_world = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
         bits = diffuse_bits(bounces, j, diffuse_limit)
         sel = sel_nd if bits == 0 else sel_all
@@ -77,6 +81,11 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
         weight[j, 0], weight[j, 1], weight[j, 2] = t0, t1, t2
         prev_pdf[j] = np.inf if s[7] else s[6]
         passthrough[j], transmit[j], diffuse[j] = s[9], crosses, s[10]
+        if len(world_pdf):
+            world_pdf[j] = COSINE if s[7] else world_density(
+                lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z,
+                side_of(z, crosses, s[10], dn[j, 0], dn[j, 1]), inside[j], sel_world, sx, sy, sz, model, dn[j, 0],
+                dn[j, 1], dn[j, 2])
         if len(first) and first[j] and not s[9]:
             pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, x, y, z, crosses, s[7], side_of(z, crosses, s[10], dn[j, 0],
                         dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], s[12], s[13],

@@ -57,6 +57,7 @@ from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
 from .shadow_catcher import Catchers, CatcherWave
 from .shadows import TransparentShadows, limits, new_queue, stopped
+from .world_lobes import COSINE, world_from_lobes
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _NO_BOUNCES = camera_bounces(0)  # the kernels' bounces when paths carry none
@@ -321,7 +322,7 @@ class Integrator:
                 if light is not None and shader.lobes:
                     # no ray leaves the last depth: its light is light sampling's alone
                     queue = self._direct(shader, group, hits, light.take(slice(start, start + len(group))), out,
-                                         depth < s.max_depth)
+                                         depth < s.max_depth, u_g.light)
                     if queue is not None:
                         queued.append(queue)
                     start += len(group)
@@ -360,7 +361,8 @@ class Integrator:
                           bounces=camera_bounces(n) if self.carried else None,
                           mis_origin=cam.origins if self.shadows is not None else None,
                           min_pdf=np.full(n, np.inf) if self.min_pdf else None,
-                          receiver=np.zeros(n, np.int64) if self.lights.linking else None)
+                          receiver=np.zeros(n, np.int64) if self.lights.linking else None,
+                          world_pdf=np.full(n, COSINE) if self.lights.uniform_world else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray:
@@ -427,7 +429,7 @@ class Integrator:
             rays, world = rays.take(keep), world[keep]
         if len(rays) and lights.world_seen:
             sampled = None if lights.world is None else (  # a world light sampling can find
-                lambda smooth: lights.pdf_world(rays.prev_shading[smooth], rays.dirs[smooth]))
+                lambda smooth: self._world_pdf(rays, smooth))
             e = add_emitted(out, rays.path, rays.throughput, world, rays.prev_pdf, sampled,
                             self._limits(rays.straight), self._group(lambda: np.full(len(rays), lights.world_group)))
             if out.split is not None:
@@ -442,6 +444,15 @@ class Integrator:
                                 None if group is None else self._group(lambda: np.full(len(bounced), group)))
                 if out.split is not None:
                     out.split.add_found(bounced.path, e)
+
+    def _world_pdf(self, rays: PathState, rows) -> np.ndarray:
+        """The density light sampling has for the world along ``rays[rows]``: lights.world's, or,
+        for a uniform world, the one the surface the ray left recorded (core.integrator.world_lobes)."""
+        cosine = self.lights.pdf_world(rays.prev_shading[rows], rays.dirs[rows])
+        if rays.world_pdf is None:
+            return cosine
+        recorded = rays.world_pdf[rows]
+        return np.where(recorded == COSINE, cosine, recorded)
 
     def _world_seen(self, rays: PathState) -> np.ndarray:
         """The world's radiance along ``rays`` as they see it (its ray visibility)."""
@@ -590,7 +601,9 @@ class Integrator:
             dims = np.full((lights.strategies, 2), -1, np.int64)
             for k in range(lights.strategies):
                 dims[k, 0] = self.light_dims.point(depth, k)
-                if k == emissive or (lights.selecting and k < lights.light_slots):
+                # a uniform world (the last strategy) picks the lobe it is drawn from
+                if k == emissive or (lights.selecting and k < lights.light_slots) or \
+                        (k == lights.strategies - 1 and lights.uniform_world):
                     dims[k, 1] = self.light_dims.choice(depth, k)
             whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats listing them
             sampler.pairs(pixel, sample, dims, None if whole else lit, light.reshape(n, -1, 2))
@@ -681,10 +694,13 @@ class Integrator:
             out.group = self.groups.column(out.group)
         return out
 
-    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, continues: bool):
+    def _direct(self, shader, group: SurfaceHits, hits, light: LightSamples, wave: WaveOutput, continues: bool,
+                u_light: np.ndarray):
         """Direct light at the hits of one shader, every strategy's shadow ray traced in the
         kernel (core.integrator.direct), weighed against the rays these hits may continue
-        through (the diffuse lobes' within the diffuse bounces), where any ``continues``;
+        through (the diffuse lobes' within the diffuse bounces), where any ``continues``, a
+        uniform world's sample drawn from their diffuse-type lobes there (``u_light``, their light
+        sample values; core.integrator.world_lobes);
         what the wave's ratio estimator needs, when there is one, shown to it after
         (core.integrator.ratio). Returns the shadow rays stopped on see-through surfaces (None:
         none, core.integrator.shadows)."""
@@ -700,6 +716,11 @@ class Integrator:
         qf, qi = new_queue(n * light.strategies, shadows)
         clear = self.shadows.clear if shadows else _NOTHING_CLEAR
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
+        if continues and self.lights.uniform_world:  # in place: the ratio estimator reads them too
+            world_from_lobes(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, _c(group.frame.m),
+                             _smooth(group), _c(group.dn), _c(group.wo_l), _c(group.inside), _c(u_light),
+                             light.strategies - 1, np.asarray(self.lights.world, np.float64), light.wi, light.value,
+                             light.pdf)
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _smooth(group), _c(group.dn), _c(group.wo_l), _c(group.inside),
@@ -732,12 +753,13 @@ class Integrator:
         next_bounces = np.empty_like(bounces)
         first = np.zeros(0, bool) if split is None else split.bounces[hits.path] == 0
         shares = np.empty((n if split is not None else 0, 6, 3))
+        world_pdf = np.empty(n if state.world_pdf is not None else 0)
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m), _smooth(hits), _c(hits.dn),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
                        _c(hits.pos), _c(hits.ng), _c(hits.scale), bounces, self.diffuse, _c(u.roulette),
                        self.roulette, go, origin, wi, weight, prev_pdf, passthrough, transmit, next_bounces, diffuse,
-                       first, shares, chance)
+                       first, shares, chance, world_pdf)
         sel = np.flatnonzero(go)
         if len(sel) == 0:
             return None
@@ -752,10 +774,13 @@ class Integrator:
         self._count("reflection", (~transmit & ~diffuse).sum())
         self._count("transparent", passthrough.sum())
         prev_pdf, prev_normal, prev_shading, origin = prev_pdf[sel], hits.ng[sel], hits.ns[sel], origin[sel]
+        world_pdf = world_pdf[sel] if len(world_pdf) else None
         mis_origin = None
         if state.mis_origin is not None:  # transparent shadows: a pass-through keeps the MIS state
             kept, rows = passthrough[:, None], hits.row[sel]
             prev_pdf = np.where(passthrough, state.prev_pdf[rows], prev_pdf)
+            if world_pdf is not None:
+                world_pdf = np.where(passthrough, state.world_pdf[rows], world_pdf)
             prev_normal = np.where(kept, state.prev_normal[rows], prev_normal)
             prev_shading = np.where(kept, state.prev_shading[rows], prev_shading)
             mis_origin = np.where(kept, state.mis_origin[rows], origin)
@@ -771,7 +796,7 @@ class Integrator:
                          prev_shading=prev_shading, straight=hits.straight[sel] & passthrough, time=hits.time[sel],
                          bounces=None if hits.bounces is None else next_bounces[sel], mis_origin=mis_origin,
                          min_pdf=min_pdf, receiver=receiver,
-                         continuation=chance[sel] if self.roulette[0] >= 0 else None)
+                         continuation=chance[sel] if self.roulette[0] >= 0 else None, world_pdf=world_pdf)
 
 
 def _material_slices(mat):

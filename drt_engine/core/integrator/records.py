@@ -76,7 +76,9 @@ class PathState(Rows):
     mis_ray_object; 0 for camera rays, which see every emitter); ``continuation`` (with Russian
     roulette) what the ray's hit divides the throughput by before it lights and bounces, 0 where the
     path ends there after the ray saw what it found (Cycles' continuation_probability,
-    core.integrator.continuation)."""
+    core.integrator.continuation); ``world_pdf`` (under a world that does not vary) the density
+    its light sample has toward the ray from the surface it left, or world_lobes.COSINE where that
+    is the cosine about ``prev_shading`` (core.integrator.world_lobes)."""
 
     path: np.ndarray
     origins: np.ndarray
@@ -93,6 +95,7 @@ class PathState(Rows):
     min_pdf: np.ndarray | None = None
     receiver: np.ndarray | None = None
     continuation: np.ndarray | None = None
+    world_pdf: np.ndarray | None = None
 
     def mis_ray(self, rows, t):
         """(origins, distances) of rays ``rows`` whose hits lie ``t`` away, as the lights' pdfs

@@ -313,6 +313,12 @@ class Lights:
     def moving(self) -> bool:
         return bool(self.motions)
 
+    @property
+    def uniform_world(self) -> bool:
+        """The world lights the scene and does not vary: its strategy (the last) may be drawn from
+        the hits' lobes (core.integrator.world_lobes)."""
+        return self.world is not None and self.environment is None
+
     # -- emission that varies over a surface ----------------------------------------
     _ESTIMATE_POINTS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1 / 3, 1 / 3, 1 / 3]], float)
 

@@ -1,0 +1,61 @@
+"""A world that does not vary, light-sampled from the hit's diffuse-type lobes.
+
+Its radiance is one constant, so the density that leaves its light sample least noise is the
+BSDF's own. Where a hit has diffuse-type lobes (Lambert, Oren-Nayar, toon, sheen, translucent:
+without diffuse bounces no ray continues through them and their world light is light
+sampling's alone), the world's sample is drawn from their mixture by albedo rather than
+cosine-weighted about the normal: a sheen's light then has the variance of its own LTC sample,
+as Cycles' BSDF rays find it (Cycles leaves such a world out of light sampling). Where the hit
+has none, and at the last depth (where every lobe, glossy ones too, is lit by this sample
+alone), the cosine sample lights.strategies drew stays. A bounce records the same mixture's
+density toward the ray it sends (``world_density``): an escaping ray is weighed against it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..base.jit import kernel
+from ..bsdf.bump_shadowing import smooth_local
+from ..bsdf.layout import SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT
+from ..bsdf.mixture import diffuse_selection, eval_lobes, sample_lobes
+
+EVERY_SLOT = SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT
+"""The mixture's ``diffuse`` bits that give every lobe its own slot, which ``diffuse_selection`` fills."""
+
+COSINE = -1.0
+"""``world_density`` where the world's sample is lights.world's cosine about the shading normal."""
+
+
+@kernel
+def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k, radiance, wi, value, pdf):
+    """Strategy ``k`` (the uniform world of ``radiance``) of each hit drawn again from the hit's
+    diffuse-type lobes, where it has any with weight: direction ``wi``, ``value`` (radiance / pdf;
+    0 where the lobe drew no direction) and ``pdf``, strategy by hit as lights.strategies fills
+    them; ``u`` (N, S, 2, 2) the hits' light sample values (the point, [k, 0], draws the
+    direction, the choice, [k, 1, 0], the lobe). Shader and hits as core.integrator.direct has them."""
+    sel = np.empty((1, max(lp.shape[0], 1)))
+    for j in range(len(wo_l)):
+        if not diffuse_selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0):
+            continue
+        sx, sy, sz, model = smooth_local(smooth, frame, j)
+        s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u[j, k, 1, 0], u[j, k, 0, 0],
+                         u[j, k, 0, 1], inside[j], sel, 0, EVERY_SLOT, sx, sy, sz, model, dn[j, 0], dn[j, 1],
+                         dn[j, 2])
+        x, y, z = s[0], s[1], s[2]
+        wi[k, j, 0] = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
+        wi[k, j, 1] = x * frame[j, 0, 1] + y * frame[j, 1, 1] + z * frame[j, 2, 1]
+        wi[k, j, 2] = x * frame[j, 0, 2] + y * frame[j, 1, 2] + z * frame[j, 2, 2]
+        p = s[6] if s[8] else 0.0
+        pdf[k, j] = p
+        for c in range(3):
+            value[k, j, c] = radiance[c] / p if p > 0.0 else 0.0
+
+
+@kernel(inline="always")
+def world_density(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, sx, sy, sz, model, dx, dy, dz):
+    """The density ``world_from_lobes`` has toward local (x, y, z) at a hit (on the side ``above``,
+    core.bsdf.mixture.side_of), or COSINE where it leaves the world's cosine sample."""
+    if not diffuse_selection(lp, lt, hp, r, mu, woz, sel, 0):
+        return COSINE
+    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, 0, EVERY_SLOT, 0, sx, sy, sz,
+                      model, dx, dy, dz, -1)[6]
