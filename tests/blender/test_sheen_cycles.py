@@ -1,7 +1,8 @@
 """The Sheen BSDF against Cycles: two smooth spheres of Cycles' microfiber sheen (roughness 0.2 and
 0.8) under an area light behind them and a point light in front, the sheen's rim light at grazing
 views; and with diffuse bounces 2 over a grey floor (paths continue through the sheen, sampled
-through its transformed cosine).
+through its transformed cosine); and under a uniform white world with no light, where the world's
+light sample is drawn from the sheen (tests/support/sheen_scenes.py).
 
 Parity as procedural_scenes.parity: DRT's worst 4x4-block difference from Cycles (seed 0) at most
 1.5x Cycles' own between seeds 0 and 1, plus 0.002; the same scene with the Sheen BSDF left out
@@ -15,28 +16,12 @@ from __future__ import annotations
 import bpy
 
 from drt_engine.blender.export import materials as export_materials
+from drt_engine.core.lights.collection import Lights
 from tests.support import procedural_scenes as ps
 from tests.support import render_helpers as rh
+from tests.support.sheen_scenes import HEIGHT, WIDTH, sheen_scene
 
-WIDTH, HEIGHT = 64, 32
 SAMPLES = 256
-
-
-
-def sheen_scene(floor=False):
-    scene = ps.sphere_pair_stage(WIDTH, HEIGHT)
-    ps.add_light(scene, "Back", "AREA", 400.0, (0.5, 3.0, 2.5), size=2.0)
-    ps.add_light(scene, "Point", "POINT", 300.0, (-3.0, -2.5, 1.0))
-    for name, x, rough, colour in (("Fine sheen", -1.1, 0.2, (0.9, 0.7, 0.5, 1.0)),
-                                   ("Rough sheen", 1.1, 0.8, (0.5, 0.7, 0.9, 1.0))):
-        material, _ = ps.closure_material(name, "ShaderNodeBsdfSheen", Color=colour, Roughness=rough)
-        ps.smooth_sphere(name, x, material)
-    if floor:
-        material, _ = ps.closure_material("Floor", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1.0))
-        bpy.ops.mesh.primitive_plane_add(size=20.0, location=(0.0, 0.0, -1.0))
-        bpy.context.active_object.data.materials.append(material)
-    return scene
-
 
 
 def test_sheen_bsdf_matches_cycles(drt, tmp_path, monkeypatch):
@@ -54,6 +39,20 @@ def test_sheen_bsdf_with_diffuse_bounces_matches_cycles(drt, tmp_path):
     scene = sheen_scene(floor=True)
     scene.drt.diffuse_bounces = 2
     ps.assert_parity(scene, SAMPLES, tmp_path, "sheen-bounces")
+
+
+def test_sheen_bsdf_under_a_white_world_matches_cycles(drt, tmp_path, monkeypatch):
+    """Under a uniform world and no light, where Cycles finds the world by BSDF rays alone (it leaves
+    such a world out of light sampling): DRT draws the world's light sample from the sheen itself
+    (core.integrator.world_lobes); cosine-weighted about the normal, as before, its noise was nearly four
+    times Cycles' and failed the limit."""
+    scene = sheen_scene(white_world=True)
+    cycles0, cycles1 = ps.assert_parity(scene, SAMPLES, tmp_path, "sheen-white-world")
+    monkeypatch.setattr(Lights, "uniform_world", property(lambda self: False))
+    cosine = rh.render(scene, "DRT", SAMPLES, 0, tmp_path, name="cosine")
+    off = ps.parity(cosine.rgb, cycles0.rgb, cycles1.rgb)
+    print("cosine-weighted world sample", off)
+    assert not off["ok"], f"the cosine-weighted world sample passes too: {off}"
 
 
 def principled_sheen_scene():
