@@ -4,10 +4,10 @@ Renders the scenes tests/blender/test_node_parity.py holds DRT to (the grid of n
 spheres of the nodes that see the view, the closures' squares, and the scenes compared whole:
 Pointiness, attributes, Object Info, Light Path, Light Falloff, Wireframe, displacement, IES, the
 mirror-ball environment, Principled Hair's Huang model under an area and a point light, the Sheen
-BSDF under a white world, each sky model this Blender offers, the Ambient Occlusion and Bevel
-nodes' cases) with DRT (seed 0) and Cycles (seeds 0 and 1), writes docs/node_parity.json, and
-replaces the page's block between the markers below with each case's worst 4x4-block difference
-from Cycles beside Cycles' own between its two seeds.
+and Translucent BSDFs under a white world, each sky model this Blender offers, the Ambient
+Occlusion and Bevel nodes' cases) with DRT (seed 0) and Cycles (seeds 0 and 1), writes
+docs/node_parity.json, and replaces the page's block between the markers below with each case's
+worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
 A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
 Run from the repository root: .venv/bin/python bench/node_parity.py (``make node-parity``).
 
@@ -64,7 +64,8 @@ def _whole_scenes() -> dict:
               "Wireframe in pixels": (ns.wireframe_scene, (0, 0)),
               "Displacement socket as bump": (ns.displacement_scene, DISPLACEMENT_MATCHED_FROM),
               HUANG: (lambda: hair_scenes.hair_scene("HUANG"), PRINCIPLED_HAIR_MATCHED_FROM),
-              "Sheen BSDF under a white world": (lambda: sheen_scenes.sheen_scene(white_world=True), (0, 0))}
+              "Sheen BSDF under a white world": (lambda: sheen_scenes.sheen_scene(white_world=True), (0, 0)),
+              "Translucent BSDF under a white world": (ns.translucent_world_scene, (0, 0))}
     for label, name in ies_scenes.CASES.items():
         scenes[f"IES Texture, {label}"] = (lambda name=name: ies_scenes.lit_by(name), IES_MATCHED_FROM)
     scenes["Light Falloff in a light's node tree"] = (lambda: ies_scenes.lit_by(ies_scenes.FALLOFF), (0, 0))

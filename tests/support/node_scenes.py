@@ -1071,6 +1071,21 @@ def _diffuse_bsdf(tree, colour):
     return bsdf.outputs["BSDF"]
 
 
+def translucent_world_scene(size=32):
+    """The Translucent squares of ``CLOSURES`` (alone, and mixed with a Diffuse) under a uniform white
+    world and no light: lit through from behind by the world alone, which Cycles' BSDF rays find
+    and DRT's light sample drawn from the translucent lobe (core.integrator.world_lobes); the
+    squares side by side in one plane, so neither sees the other (a Translucent ray is a
+    transmission bounce in Cycles, which DRT does not trace)."""
+    scene = closure_scene([case for case in CLOSURES if case.name.startswith("Translucent")], size)
+    for name in ("Front", "Back"):
+        bpy.data.objects.remove(bpy.data.objects[name])
+    world = new_world("White")
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scene.world = world
+    return scene
+
+
 def _mixed_by_camera(tree, other, camera):
     """A Mix Shader of ``other`` and ``camera`` (two shader outputs) by Is Camera Ray."""
     mix = _node(tree, "ShaderNodeMixShader")
