@@ -716,11 +716,8 @@ class Integrator:
         qf, qi = new_queue(n * light.strategies, shadows)
         clear = self.shadows.clear if shadows else _NOTHING_CLEAR
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
-        if continues and self.lights.uniform_world:  # in place: the ratio estimator reads them too
-            world_from_lobes(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, _c(group.frame.m),
-                             _smooth(group), _c(group.dn), _c(group.wo_l), _c(group.inside), _c(u_light),
-                             light.strategies - 1, np.asarray(self.lights.world, np.float64), light.wi, light.value,
-                             light.pdf)
+        if continues and self.lights.uniform_world:
+            self._world_from_lobes(shader, group, light, u_light)
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
             _c(group.ng), _c(group.frame.m), _smooth(group), _c(group.dn), _c(group.wo_l), _c(group.inside),
@@ -738,6 +735,17 @@ class Integrator:
         if wave.ratio is not None:
             wave.ratio.direct(shader, group, light.value, f_diff, visibility, cuts)
         return stopped(qf, qi, m, group.bounces)
+
+    def _world_from_lobes(self, shader, group: SurfaceHits, light: LightSamples, u_light: np.ndarray) -> None:
+        """The uniform world's samples (the last strategy) of ``light`` drawn again from the hits'
+        diffuse-type lobes (core.integrator.world_lobes), in place: the ratio estimator reads them
+        too. The kernel takes contiguous copies, whatever views ``light`` holds (one specialization)."""
+        k = light.strategies - 1
+        wi, value, pdf = (np.ascontiguousarray(a[k]) for a in (light.wi, light.value, light.pdf))
+        world_from_lobes(shader.lp, shader.lt, shader.hp, shader.hit_rows(len(group)), shader.mu, _c(group.frame.m),
+                         _smooth(group), _c(group.dn), _c(group.wo_l), _c(group.inside), _c(u_light), k,
+                         np.asarray(self.lights.world, np.float64), wi, value, pdf)
+        light.wi[k], light.value[k], light.pdf[k] = wi, value, pdf
 
     # -- continuation through one lobe -------------------------------------------------
     def _continue(self, shader, hits: SurfaceHits, u: StepSamples, state: PathState,

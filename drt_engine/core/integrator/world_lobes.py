@@ -28,10 +28,10 @@ COSINE = -1.0
 
 @kernel
 def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k, radiance, wi, value, pdf):
-    """Strategy ``k`` (the uniform world of ``radiance``) of each hit drawn again from the hit's
-    diffuse-type lobes, where it has any with weight: direction ``wi``, ``value`` (radiance / pdf;
-    0 where the lobe drew no direction) and ``pdf``, strategy by hit as lights.strategies fills
-    them; ``u`` (N, S, 2, 2) the hits' light sample values (the point, [k, 0], draws the
+    """The uniform world's sample (of ``radiance``, strategy ``k``) of each hit drawn again from the
+    hit's diffuse-type lobes, where it has any with weight: per hit its direction ``wi``, ``value``
+    (radiance / pdf; 0 where the lobe drew no direction) and ``pdf``, as lights.strategies fills
+    strategy k's; ``u`` (N, S, 2, 2) the hits' light sample values (the point, [k, 0], draws the
     direction, the choice, [k, 1, 0], the lobe). Shader and hits as core.integrator.direct has them."""
     sel = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
@@ -42,13 +42,13 @@ def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k
                          u[j, k, 0, 1], inside[j], sel, 0, EVERY_SLOT, sx, sy, sz, model, dn[j, 0], dn[j, 1],
                          dn[j, 2])
         x, y, z = s[0], s[1], s[2]
-        wi[k, j, 0] = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
-        wi[k, j, 1] = x * frame[j, 0, 1] + y * frame[j, 1, 1] + z * frame[j, 2, 1]
-        wi[k, j, 2] = x * frame[j, 0, 2] + y * frame[j, 1, 2] + z * frame[j, 2, 2]
+        wi[j, 0] = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
+        wi[j, 1] = x * frame[j, 0, 1] + y * frame[j, 1, 1] + z * frame[j, 2, 1]
+        wi[j, 2] = x * frame[j, 0, 2] + y * frame[j, 1, 2] + z * frame[j, 2, 2]
         p = s[6] if s[8] else 0.0
-        pdf[k, j] = p
+        pdf[j] = p
         for c in range(3):
-            value[k, j, c] = radiance[c] / p if p > 0.0 else 0.0
+            value[j, c] = radiance[c] / p if p > 0.0 else 0.0
 
 
 @kernel(inline="always")
