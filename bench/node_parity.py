@@ -1,13 +1,14 @@
 """Measure DRT's shader nodes and closures against Cycles and write the figures into docs/shader-node-parity.md.
 
-Renders the scenes tests/blender/test_node_parity.py holds DRT to (the grid of node cases, the
-spheres of the nodes that see the view, the closures' squares, and the scenes compared whole:
+Renders the scenes the tests hold DRT to (tests/blender/test_node_parity.py's grid of node cases,
+spheres of the nodes that see the view and closures' squares, and the scenes compared whole:
 Pointiness, attributes, Object Info, Light Path, Light Falloff, Wireframe, displacement, IES, the
 mirror-ball environment, Principled Hair's Huang model under an area and a point light, the
-Principled Coat Normal, the Sheen and Translucent BSDFs under a white world, each sky model this
-Blender offers, the Ambient Occlusion and Bevel nodes' cases) with DRT (seed 0) and Cycles (seeds
-0 and 1), writes docs/node_parity.json, and replaces the page's block between the markers below
-with each case's worst 4x4-block difference from Cycles beside Cycles' own between its two seeds.
+Principled Coat Normal, anisotropic GGX, the Sheen and Translucent BSDFs under a white world, each
+sky model this Blender offers, the Ambient Occlusion and Bevel nodes' cases) with DRT (seed 0) and
+Cycles (seeds 0 and 1), writes docs/node_parity.json, and replaces the page's block between the
+markers below with each case's worst 4x4-block difference from Cycles beside Cycles' own between
+its two seeds.
 A case this Blender's Cycles computes otherwise (and DRT names in its warning) is listed as such.
 Run from the repository root: .venv/bin/python bench/node_parity.py (``make node-parity``).
 
@@ -33,7 +34,7 @@ from drt_engine.blender.export.materials import OREN_NAYAR_MATCHED_FROM, PRINCIP
 from drt_engine.blender.export.shader_graph import (DISPLACEMENT_MATCHED_FROM,  # noqa: E402
                                                    FALLOFF_WORLD_MATCHED_FROM, IES_MATCHED_FROM)
 from drt_engine.headless.cli import exit_now  # noqa: E402
-from tests.support import coat_scenes, hair_scenes, ies_scenes, sheen_scenes  # noqa: E402
+from tests.support import anisotropic_scenes, coat_scenes, hair_scenes, ies_scenes, sheen_scenes  # noqa: E402
 from tests.support import node_scenes as ns  # noqa: E402
 from tests.support import procedural_scenes as ps  # noqa: E402
 from tests.support import sky_scenes  # noqa: E402
@@ -67,7 +68,11 @@ def _whole_scenes() -> dict:
               "Sheen BSDF under a white world": (lambda: sheen_scenes.sheen_scene(white_world=True), (0, 0)),
               "Translucent BSDF under a white world": (ns.translucent_world_scene, (0, 0)),
               "Principled Coat Normal (a Bump's; a Normal Map's over a bumped base)": (coat_scenes.coat_normal_scene,
-                                                                                        (0, 0))}
+                                                                                        (0, 0)),
+              "Anisotropic GGX (Principled metal; Glossy turned by Rotation)": (anisotropic_scenes.anisotropic_scene,
+                                                                                  (0, 0)),
+              "Anisotropic GGX textured (anisotropy and rotation per hit, UV tangent)":
+                  (anisotropic_scenes.textured_scene, (0, 0))}
     for label, name in ies_scenes.CASES.items():
         scenes[f"IES Texture, {label}"] = (lambda name=name: ies_scenes.lit_by(name), IES_MATCHED_FROM)
     scenes["Light Falloff in a light's node tree"] = (lambda: ies_scenes.lit_by(ies_scenes.FALLOFF), (0, 0))
