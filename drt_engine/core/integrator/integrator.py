@@ -57,7 +57,7 @@ from .ratio import RatioEstimator
 from .records import PathState, Samples, ShadowRays, SurfaceHits
 from .shadow_catcher import Catchers, CatcherWave
 from .shadows import TransparentShadows, limits, new_queue, stopped
-from .world_lobes import COSINE, world_from_lobes
+from .world_lobes import COSINE, draws_from, world_from_lobes
 
 _MISS_DEPTH = 1e10  # Blender's depth for the background
 _NO_BOUNCES = camera_bounces(0)  # the kernels' bounces when paths carry none
@@ -716,7 +716,7 @@ class Integrator:
         qf, qi = new_queue(n * light.strategies, shadows)
         clear = self.shadows.clear if shadows else _NOTHING_CLEAR
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
-        if continues and self.lights.uniform_world:
+        if continues and self.lights.uniform_world and draws_from(shader):
             self._world_from_lobes(shader, group, light, u_light)
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
@@ -761,7 +761,8 @@ class Integrator:
         next_bounces = np.empty_like(bounces)
         first = np.zeros(0, bool) if split is None else split.bounces[hits.path] == 0
         shares = np.empty((n if split is not None else 0, 6, 3))
-        world_pdf = np.empty(n if state.world_pdf is not None else 0)
+        drawn = state.world_pdf is not None and draws_from(shader)  # else the cosine's, COSINE
+        world_pdf = np.empty(n if drawn else 0)
         continue_paths(shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled),
                        _c(hits.frame.m), _smooth(hits), _c(hits.dn),
                        _c(hits.wo_l), _c(hits.inside), _c(u.lobe_choice), _c(u.lobe), _c(hits.throughput),
@@ -782,7 +783,7 @@ class Integrator:
         self._count("reflection", (~transmit & ~diffuse).sum())
         self._count("transparent", passthrough.sum())
         prev_pdf, prev_normal, prev_shading, origin = prev_pdf[sel], hits.ng[sel], hits.ns[sel], origin[sel]
-        world_pdf = world_pdf[sel] if len(world_pdf) else None
+        world_pdf = None if state.world_pdf is None else world_pdf[sel] if drawn else np.full(len(sel), COSINE)
         mis_origin = None
         if state.mis_origin is not None:  # transparent shadows: a pass-through keeps the MIS state
             kept, rows = passthrough[:, None], hits.row[sel]
