@@ -80,19 +80,3 @@ def test_an_adopted_scene_renders_on_the_prepared_parts():
     s = RenderSettings(samples=2, threads=1)
     fresh = Renderer(later, s, PreparedScene(later, center=prepared.geometry.center)).render().passes["Combined"]
     assert np.array_equal(Renderer(adopted, s, prepared).render().passes["Combined"], fresh)
-
-
-def test_world_light_through_a_translucent_lobe_is_named():
-    """The world lights diffuse lobes from above the surface only, so a Translucent BSDF under a
-    lit world misses its light from behind: each such material is named once, and only then."""
-    from drt_engine.core.scene import Closure, Material, World
-    base = scene()
-    leaf = Material("Leaf", [Closure("TRANSLUCENT", color=(0.3, 0.8, 0.2))])
-    materials = [leaf] + list(base.materials[1:])
-    lit = PreparedScene(dataclasses.replace(base, materials=materials, world=World(radiance=(0.5, 0.5, 0.5))))
-    assert [w for w in lit.warnings if "Translucent" in w] == [
-        "material 'Leaf': the world's light through its Translucent BSDF is left out"]
-    dark = PreparedScene(dataclasses.replace(base, materials=materials, world=World()))
-    assert not [w for w in dark.warnings if "Translucent" in w]
-    plain = PreparedScene(dataclasses.replace(base, world=World(radiance=(0.5, 0.5, 0.5))))
-    assert not [w for w in plain.warnings if "Translucent" in w]

@@ -103,7 +103,8 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
     map (and its sun cone, ``sun``) with probability ``share``, value left to the caller). ``u`` (N, S, 2, 2): per strategy
     the point [k, 0] and the choice [k, 1, 0]. Fills the strategy-by-hit outputs; ``pick`` the
     light or triangle sampled, ``bary`` the triangle's barycentrics, ``lit`` where the caller's
-    value applies (a triangle's front seen, a map direction above the normal)."""
+    value applies (a triangle's front seen, a map direction of some density: below the normal too,
+    where a transmitting lobe takes it, as the escaping rays' MIS weighs against it)."""
     for j in range(len(pos)):
         px, py, pz = pos[j, 0], pos[j, 1], pos[j, 2]
         for k in range(slots):
@@ -146,6 +147,6 @@ def sample_strategies(table, slots, selecting, vertices, triangles, tri_ng, area
         else:
             wx, wy, wz, p = sample_world_direction(nx, ny, nz, u[j, k, 0, 0], u[j, k, 0, 1], share, row_cdf, col_cdf,
                                                    cell, cell_area, sun)
-            lit[k, j] = nx * wx + ny * wy + nz * wz > 0 and p > 0
+            lit[k, j] = p > 0
             cycles_pdf[k, j] = map_pdf(cell, cell_area, sun, wx, wy, wz)
         wi[k, j, 0], wi[k, j, 1], wi[k, j, 2], dist[k, j], pdf[k, j] = wx, wy, wz, math.inf, p

@@ -164,16 +164,8 @@ class PreparedScene:
     def warnings(self) -> list[str]:
         """The scene's, the geometry's, the images' and the materials' warnings (materials add
         theirs while rendering), each once."""
-        found = self.scene.warnings + self.geometry.warnings + self.texture_warnings + self._translucent_warnings()
+        found = self.scene.warnings + self.geometry.warnings + self.texture_warnings
         return list(dict.fromkeys(found + [w for sh in self.shading for w in sh.warnings]))
-
-    def _translucent_warnings(self) -> list[str]:
-        """The world lights diffuse lobes by sampling above the surface only, so none of its light
-        reaches a translucent lobe (which Cycles lights from behind): named, not dropped silently."""
-        if self.lights.world is None:
-            return []
-        return [f"material '{sh.material.name}': the world's light through its Translucent BSDF is left out"
-                for sh in self.shaders if any(lobe.kind == "translucent" for lobe in sh.lobes)]
 
     def serves(self, scene: SceneData) -> bool:
         """Whether ``scene`` is this prepared scene's with at most another camera."""
