@@ -67,6 +67,7 @@ def _whole_scenes() -> dict:
               HUANG: (lambda: hair_scenes.hair_scene("HUANG"), PRINCIPLED_HAIR_MATCHED_FROM),
               "Sheen BSDF under a white world": (lambda: sheen_scenes.sheen_scene(white_world=True), (0, 0)),
               "Translucent BSDF under a white world": (ns.translucent_world_scene, (0, 0)),
+              "Translucent BSDF seen through a Translucent BSDF": (ns.translucent_pair_scene, (0, 0)),
               "Principled Coat Normal (a Bump's; a Normal Map's over a bumped base)": (coat_scenes.coat_normal_scene,
                                                                                         (0, 0)),
               "Anisotropic GGX (Principled metal; Glossy turned by Rotation)": (anisotropic_scenes.anisotropic_scene,

@@ -182,31 +182,35 @@ def _hemisphere_quadrature(n=600):
     return wi, np.full(len(wi), 2 * np.pi / (2 * n * n))
 
 
-def _diffuse_albedo(closure, mu, below=False):
-    """Integral of the diffuse part's f |cos| over the hemisphere above (or below) the surface."""
+def _diffuse_albedo(closure, mu, below=False, continued=False):
+    """Integral of f |cos| over the hemisphere above (or below) the surface: of the part no ray
+    continues through (a diffuse reflection's), or, ``continued``, of the part rays continue
+    through (a translucent's); the other part is 0."""
     shader = MaterialShader(Material("m", [closure]))
     wi, dw = _hemisphere_quadrature()
     if below:
         wi = wi * [1, 1, -1]
     wo = np.tile([np.sqrt(1 - mu * mu), 0.0, mu], (len(wi), 1))
     f_d, f_nd, _ = shader.evaluate(wo, wi, np.full(len(wi), not below), np.zeros(len(wi), bool))
-    assert not f_nd.any()
-    return (f_d * dw[:, None]).sum(axis=0)
+    part, other = (f_nd, f_d) if continued else (f_d, f_nd)
+    assert not other.any()
+    return (part * dw[:, None]).sum(axis=0)
 
 
 @pytest.mark.parametrize("mu", [1.0, 0.4, 0.05])
 def test_translucent_is_lambert_on_the_far_side(mu):
     """Cycles' bsdf_translucent: all of its colour leaves on the side opposite the normal, as
-    |cos| / pi, and none on the near side."""
+    |cos| / pi, and none on the near side. Its ray is a transmission bounce (Cycles'), which rays
+    continue through whatever the diffuse bounces: its BSDF is the part they continue through."""
     colour = np.array([0.9, 0.5, 0.2])
     closure = Closure("TRANSLUCENT", color=colour)
-    assert np.allclose(_diffuse_albedo(closure, mu, below=True), colour, atol=1e-4)
-    assert not _diffuse_albedo(closure, mu).any()
+    assert np.allclose(_diffuse_albedo(closure, mu, below=True, continued=True), colour, atol=1e-4)
+    assert not _diffuse_albedo(closure, mu, continued=True).any()
     shader = MaterialShader(Material("m", [closure]))
-    assert not shader.can_continue and not shader.lambertian
+    assert shader.can_continue and not shader.lambertian
     wi = np.array([[0.6, 0.0, -0.8]])
-    f_d, _, _ = shader.evaluate(np.array([[0.0, 0.0, 1.0]]), wi, np.zeros(1, bool), np.zeros(1, bool))
-    assert np.allclose(f_d, colour * 0.8 / np.pi, rtol=1e-12)
+    _, f_nd, _ = shader.evaluate(np.array([[0.0, 0.0, 1.0]]), wi, np.zeros(1, bool), np.zeros(1, bool))
+    assert np.allclose(f_nd, colour * 0.8 / np.pi, rtol=1e-12)
 
 
 @pytest.mark.parametrize("sigma", [0.2, 0.6, 1.0])

@@ -124,7 +124,7 @@ def test_sampling_with_diffuse_lobes_integrates_the_whole_bsdf(name, bump):
     bump, sampling weighs by the same bump shadowing as evaluation; at a rim the diffuse lobes are
     sampled and evaluated about their own normal alike."""
     shader = MaterialShader(Material("m", GI_MATERIALS[name]))
-    bits = layout.SAMPLE_DIFFUSE | layout.SAMPLE_TRANSLUCENT
+    bits = layout.SAMPLE_DIFFUSE
     args = (shader.lp, shader.lt, shader.hp, 0, shader.mu)
     wo = np.array([np.sqrt(1 - 0.6 ** 2), 0.0, 0.6])
     sel = np.zeros((1, len(shader.lobes)))

@@ -1012,8 +1012,7 @@ CLOSURES = (
 """Closures under two suns, each in its own square of ``closure_scene``: toon spheres, glossy and
 diffuse (the sharp edges of Cycles' cones), a Metallic BSDF sphere, thin-film spheres from 5.0 (whose
 Cycles computes the film as DRT does; these first: a glossy
-neighbour would light the translucent squares through Cycles' transmission bounces, which DRT
-does not trace through a Translucent), rough diffuse spheres
+neighbour would light the translucent squares through their transmission bounces), rough diffuse spheres
 (Oren-Nayar's flat look and bright limb under light from the camera's side; roughness constant,
 textured, and a Principled BSDF's Diffuse Roughness), upright squares lit through from behind
 (Translucent, alone and mixed with a Diffuse lit in front) and sheen spheres (the Sheen BSDF, a
@@ -1075,14 +1074,31 @@ def translucent_world_scene(size=32):
     """The Translucent squares of ``CLOSURES`` (alone, and mixed with a Diffuse) under a uniform white
     world and no light: lit through from behind by the world alone, which Cycles' BSDF rays find
     and DRT's light sample drawn from the translucent lobe (core.integrator.world_lobes); the
-    squares side by side in one plane, so neither sees the other (a Translucent ray is a
-    transmission bounce in Cycles, which DRT does not trace)."""
+    squares side by side in one plane, so neither sees the other (``translucent_pair_scene`` has
+    two that do)."""
     scene = closure_scene([case for case in CLOSURES if case.name.startswith("Translucent")], size)
     for name in ("Front", "Back"):
         bpy.data.objects.remove(bpy.data.objects[name])
     world = new_world("White")
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     scene.world = world
+    return scene
+
+
+def translucent_pair_scene(width=64, height=32):
+    """Two Translucent squares (orange, blue), tilted alike, under a uniform white world and no light,
+    each seeing part of the other behind it: the far one's light comes through the near one,
+    which a Translucent ray carries (Cycles counts it a transmission bounce, not a diffuse one:
+    its default diffuse bounces 0 keep it). DRT's light sample alone, blocked by the near square,
+    left the far one 1.4-3.2% dark per channel."""
+    scene = ps.sphere_pair_stage(width, height)
+    world = new_world("White")
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scene.world = world
+    for i, (x, colour) in enumerate(((-1.1, (0.8, 0.5, 0.3, 1.0)), (1.1, (0.3, 0.6, 0.8, 1.0)))):
+        material, _ = ps.closure_material(f"Translucent {i}", "ShaderNodeBsdfTranslucent", Color=colour)
+        bpy.ops.mesh.primitive_plane_add(size=1.8, location=(x, 0.0, 0.0), rotation=(1.2, 0.0, 0.3))
+        bpy.context.active_object.data.materials.append(material)
     return scene
 
 

@@ -12,10 +12,10 @@ DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOO
 F_DIELECTRIC, F_F82, F_TINT, F_FILM, F_F82_FILM = 0, 1, 2, 3, 4  # F_FILM: thin film over a dielectric
 SHEEN = 8
 HAIR_REFLECTION, HAIR_TRANSMISSION, HAIR_CHIANG, HAIR_HUANG = 9, 10, 11, 12
-# which diffuse lobes a path may continue through at a hit (bits of ``mixture``'s ``diffuse``):
-# with none, the lobe choice covers the non-diffuse lobes alone (slots P_SAMPLED); with any, it
-# covers every lobe (slot = lobe index) and the diffuse lobes outside the bits get no share
-SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT = 1, 2
+# whether a path may continue through the diffuse reflections at a hit (``mixture``'s ``diffuse``
+# bits): without, the lobe choice covers the others alone (slots P_SAMPLED, translucent included:
+# its ray is a transmission bounce); with, it covers every lobe (slot = lobe index)
+SAMPLE_DIFFUSE = 1
 
 # lp: constants per lobe
 P_KIND = 0
@@ -33,7 +33,7 @@ P_E_AVG = 12  # cosine-weighted white albedo (multiscatter)
 P_AFFINE = 13  # 1: albedo from the tables of f0 A + B with a per-hit f0 (T_EA, T_EB)
 P_LAYERS = 14  # number of layers above (0 to 2)
 P_LAYER_TINT = 15  # (2 x 3) tint of each layer term
-P_SAMPLED = 21  # index among the lobes a ray continues through, -1 for diffuse
+P_SAMPLED = 21  # index among the lobes a ray continues through, -1 for a diffuse reflection
 P_WEIGHT = 22  # (3) constant weight
 P_A_AVG = 25  # (3) cosine averages of A and B (affine multiscatter)
 P_B_AVG = 28

@@ -27,8 +27,8 @@ from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
 from .hair_lobes import files_as_transmission, hair_lobe_eval, hair_lobe_sample, is_hair
-from .layout import (DIFFUSE, H_NORMAL, OREN_NAYAR, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
-                     SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .layout import (DIFFUSE, H_NORMAL, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
+                     SAMPLE_DIFFUSE, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
@@ -45,59 +45,52 @@ counts it for lights), the others' reflection and their transmission."""
 
 @kernel(inline="always")
 def slot(lp, l, diffuse):
-    """Lobe l's place in the lobe choice at a hit whose path may continue through the ``diffuse``
-    lobes (layout.SAMPLE_* bits), -1 where no ray continues through it: with no bits the
-    non-diffuse lobes' P_SAMPLED (as without diffuse bounces), with any the lobe's own index."""
-    if diffuse == 0:
-        return int(lp[l, P_SAMPLED])
-    kind = int(lp[l, P_KIND])
-    if kind == DIFFUSE or kind == OREN_NAYAR or kind == TOON_DIFFUSE or kind == SHEEN:
-        return l if diffuse & SAMPLE_DIFFUSE else -1
-    if kind == TRANSLUCENT:
-        return l if diffuse & SAMPLE_TRANSLUCENT else -1
-    return l
+    """Lobe l's place in the lobe choice at a hit whose path may continue through the diffuse
+    reflections where ``diffuse`` (layout.SAMPLE_DIFFUSE) says so, -1 where no ray continues through
+    it: without, P_SAMPLED (every lobe but the diffuse reflections, as without diffuse bounces), with,
+    the lobe's own index."""
+    return l if diffuse != 0 else int(lp[l, P_SAMPLED])
 
 
 @kernel(inline="always")
-def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
-    """Fill ``sel[si]`` with the probabilities of continuing through each lobe a ray may continue
-    through (``slot``): proportional to their albedos' largest channel, uniform when all are
-    black; 0 in a slot of a lobe left out (with ``diffuse`` bits, ``sel`` has one slot per lobe)."""
+def _by_albedo(lp, lt, hp, r, mu, mu_o, sel, si, diffuse, diffuse_only):
+    """Fill the slots (``slot``) of ``sel[si]`` with their lobes' albedos' largest channel (0 for all
+    but the diffuse-type lobes, passes.diffuse_kind, where ``diffuse_only``); (their sum, the slots)."""
     j, t = locate(mu, mu_o)
     total = 0.0
     n = 0
     for l in range(lp.shape[0]):
         k = slot(lp, l, diffuse)
         if k < 0:
-            if diffuse != 0:
-                sel[si, l] = 0.0
+            continue
+        n += 1
+        sel[si, k] = 0.0
+        if diffuse_only and not diffuse_kind(int(lp[l, P_KIND])):
             continue
         a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
         sel[si, k] = max(max(a0, a1), a2)
         total += sel[si, k]
-        n += 1
-    for k in range(n if diffuse == 0 else lp.shape[0]):
-        if diffuse != 0 and slot(lp, k, diffuse) < 0:
-            continue
+    return total, n
+
+
+@kernel(inline="always")
+def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
+    """Fill ``sel[si]`` with the probabilities of continuing through each lobe a ray may continue
+    through (``slot``): proportional to their albedos' largest channel, uniform when all are black."""
+    total, n = _by_albedo(lp, lt, hp, r, mu, mu_o, sel, si, diffuse, False)
+    for k in range(n):
         sel[si, k] = sel[si, k] / max(total, TINY) if total > 0.0 else 1.0 / n
 
 
 @kernel(inline="always")
 def diffuse_selection(lp, lt, hp, r, mu, mu_o, sel, si):
-    """Fill ``sel[si]`` (a slot per lobe, as ``selection`` with any ``diffuse`` bits) with the
-    chance of sampling each diffuse-type lobe (passes.diffuse_kind) by its albedo's largest
-    channel, 0 for every other lobe; whether any has weight (core.integrator.world_lobes)."""
-    j, t = locate(mu, mu_o)
-    total = 0.0
-    for l in range(lp.shape[0]):
-        sel[si, l] = 0.0
-        if diffuse_kind(int(lp[l, P_KIND])):
-            a0, a1, a2 = lobe_albedo(lp, lt, hp, r, j, t, l)
-            sel[si, l] = max(max(a0, a1), a2)
-            total += sel[si, l]
+    """Fill ``sel[si]`` (a slot per lobe, as ``selection`` with SAMPLE_DIFFUSE) with the chance of
+    sampling each diffuse-type lobe by its albedo's largest channel, 0 for every other lobe;
+    whether any has weight (core.integrator.world_lobes)."""
+    total, n = _by_albedo(lp, lt, hp, r, mu, mu_o, sel, si, SAMPLE_DIFFUSE, True)
     if not total > 0.0:
         return False
-    for l in range(lp.shape[0]):
+    for l in range(n):
         sel[si, l] = sel[si, l] / total
     return True
 
@@ -129,7 +122,7 @@ def eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, s
     left out, BSDF and density (the sampled hair lobe whose own value ``sample_lobes`` keeps), -1:
     none. (sx, sy, sz, model): the smooth normal before a bump and its model of shadowing
     (``bump_shadowing``); (dx, dy, dz) the diffuse lobes' normal (core.bsdf.diffuse_normal). Returns (the part
-    no ray continues through RGB: the diffuse lobes (Lambert, Oren-Nayar, translucent) left out
+    no ray continues through RGB: the diffuse reflections (Lambert, Oren-Nayar, toon, sheen) left out
     of the choice, the part rays continue through RGB, density of continuing toward wi through
     the lobes of the choice).
     """
@@ -268,7 +261,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     (one-sample MIS over lobes), as multiple importance sampling with light sampling requires.
     """
     n = sel.shape[1]
-    if n == 0:  # nothing to continue through (diffuse, translucent): no sample, and no read past sel
+    if n == 0:  # nothing to continue through (diffuse reflections only): no sample, and no read past sel
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, False, False, False, False, -1, 0.0, 0.0, 0.0, False
     count = 0
     acc = 0.0

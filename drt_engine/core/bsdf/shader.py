@@ -102,8 +102,14 @@ class Lobe:
 
     @property
     def diffuse(self) -> bool:
-        """One of the diffuse lobes, which rays continue through only with diffuse bounces on."""
+        """One of the diffuse lobes (Cycles' CLOSURE_IS_BSDF_DIFFUSE)."""
         return self.kind in DIFFUSE_KINDS
+
+    @property
+    def bounces_diffuse(self) -> bool:
+        """A diffuse reflection, which rays continue through only with diffuse bounces on: a
+        translucent lobe's ray is a transmission bounce (Cycles' path_state_next), taken always."""
+        return self.diffuse and self.kind != "translucent"
 
     @property
     def alpha_t(self) -> float:
@@ -635,7 +641,7 @@ class MaterialShader:
         self.material = material
         self.lobes = lobes_of(material, tables)
         self.emission = material.emission
-        self.sampled = [lobe for lobe in self.lobes if not lobe.diffuse]
+        self.sampled = [lobe for lobe in self.lobes if not lobe.bounces_diffuse]
         self.has_glass = any(lobe.kind == "glass" for lobe in self.lobes)
         self.hair = any(lobe.role in ("hair", "principled_hair") for lobe in self.lobes)
         """It has hair lobes: a bound shader takes their frames with ``turn_hair``."""

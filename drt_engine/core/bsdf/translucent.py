@@ -1,6 +1,6 @@
 """Translucent lobe: Lambert on the side opposite the shading normal (Cycles' bsdf_translucent in
-kernel/closure/bsdf_diffuse.h). A diffuse transmission, so as the Lambert lobe it is evaluated for
-light sampling only (Cycles with diffuse bounces 0 continues no ray from it)."""
+kernel/closure/bsdf_diffuse.h). A diffuse transmission, which Cycles counts as a transmission
+bounce: rays continue through it whatever the diffuse bounces (core.integrator.bounces)."""
 from __future__ import annotations
 
 import numpy as np

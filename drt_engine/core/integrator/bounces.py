@@ -1,12 +1,13 @@
-"""Cycles' bounce limits per kind: which diffuse lobes a path may continue through at a hit, and
-which paths the glossy and transmission limits end.
+"""Cycles' bounce limits per kind: whether a path may continue through the diffuse reflections at a
+hit, and which paths the glossy and transmission limits end.
 
-With diffuse bounces k, a path continues through a diffuse reflection (Lambert, Oren-Nayar)
-while it has taken fewer than k of them (Cycles' path_state_next, whose kernel limit is the
+With diffuse bounces k, a path continues through a diffuse reflection (Lambert, Oren-Nayar, toon,
+sheen) while it has taken fewer than k of them (Cycles' path_state_next, whose kernel limit is the
 setting + 1: with k = 0 a diffuse surface gets direct light only, DRT's classic image). A
 translucent lobe is a diffuse transmission, which Cycles counts as a transmission bounce: it is
-sampled whenever diffuse bounces are on, within the path's depth. The answer is the
-``diffuse`` bits of core.bsdf.mixture, 0 where paths carry no depths (diffuse bounces 0).
+sampled as a glossy lobe is, whatever the diffuse bounces (core.bsdf.shader.Lobe.bounces_diffuse).
+The answer is the ``diffuse`` bits of core.bsdf.mixture, 0 where paths carry no depths (diffuse
+bounces 0).
 
 The glossy and transmission limits work as Cycles' path_state_next: every lobe is sampled as
 usual, and a bounce that takes the path's glossy (non-diffuse reflection) or transmission depth
@@ -19,7 +20,7 @@ transparent surfaces; DRT ends it there too). The depths only reach a limit belo
 from __future__ import annotations
 
 from ..base.jit import kernel
-from ..bsdf.layout import SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT
+from ..bsdf.layout import SAMPLE_DIFFUSE
 from ..shading.lightpath import DIFFUSE_DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH
 
 
@@ -28,9 +29,7 @@ def diffuse_bits(bounces, j, limit):
     """The mixture's ``diffuse`` bits at hit j of paths with depths ``bounces`` (core.shading.lightpath)."""
     if limit <= 0 or len(bounces) == 0:
         return 0
-    if bounces[j, DIFFUSE_DEPTH] < limit:
-        return SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT
-    return SAMPLE_TRANSLUCENT
+    return SAMPLE_DIFFUSE if bounces[j, DIFFUSE_DEPTH] < limit else 0
 
 LIMIT_TRANSPARENCY = ("paths ended by the Glossy or Transmission bounce limit stop at transparent surfaces, "
                       "where Cycles lets them pass on")

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.layout import SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT
+from ..bsdf.layout import SAMPLE_DIFFUSE
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
@@ -172,10 +172,10 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             wd = 1.0  # the diffuse lobes light-sampled alone take it all, but on the wrong side
             if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0.0) == above and not left_out & NO_MIS:
                 if not rim_selected:
-                    selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel_rim, 0, SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT)
+                    selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel_rim, 0, SAMPLE_DIFFUSE)
                     rim_selected = True
                 every = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                   inside[j], sel_rim, 0, SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT, 0, sx, sy, sz, model,
+                                   inside[j], sel_rim, 0, SAMPLE_DIFFUSE, 0, sx, sy, sz, model,
                                    dn[j, 0], dn[j, 1], dn[j, 2], -1)
                 w = wd = power(cycles_pdf[k, j], every[6])
             mask = masks[k, j] if masking else shadow_mask

@@ -187,9 +187,10 @@ class Integrator:
                                               or plan.rays["diffuse"])
         # paths carry their ray kind and depths only for a scene whose shader programs read them,
         # with diffuse bounces, with transparent shadows (which count them), with objects hidden
-        # from some kind of ray (whose masks they give) or with a glossy or transmission limit
+        # from some kind of ray (whose masks they give), with a glossy or transmission limit or
+        # with Translucent rays and an emitter hidden from diffuse rays
         self.carried = (self.light_path or self.diffuse > 0 or self.shadows is not None or self.geometry.masked
-                        or self.limited)
+                        or self.limited or (plan.rays["diffuse"] and self.lights.hidden_from_diffuse))
         # Russian roulette after the minimum bounces, as Cycles, only with diffuse bounces (the
         # classic paths, bounded by the depth alone, stay as they were)
         self.roulette = (np.array([settings.min_light_bounces, settings.min_transparent_bounces], np.int64)

@@ -75,12 +75,15 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     used = {int(m) for m in geometry.materials_used()}
     kinds = {lobe.kind for m in used for lobe in shaders[m].lobes}
     bounces = settings.max_depth > 0
+    # diffuse reflections bounce with diffuse bounces on; a translucent lobe's ray (a diffuse
+    # transmission, counted as a transmission bounce as Cycles does) always
+    reflected = bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS))
     rays = {"camera": True,
             "shadow": lights.strategies > 0 and bool(kinds),
             "reflection": bounces and bool(kinds & REFLECTING),
             "refraction": bounces and bool(kinds & TRANSMITTING),
             "transparent": bounces and "transparent" in kinds,
-            "diffuse": bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS)),
+            "diffuse": reflected or (bounces and "translucent" in kinds),
             "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion and Bevel nodes
 
     strategies = []
@@ -112,7 +115,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     # the ratio estimator takes diffuse direct light as light sampling alone, which with
     # diffuse bounces is weighed against the diffuse rays, and a shadow ray's visibility as all
     # or nothing, which transparent shadows are not (Monte Carlo then)
-    ratio = (ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not rays["diffuse"]
+    ratio = (ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not reflected
              and not clear else [])
     by_ratio = settings.shadow_estimator == "RATIO"
     monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []

@@ -2,8 +2,8 @@
 
 Its radiance is one constant, so the density that leaves its light sample least noise is the
 BSDF's own. Where a hit has diffuse-type lobes (Lambert, Oren-Nayar, toon, sheen, translucent:
-without diffuse bounces no ray continues through them and their world light is light
-sampling's alone), the world's sample is drawn from their mixture by albedo rather than
+without diffuse bounces no ray continues through the reflections among them, whose world light is
+then light sampling's alone), the world's sample is drawn from their mixture by albedo rather than
 cosine-weighted about the normal: a sheen's light then has the variance of its own LTC sample,
 as Cycles' BSDF rays find it (Cycles leaves such a world out of light sampling). Where the hit
 has none, or only Lambert and Oren-Nayar lobes (their mixture is the very cosine about the same
@@ -18,11 +18,8 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.layout import DIFFUSE, OREN_NAYAR, P_KIND, SAMPLE_DIFFUSE, SAMPLE_TRANSLUCENT
+from ..bsdf.layout import DIFFUSE, OREN_NAYAR, P_KIND, SAMPLE_DIFFUSE
 from ..bsdf.mixture import diffuse_selection, eval_lobes, sample_lobes
-
-EVERY_SLOT = SAMPLE_DIFFUSE | SAMPLE_TRANSLUCENT
-"""The mixture's ``diffuse`` bits that give every lobe its own slot, which ``diffuse_selection`` fills."""
 
 COSINE = -1.0
 """``world_density`` where the world's sample is lights.world's cosine about the shading normal."""
@@ -53,9 +50,9 @@ def _drawn_from_lobes(lp, lt, hp, r, mu, woz, sel):
 @kernel
 def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k, radiance, wi, value, pdf):
     """The uniform world's sample (of ``radiance``, strategy ``k``) of each hit drawn again from the
-    hit's diffuse-type lobes, where they are not the cosine it was drawn from: per hit its direction ``wi``, ``value``
-    (radiance / pdf; 0 where the lobe drew no direction) and ``pdf``, as lights.strategies fills
-    strategy k's; ``u`` (N, S, 2, 2) the hits' light sample values (the point, [k, 0], draws the
+    hit's diffuse-type lobes, where they are not the cosine it was drawn from: per hit its direction
+    ``wi``, ``value`` (radiance / pdf; 0 where the lobe drew no direction) and ``pdf``, as
+    lights.strategies fills strategy k's; ``u`` (N, S, 2, 2) the hits' light sample values (the point, [k, 0], draws the
     direction, the choice, [k, 1, 0], the lobe). Shader and hits as core.integrator.direct has them."""
     sel = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
@@ -63,7 +60,7 @@ def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k
             continue
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u[j, k, 1, 0], u[j, k, 0, 0],
-                         u[j, k, 0, 1], inside[j], sel, 0, EVERY_SLOT, sx, sy, sz, model, dn[j, 0], dn[j, 1],
+                         u[j, k, 0, 1], inside[j], sel, 0, SAMPLE_DIFFUSE, sx, sy, sz, model, dn[j, 0], dn[j, 1],
                          dn[j, 2])
         x, y, z = s[0], s[1], s[2]
         wi[j, 0] = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
@@ -81,5 +78,5 @@ def world_density(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel,
     core.bsdf.mixture.side_of), or COSINE where it leaves the world's cosine sample."""
     if not _drawn_from_lobes(lp, lt, hp, r, mu, woz, sel):
         return COSINE
-    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, 0, EVERY_SLOT, 0, sx, sy, sz,
+    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, 0, SAMPLE_DIFFUSE, 0, sx, sy, sz,
                       model, dx, dy, dz, -1)[6]

@@ -314,6 +314,12 @@ class Lights:
         return bool(self.motions)
 
     @property
+    def hidden_from_diffuse(self) -> bool:
+        """Some light, or the world, is hidden from diffuse rays: a Translucent's ray, a diffuse ray
+        and a transmission at once (Cycles' ray flags), is told from a refraction by its kind alone."""
+        return not (self.world_visibility[1] and self.visibility[:, 1].all())
+
+    @property
     def uniform_world(self) -> bool:
         """The world lights the scene and does not vary: its strategy (the last) may be drawn from
         the hits' lobes (core.integrator.world_lobes)."""
