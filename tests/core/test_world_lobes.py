@@ -60,3 +60,22 @@ def test_a_sheen_is_lit_with_a_fraction_of_the_cosine_samples_noise(monkeypatch)
     lobes = _render(scene, False, monkeypatch, samples=16).std()
     cosine = _render(scene, True, monkeypatch, samples=16).std()
     assert lobes < 0.5 * cosine, (lobes, cosine)
+
+
+def test_a_scene_with_no_lobe_to_draw_from_skips_the_draw_and_keeps_its_image(monkeypatch):
+    """Lambert and glossy lobes keep the cosine sample: a scene with no sheen, toon or translucent
+    lobe draws no lobe choice for the world and records no density for it (integrator.world_drawn),
+    and its image is the very one it was with them drawn."""
+    from drt_engine.core.integrator import integrator
+    scene = _scene([Closure("DIFFUSE", weight=np.full(3, 0.5), color=(0.8, 0.6, 0.4)),
+                    Closure("GLOSSY", weight=np.full(3, 0.5), color=(1, 1, 1), roughness=0.4)])
+    settings = RenderSettings(samples=16, threads=1, seed=3, max_depth=3)
+    renderer = Renderer(scene, settings)
+    skipped = renderer.render().passes["Combined"]
+    assert not renderer.integrator.world_drawn
+    with monkeypatch.context() as m:
+        m.setattr(integrator, "draws_from", lambda shader: True)
+        drawn = Renderer(scene, settings)
+        image = drawn.render().passes["Combined"]
+        assert drawn.integrator.world_drawn
+    assert np.array_equal(image, skipped)

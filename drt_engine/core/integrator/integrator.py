@@ -197,6 +197,10 @@ class Integrator:
                          if self.diffuse else _NO_ROULETTE)
         # per material (and none): its hits draw lobe samples; with diffuse bounces, every lit one
         self.continues = prepared.continues | prepared.lit if self.diffuse else prepared.continues
+        # a uniform world's sample is drawn again from the lobes of the hits that have a sheen, toon
+        # or translucent lobe (core.integrator.world_lobes): its lobe choice, its own sample
+        # dimension, and the density paths record for it, only in a scene with one
+        self.world_drawn = self.lights.uniform_world and any(draws_from(sh) for sh in prepared.shaders)
         held = np.array([i.holdout for i in scene.instances], bool)
         self.holdouts = Holdouts(held, self.geometry) if held.any() or any(
             m.shader.holds_out for m in prepared.shading) else None
@@ -363,7 +367,7 @@ class Integrator:
                           mis_origin=cam.origins if self.shadows is not None else None,
                           min_pdf=np.full(n, np.inf) if self.min_pdf else None,
                           receiver=np.zeros(n, np.int64) if self.lights.linking else None,
-                          world_pdf=np.full(n, COSINE) if self.lights.uniform_world else None)
+                          world_pdf=np.full(n, COSINE) if self.world_drawn else None)
         return state, cam
 
     def _limits(self, straight: np.ndarray) -> np.ndarray:
@@ -602,9 +606,9 @@ class Integrator:
             dims = np.full((lights.strategies, 2), -1, np.int64)
             for k in range(lights.strategies):
                 dims[k, 0] = self.light_dims.point(depth, k)
-                # a uniform world (the last strategy) picks the lobe it is drawn from
+                # a uniform world drawn from the hits' lobes (the last strategy) picks the lobe
                 if k == emissive or (lights.selecting and k < lights.light_slots) or \
-                        (k == lights.strategies - 1 and lights.uniform_world):
+                        (k == lights.strategies - 1 and self.world_drawn):
                     dims[k, 1] = self.light_dims.choice(depth, k)
             whole = len(lit) >= n - n // 8  # drawing for a few hits that do not need it beats listing them
             sampler.pairs(pixel, sample, dims, None if whole else lit, light.reshape(n, -1, 2))
@@ -717,7 +721,7 @@ class Integrator:
         qf, qi = new_queue(n * light.strategies, shadows)
         clear = self.shadows.clear if shadows else _NOTHING_CLEAR
         allowed = limits(group.bounces, self.settings.max_transparent_bounces) if shadows else _NO_LIMITS
-        if continues and self.lights.uniform_world and draws_from(shader):
+        if continues and self.world_drawn and draws_from(shader):
             self._world_from_lobes(shader, group, light, u_light)
         traced, m = direct_light(
             shader.lp, shader.lt, shader.hp, shader.hit_rows(n), shader.mu, len(shader.sampled), _c(group.pos),
