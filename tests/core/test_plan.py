@@ -63,6 +63,18 @@ def test_diffuse_rays_only_with_diffuse_bounces():
     assert rays["reflection"] == rays["refraction"] == rays["transparent"] == 0
 
 
+def test_a_path_out_of_diffuse_bounces_ends_where_only_diffuse_reflections_are():
+    """Sheen only, diffuse bounces 1: a path's one diffuse bounce spent, its next hit has no lobe to
+    continue through (no column in the lobe choice, whose one uninitialised column once let a
+    path read past the lobes: a firefly of 1e28 in tests/blender/test_sheen_cycles.py)."""
+    sheen = Material("sheen", [Closure("SHEEN", color=(0.8, 0.8, 0.8), roughness=0.3)])
+    _, res = run(floor_scene((sheen, sheen), [point(0, 0, 3)], ball=np.eye(4)), diffuse_bounces=1)
+    rays, image = res.stats["rays"], res.passes["Combined"][..., :3]
+    assert 0 < rays["diffuse"] <= rays["camera"]
+    assert rays["reflection"] == rays["refraction"] == rays["transparent"] == 0
+    assert np.isfinite(image).all() and image.max() < 10.0
+
+
 def test_each_lobe_kind_traces_its_own_ray_kind_and_only_that():
     _, mirror = run(floor_scene((DIFFUSE, MIRROR), [point(0, 0, 3)], ball=np.eye(4)))
     assert mirror.stats["rays"]["reflection"] > 0 and mirror.stats["rays"]["refraction"] == 0

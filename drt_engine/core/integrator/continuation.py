@@ -47,7 +47,7 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
     (Cycles' bsdf_eval_pass_*_weight), a delta lobe's whole by its side.
     Shader and hits as core.integrator.direct has them."""
-    sel_nd = np.empty((1, max(n_sampled, 1)))
+    sel_nd = np.empty((1, n_sampled))  # no column where only diffuse reflections are: no lobe to read
     sel_all = np.empty((1, max(lp.shape[0], 1)))
     sel_world = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
