@@ -4,6 +4,8 @@ Exact where the light is wholly in view; no bias against a converged Monte Carlo
 beyond the noise (image mean and 4x4 blocks); an error estimate (Noise pass, error log) that
 tracks the true error as tests/blender/test_adaptive_calibration.py asks of Monte Carlo.
 """
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -11,7 +13,7 @@ from drt_engine.core.render.adaptive import true_error
 from drt_engine.core.film.film import Film
 from drt_engine.core.film.ratio_sums import FILM_CHANNELS, NDU_CHANNELS, RATIO
 from drt_engine.core.render.render import Renderer
-from drt_engine.core.scene import Light
+from drt_engine.core.scene import Closure, Light
 from drt_engine.core.settings import RenderSettings
 from tests.support import scenes
 from tests.support.scenes import translation
@@ -173,3 +175,19 @@ def test_film_reads_combined_resolved():
     b = s - a
     half_a, half_b = 0.25 + a[6:9] / (n / 2) * a[0:3] / a[3:6], 0.25 + b[6:9] / (n / 2) * b[0:3] / b[3:6]
     assert np.allclose(images["Noise"][0, 0], np.abs(half_a - half_b) / 2)
+
+
+def test_diffuse_bounces_set_the_ratio_estimator_aside_only_for_diffuse_reflections():
+    """With diffuse bounces a diffuse reflection's direct light is weighed against its rays, which the
+    ratio estimator does not do, so it stands aside; a Translucent's rays are traced whatever the
+    diffuse bounces (Lobe.bounces_diffuse), so a scene whose only diffuse lobes are Translucent keeps
+    the plan it has at diffuse bounces 0."""
+    scene, base = soft_shadow_scene(16)
+
+    def ratio(closure, diffuse_bounces):
+        materials = [replace(m, closures=[Closure(closure, color=(0.6, 0.6, 0.6))]) for m in scene.materials]
+        settings = RenderSettings(samples=1, shadow_estimator="RATIO", diffuse_bounces=diffuse_bounces, **base)
+        return Renderer(replace(scene, materials=materials), settings).plan.ratio
+
+    assert ratio("TRANSLUCENT", 1) == ratio("TRANSLUCENT", 0) != []
+    assert ratio("DIFFUSE", 0) != [] and ratio("DIFFUSE", 1) == []

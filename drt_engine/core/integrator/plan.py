@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..bsdf.shader import DIFFUSE_KINDS, see_through
+from ..bsdf.shader import see_through
 from ..geometry.motion import Motion, deforms, moves
 from ..shading.occlusion import traces
 from .ratio import delta_light, ratio_strategies
@@ -73,17 +73,19 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     time = geometry.moving or lights.moving or camera_moves
 
     used = {int(m) for m in geometry.materials_used()}
-    kinds = {lobe.kind for m in used for lobe in shaders[m].lobes}
+    lobes = [lobe for m in used for lobe in shaders[m].lobes]
+    kinds = {lobe.kind for lobe in lobes}
     bounces = settings.max_depth > 0
     # diffuse reflections bounce with diffuse bounces on; a translucent lobe's ray (a diffuse
-    # transmission, counted as a transmission bounce as Cycles does) always
-    reflected = bounces and settings.diffuse_bounces > 0 and bool(kinds & set(DIFFUSE_KINDS))
+    # transmission, counted as a transmission bounce as Cycles does) always (Lobe.bounces_diffuse)
+    reflected = bounces and settings.diffuse_bounces > 0 and any(lobe.bounces_diffuse for lobe in lobes)
+    transmitted = bounces and any(lobe.diffuse and not lobe.bounces_diffuse for lobe in lobes)
     rays = {"camera": True,
             "shadow": lights.strategies > 0 and bool(kinds),
             "reflection": bounces and bool(kinds & REFLECTING),
             "refraction": bounces and bool(kinds & TRANSMITTING),
             "transparent": bounces and "transparent" in kinds,
-            "diffuse": reflected or (bounces and "translucent" in kinds),
+            "diffuse": reflected or transmitted,
             "occlusion": any(traces(scene.materials[m].program) for m in used)}  # Ambient Occlusion and Bevel nodes
 
     strategies = []
