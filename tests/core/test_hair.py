@@ -277,7 +277,7 @@ def test_a_hair_sample_is_labelled_by_its_lobe_not_its_side():
     u = RNG.random((n, 3))
     differs = 0
     for i in range(n):
-        s = mixture.sample_lobes(lp, shader.lt, hp, i, shader.mu, *wo[i], u[i, 0], u[i, 1], u[i, 2], False, sel, 0, 0,
+        s = mixture.sample_lobes(lp, shader.lt, hp, i, shader.mu, *wo[i], u[i, 0], u[i, 1], u[i, 2], False, sel, 0, False,
                                  0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         sigma, frame = hp[i, 0, layout.H_SIGMA:layout.H_SIGMA + 3], hp[i, 0, layout.H_HAIR:layout.H_HAIR + 7]
         *_, reflect = hair_chiang.chiang_sample(*c, *sigma, frame[6], *frame[:6], *wo[i], u[i, 1], u[i, 2], u[i, 0])

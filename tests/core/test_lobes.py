@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from drt_engine.core.bsdf import microfacet as mf
-from drt_engine.core.bsdf import bump_shadowing, layout, mixture, tables
+from drt_engine.core.bsdf import bump_shadowing, mixture, tables
 from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.scene import Closure, Material
 
@@ -86,15 +86,15 @@ def test_scalar_functions_give_the_batch_results():
     sampled = shader.sample(wo, u_sel, u2, inside)
     sel = np.zeros((1, len(shader.sampled)))
     for i in range(n):
-        mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, 0)
+        mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, False)
         e = mixture.eval_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *wi[i], above[i], inside[i],
-                               sel, 0, 0, 0, *NO_BUMP, -1)
+                               sel, 0, False, 0, *NO_BUMP, -1)
         assert np.array_equal(e, [*f_diff[i], *f_nd[i], pdf[i]])
         s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], u_sel[i], *u2[i], inside[i],
-                                 sel, 0, 0, *NO_BUMP)
+                                 sel, 0, False, *NO_BUMP)
         assert np.array_equal(s[:7], [*sampled[0][i], *sampled[1][i], sampled[2][i]])
         assert s[7:10] == tuple(bool(x[i]) for x in sampled[3:])
-        assert not s[10]  # no diffuse lobe without the diffuse bits
+        assert not s[10]  # no diffuse lobe without the diffuse flag
 
 
 GI_MATERIALS = {
@@ -117,35 +117,35 @@ BUMPED_RIM = (-np.sin(0.5), 0.0, np.cos(0.5), bump_shadowing.GGX, -np.sin(1.0), 
 @pytest.mark.parametrize("bump", [NO_BUMP, BUMPED, RIM, BUMPED_RIM], ids=["smooth", "bumped", "rim", "bumped rim"])
 @pytest.mark.parametrize("name", list(GI_MATERIALS))
 def test_sampling_with_diffuse_lobes_integrates_the_whole_bsdf(name, bump):
-    """With diffuse bounces (the mixture's diffuse bits), a ray continues through any lobe, the
+    """With diffuse bounces (the mixture's diffuse flag), a ray continues through any lobe, the
     diffuse ones cosine-weighted, weighted by the whole mixture's f / pdf: its mean weight is
     the BSDF's albedo, the integral of f |cos| over the sphere that uniform directions give.
     A pdf that is not the sampler's density (a lobe's share or its cosine left out) fails; with a
     bump, sampling weighs by the same bump shadowing as evaluation; at a rim the diffuse lobes are
     sampled and evaluated about their own normal alike."""
     shader = MaterialShader(Material("m", GI_MATERIALS[name]))
-    bits = layout.SAMPLE_DIFFUSE
+    diffuse = True
     args = (shader.lp, shader.lt, shader.hp, 0, shader.mu)
     wo = np.array([np.sqrt(1 - 0.6 ** 2), 0.0, 0.6])
     sel = np.zeros((1, len(shader.lobes)))
-    mixture.selection(*args, wo[2], sel, 0, bits)
+    mixture.selection(*args, wo[2], sel, 0, diffuse)
     n = 40_000
     rng = np.random.default_rng(7)
     u = rng.random((n, 3))
     sampled = np.zeros(3)
     diffuse_taken = 0
     for i in range(n):
-        s = mixture.sample_lobes(*args, *wo, u[i, 0], u[i, 1], u[i, 2], False, sel, 0, bits, *bump)
+        s = mixture.sample_lobes(*args, *wo, u[i, 0], u[i, 1], u[i, 2], False, sel, 0, diffuse, *bump)
         if s[8]:
             sampled += s[3:6]
-            e = mixture.eval_lobes(*args, *wo, *s[:3], s[2] > 0, False, sel, 0, bits, 0, *bump, -1)
+            e = mixture.eval_lobes(*args, *wo, *s[:3], s[2] > 0, False, sel, 0, diffuse, 0, *bump, -1)
             assert e[6] == pytest.approx(s[6], rel=1e-9) and not any(e[:3])  # every lobe is sampled
         diffuse_taken += s[10]
     wi = rng.normal(size=(n, 3))
     wi /= np.linalg.norm(wi, axis=1)[:, None]
     uniform = np.zeros(3)
     for i in range(n):
-        e = mixture.eval_lobes(*args, *wo, *wi[i], wi[i, 2] > 0, False, sel, 0, bits, 0, *bump, -1)
+        e = mixture.eval_lobes(*args, *wo, *wi[i], wi[i, 2] > 0, False, sel, 0, diffuse, 0, *bump, -1)
         uniform += np.add(e[:3], e[3:6])
     assert diffuse_taken > 0 and (diffuse_taken < n or all(lobe.diffuse for lobe in shader.lobes))
     np.testing.assert_allclose(sampled / n, uniform * 4 * np.pi / n, rtol=0.03)

@@ -4,7 +4,7 @@ finite at grazing views and at roughness 0 and 1."""
 import numpy as np
 import pytest
 
-from drt_engine.core.bsdf import layout, mixture, sheen
+from drt_engine.core.bsdf import mixture, sheen
 from drt_engine.core.bsdf.shader import MaterialShader
 from drt_engine.core.bsdf.tables import locate
 from drt_engine.core.scene import Closure, Material
@@ -64,12 +64,12 @@ def test_samples_follow_the_density(rough, cos_o):
     wo = _wo(cos_o)
     n = 40000
     sel = np.empty((1, len(shader.lobes)))
-    mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[2], sel, 0, layout.SAMPLE_DIFFUSE)
+    mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[2], sel, 0, True)
     u = RNG.random((n, 3))
     wi = np.zeros((n, 3))
     for i in range(n):
         s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo, *u[i], False, sel, 0,
-                                 layout.SAMPLE_DIFFUSE, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
+                                 True, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         wi[i] = s[0:3]
         if s[8]:
             f, _, _, p = _eval(shader, wo, wi[i])

@@ -3,7 +3,7 @@ density integrates to one over it, and the intensity is Cycles' (bsdf_toon.h).""
 import numpy as np
 import pytest
 
-from drt_engine.core.bsdf import layout, mixture
+from drt_engine.core.bsdf import mixture
 from drt_engine.core.bsdf.shader import MaterialShader, toon_angles
 from drt_engine.core.scene import Closure, Material
 
@@ -49,12 +49,12 @@ def _sample(shader, kind, wo):
     """Sample through the mixture (the diffuse toon as with diffuse bounces on): (wi, weight, pdf, valid)."""
     n = len(wo)
     out = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), np.zeros(n, bool)
-    bits = layout.SAMPLE_DIFFUSE if kind == "DIFFUSE_TOON" else 0
-    sel = np.empty((1, len(shader.lobes) if bits else len(shader.sampled)))
+    diffuse = kind == "DIFFUSE_TOON"
+    sel = np.empty((1, len(shader.lobes) if diffuse else len(shader.sampled)))
     u = RNG.random((n, 3))
     for i in range(n):
-        mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, bits)
-        s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *u[i], False, sel, 0, bits,
+        mixture.selection(shader.lp, shader.lt, shader.hp, 0, shader.mu, wo[i, 2], sel, 0, diffuse)
+        s = mixture.sample_lobes(shader.lp, shader.lt, shader.hp, 0, shader.mu, *wo[i], *u[i], False, sel, 0, diffuse,
                                  0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         out[0][i], out[1][i], out[2][i], out[3][i] = s[0:3], s[3:6], s[6], s[8]
         assert not s[7] and s[10] == (kind == "DIFFUSE_TOON")  # neither is a delta; the diffuse one is diffuse

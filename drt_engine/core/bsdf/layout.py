@@ -12,11 +12,6 @@ DIFFUSE, REFLECT, GLASS, TRANSPARENT, TRANSLUCENT, OREN_NAYAR, TOON_DIFFUSE, TOO
 F_DIELECTRIC, F_F82, F_TINT, F_FILM, F_F82_FILM = 0, 1, 2, 3, 4  # F_FILM: thin film over a dielectric
 SHEEN = 8
 HAIR_REFLECTION, HAIR_TRANSMISSION, HAIR_CHIANG, HAIR_HUANG = 9, 10, 11, 12
-# whether a path may continue through the diffuse reflections at a hit (``mixture``'s ``diffuse``
-# bits): without, the lobe choice covers the others alone (slots P_SAMPLED, translucent included:
-# its ray is a transmission bounce); with, it covers every lobe (slot = lobe index)
-SAMPLE_DIFFUSE = 1
-
 # lp: constants per lobe
 P_KIND = 0
 P_DELTA = 1  # 1: sampled as a delta distribution (see shader.Lobe.delta)

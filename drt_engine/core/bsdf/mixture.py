@@ -27,8 +27,8 @@ from .diffuse import cosine_sample, diffuse_eval
 from .diffuse_normal import into, out_of, tilted
 from .glass import glass_eval, glass_sample, lobe_eta
 from .hair_lobes import files_as_transmission, hair_lobe_eval, hair_lobe_sample, is_hair
-from .layout import (DIFFUSE, H_NORMAL, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT,
-                     SAMPLE_DIFFUSE, SHEEN, TOON_DIFFUSE, TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
+from .layout import (DIFFUSE, H_NORMAL, P_KIND, P_OWN_NORMAL, P_SAMPLED, REFLECT, SHEEN, TOON_DIFFUSE,
+                     TOON_GLOSSY, TRANSLUCENT, TRANSPARENT)
 from .oren_nayar import oren_nayar_eval
 from .passes import diffuse_kind
 from .reflection import own_reflect_eval, own_reflect_sample, reflect_eval, reflect_sample
@@ -45,11 +45,11 @@ counts it for lights), the others' reflection and their transmission."""
 
 @kernel(inline="always")
 def slot(lp, l, diffuse):
-    """Lobe l's place in the lobe choice at a hit whose path may continue through the diffuse
-    reflections where ``diffuse`` (layout.SAMPLE_DIFFUSE) says so, -1 where no ray continues through
-    it: without, P_SAMPLED (every lobe but the diffuse reflections, as without diffuse bounces), with,
-    the lobe's own index."""
-    return l if diffuse != 0 else int(lp[l, P_SAMPLED])
+    """Lobe l's place in the lobe choice at a hit, -1 where no ray continues through it: where paths
+    may continue through the diffuse reflections (``diffuse``, the flag every function here takes
+    with the choice), the lobe's own index; where not, P_SAMPLED (every lobe but the diffuse
+    reflections, as without diffuse bounces; a translucent's ray is a transmission bounce, taken)."""
+    return l if diffuse else int(lp[l, P_SAMPLED])
 
 
 @kernel(inline="always")
@@ -84,10 +84,10 @@ def selection(lp, lt, hp, r, mu, mu_o, sel, si, diffuse):
 
 @kernel(inline="always")
 def diffuse_selection(lp, lt, hp, r, mu, mu_o, sel, si):
-    """Fill ``sel[si]`` (a slot per lobe, as ``selection`` with SAMPLE_DIFFUSE) with the chance of
+    """Fill ``sel[si]`` (a slot per lobe, as ``selection`` with ``diffuse``) with the chance of
     sampling each diffuse-type lobe by its albedo's largest channel, 0 for every other lobe;
     whether any has weight (core.integrator.world_lobes)."""
-    total, n = _by_albedo(lp, lt, hp, r, mu, mu_o, sel, si, SAMPLE_DIFFUSE, True)
+    total, n = _by_albedo(lp, lt, hp, r, mu, mu_o, sel, si, True, True)
     if not total > 0.0:
         return False
     for l in range(n):
@@ -248,7 +248,7 @@ def sample_lobe(lp, lt, hp, r, j, t, l, wox, woy, woz, u_choice, u0, u1, eta):
 def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel, si, diffuse,
                  sx, sy, sz, model, dx, dy, dz):
     """Continue through one lobe chosen by ``sel[si]`` (``selection`` at wo with the same
-    ``diffuse`` bits): a non-diffuse one, or a diffuse one the bits let paths continue through
+    ``diffuse`` flag): a non-diffuse one, or a diffuse one where the flag lets paths continue through
     (about the diffuse lobes' normal (dx, dy, dz)); (sx, sy, sz, model) the smooth normal as
     ``eval_lobes`` takes it.
 
@@ -277,7 +277,7 @@ def sample_lobes(lp, lt, hp, r, mu, wox, woy, woz, u_select, u0, u1, inside, sel
     u_re = min(max((u_select - lo) / max(p_choice, TINY), 0.0), 1.0 - 1e-12)
     j, t = locate(mu, woz)
     l = choice
-    if diffuse == 0:
+    if not diffuse:
         l = 0
         while int(lp[l, P_SAMPLED]) != choice:
             l += 1

@@ -13,14 +13,14 @@ from .tables import lobe_scale, locate, ms_factor
 @kernel
 def selection_rows(lp, lt, hp, prow, mu, mu_o, out):
     for i in range(len(mu_o)):
-        selection(lp, lt, hp, prow[i], mu, mu_o[i], out, i, 0)
+        selection(lp, lt, hp, prow[i], mu, mu_o[i], out, i, False)
 
 
 @kernel
 def evaluate_rows(lp, lt, hp, prow, mu, wo, wi, above, inside, sel, f_diff, f_nd, pdf):
     for i in range(len(wo)):
         v = eval_lobes(lp, lt, hp, prow[i], mu, wo[i, 0], wo[i, 1], wo[i, 2], wi[i, 0], wi[i, 1], wi[i, 2],
-                       above[i], inside[i], sel, i, 0, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0, -1)
+                       above[i], inside[i], sel, i, False, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0, -1)
         f_diff[i, 0], f_diff[i, 1], f_diff[i, 2] = v[0], v[1], v[2]
         f_nd[i, 0], f_nd[i, 1], f_nd[i, 2] = v[3], v[4], v[5]
         pdf[i] = v[6]
@@ -31,9 +31,9 @@ def sample_rows(lp, lt, hp, prow, mu, wo, u_select, u2, inside, wi, weight, pdf,
                 n_sampled):
     sel = np.empty((1, n_sampled))
     for i in range(len(wo)):
-        selection(lp, lt, hp, prow[i], mu, wo[i, 2], sel, 0, 0)
+        selection(lp, lt, hp, prow[i], mu, wo[i, 2], sel, 0, False)
         v = sample_lobes(lp, lt, hp, prow[i], mu, wo[i, 0], wo[i, 1], wo[i, 2], u_select[i], u2[i, 0], u2[i, 1],
-                         inside[i], sel, 0, 0, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
+                         inside[i], sel, 0, False, 0.0, 0.0, 1.0, 0, 0.0, 0.0, 1.0)
         wi[i, 0], wi[i, 1], wi[i, 2] = v[0], v[1], v[2]
         weight[i, 0], weight[i, 1], weight[i, 2] = v[3], v[4], v[5]
         pdf[i], delta[i], valid[i], passthrough[i] = v[6], v[7], v[8], v[9]

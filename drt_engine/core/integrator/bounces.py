@@ -20,16 +20,16 @@ transparent surfaces; DRT ends it there too). The depths only reach a limit belo
 from __future__ import annotations
 
 from ..base.jit import kernel
-from ..bsdf.layout import SAMPLE_DIFFUSE
 from ..shading.lightpath import DIFFUSE_DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH
 
 
 @kernel(inline="always")
-def diffuse_bits(bounces, j, limit):
-    """The mixture's ``diffuse`` bits at hit j of paths with depths ``bounces`` (core.shading.lightpath)."""
+def diffuse_left(bounces, j, limit):
+    """Whether paths at hit j (depths ``bounces``, core.shading.lightpath) may still continue through
+    the diffuse reflections: the mixture's ``diffuse`` flag."""
     if limit <= 0 or len(bounces) == 0:
-        return 0
-    return SAMPLE_DIFFUSE if bounces[j, DIFFUSE_DEPTH] < limit else 0
+        return False
+    return bounces[j, DIFFUSE_DEPTH] < limit
 
 LIMIT_TRANSPARENCY = ("paths ended by the Glossy or Transmission bounce limit stop at transparent surfaces, "
                       "where Cycles lets them pass on")

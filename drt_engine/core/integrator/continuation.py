@@ -15,7 +15,7 @@ from ..bsdf.mixture import UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, s
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
 from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
-from .bounces import diffuse_bits
+from .bounces import diffuse_left
 from .lightpasses import eval_parts, other_parts, share
 from .world_lobes import COSINE, world_density
 
@@ -51,12 +51,12 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     sel_all = np.empty((1, max(lp.shape[0], 1)))
     sel_world = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
-        bits = diffuse_bits(bounces, j, diffuse_limit)
-        sel = sel_nd if bits == 0 else sel_all
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
+        diffuse_on = diffuse_left(bounces, j, diffuse_limit)
+        sel = sel_all if diffuse_on else sel_nd
+        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, diffuse_on)
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
-                         inside[j], sel, 0, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
+                         inside[j], sel, 0, diffuse_on, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])
         t0, t1, t2 = throughput[j, 0] * s[3], throughput[j, 1] * s[4], throughput[j, 2] * s[5]
         peak = np.maximum(np.maximum(t0, t1), t2)
         go[j] = False
@@ -88,8 +88,8 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
                 dn[j, 1], dn[j, 2])
         if len(first) and first[j] and not s[9]:
             pass_shares(lp, lt, hp, prow[j], mu, wo_l, j, x, y, z, crosses, s[7], side_of(z, crosses, s[10], dn[j, 0],
-                        dn[j, 1]), inside[j], sel, bits, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], s[12], s[13],
-                        s[14], s[15], shares)
+                        dn[j, 1]), inside[j], sel, diffuse_on, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2],
+                        s[12], s[13], s[14], s[15], shares)
         if len(bounces):
             next_bounces[j] = bounces[j]
             if s[9]:
@@ -105,7 +105,7 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
 
 
 @kernel(inline="always")
-def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, bits, sx, sy, sz, model, dx, dy,
+def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, inside, sel, diffuse, sx, sy, sz, model, dx, dy,
                 dz, own, o0, o1, o2, shares):
     """``shares[j]``: the diffuse, glossy and transmission weights of a path continued toward local
     (x, y, z) (on the side ``above`` as the sampling weighed it, core.bsdf.mixture.side_of; the
@@ -128,12 +128,12 @@ def pass_shares(lp, lt, hp, r, mu, wo_l, j, x, y, z, crosses, delta, above, insi
             shares[j, 2 if crosses else 1, c] = shares[j, 5 if crosses else 4, c] = 1.0
         return
     # np.int64(0), not the literal 0: a literal argument would compile eval_parts a second time
-    f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+    f = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, diffuse,
                    np.int64(0), sx, sy, sz, model, dx, dy, dz, own)
-    fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+    fd = eval_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, diffuse,
                     UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model, dx, dy, dz, own)
     # the other lobes' glossy and transmission parts, the sampled hair lobe's by its closure
-    fo = other_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, bits,
+    fo = other_parts(lp, lt, hp, r, mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], x, y, z, above, inside, sel, diffuse,
                      np.int64(0), sx, sy, sz, model, dx, dy, dz, own)
     g0, g1, g2, t0, t1, t2 = fo
     if own >= 0:

@@ -13,12 +13,11 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.layout import SAMPLE_DIFFUSE
 from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, eval_lobes, selection
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_MIS, NO_SHADOW, UNRESTRICTED
-from .bounces import diffuse_bits
+from .bounces import diffuse_left
 from .clamp import clamped, limit_at
 from .lightpasses import add_split, add_weighted, eval_parts, other_parts
 from .mis import power
@@ -127,7 +126,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     """
     rayhit = embree.new_rayhit()
     scratch = np.empty((2, 3, 4))
-    sel_nd = np.empty((1, max(n_sampled, 1)))
+    sel_nd = np.empty((1, n_sampled))  # no column where only diffuse reflections are: no lobe to read
     sel_all = np.empty((1, max(lp.shape[0], 1)))
     sel_rim = np.empty((1, max(lp.shape[0], 1)))
     keep = f_diff.shape[1] > 0
@@ -139,9 +138,9 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     traced = queued = 0
     for j in range(len(pos)):
         first = splitting and passed[path[j]] == 0
-        bits = diffuse_bits(bounces, j, diffuse_limit)
-        sel = sel_nd if bits == 0 else sel_all
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, bits)
+        diffuse_on = diffuse_left(bounces, j, diffuse_limit)
+        sel = sel_all if diffuse_on else sel_nd
+        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, diffuse_on)
         time = times[j] if len(times) else 0.5
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         hx = hy = hz = 0.0
@@ -163,7 +162,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             cd = lx * dn[j, 0] + ly * dn[j, 1] + lz * dn[j, 2]
             above = cd > 0  # the shading hemisphere decides, as in Cycles (of sd->N), not the facet
             f = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                           inside[j], sel, 0, bits, unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS)),
+                           inside[j], sel, 0, diffuse_on, unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS)),
                            sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2], -1)
             d0, d1, d2, n0, n1, n2 = f[0], f[1], f[2], f[3], f[4], f[5]
             if keep:
@@ -172,10 +171,10 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             wd = 1.0  # the diffuse lobes light-sampled alone take it all, but on the wrong side
             if (wx * ng[j, 0] + wy * ng[j, 1] + wz * ng[j, 2] < 0.0) == above and not left_out & NO_MIS:
                 if not rim_selected:
-                    selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel_rim, 0, SAMPLE_DIFFUSE)
+                    selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel_rim, 0, True)
                     rim_selected = True
                 every = eval_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                   inside[j], sel_rim, 0, SAMPLE_DIFFUSE, 0, sx, sy, sz, model,
+                                   inside[j], sel_rim, 0, True, 0, sx, sy, sz, model,
                                    dn[j, 0], dn[j, 1], dn[j, 2], -1)
                 w = wd = power(cycles_pdf[k, j], every[6])
             mask = masks[k, j] if masking else shadow_mask
@@ -188,15 +187,15 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
             if first:
                 unlit = unlit_parts(restrict, k) | (left_out & ~(NO_SHADOW | NO_MIS))
                 fd = eval_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                inside[j], sel, bits, unlit | UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz, model,
-                                dn[j, 0], dn[j, 1], dn[j, 2], np.int64(-1))
+                                inside[j], sel, diffuse_on, unlit | UNLIT_REFLECTION | UNLIT_TRANSMISSION, sx, sy, sz,
+                                model, dn[j, 0], dn[j, 1], dn[j, 2], np.int64(-1))
                 e0 = throughput[j, 0] * v0 * (fd[0] * wd + fd[3] * w)
                 e1 = throughput[j, 1] * v1 * (fd[1] * wd + fd[4] * w)
                 e2 = throughput[j, 2] * v2 * (fd[2] * wd + fd[5] * w)
                 # the other lobes' glossy and transmission parts, each its own evaluation, exactly 0
                 # where the BSDF has none
                 fo = other_parts(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], lx, ly, lz, above,
-                                 inside[j], sel, bits, unlit, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2],
+                                 inside[j], sel, diffuse_on, unlit, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2],
                                  np.int64(-1))
                 h0, h1, h2 = throughput[j, 0] * v0 * fo[0] * w, throughput[j, 1] * v1 * fo[1] * w, \
                     throughput[j, 2] * v2 * fo[2] * w

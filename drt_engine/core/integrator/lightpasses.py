@@ -106,29 +106,29 @@ def share(part, total):
 
 
 @kernel
-def eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, unlit, sx, sy, sz, model,
+def eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, diffuse, unlit, sx, sy, sz, model,
                dx, dy, dz, skip):
     """core.bsdf.mixture.eval_lobes with the parts ``unlit`` leaves out (and lobe ``skip``, -1: none): a
     call, not inlined, so the kernels that split contributions by lobe kind hold one more copy of the
     mixture, not one per use."""
-    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, 0, bits, unlit, sx, sy, sz,
+    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, 0, diffuse, unlit, sx, sy, sz,
                       model, dx, dy, dz, skip)
 
 
 @kernel(inline="always")
-def other_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, unlit, sx, sy, sz, model,
+def other_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, diffuse, unlit, sx, sy, sz, model,
                 dx, dy, dz, skip):
     """(Glossy RGB, Transmission RGB): the non-diffuse lobes' BSDF times |cos| toward wi without the
     parts ``unlit`` leaves out, each its own evaluation. A lobe's light on wo's side (``above``) is
     glossy, through the surface transmission; a hair lobe's goes by its closure whatever the side
     (core.bsdf.mixture.eval_lobes), so the other side's part is evaluated where the mixture has hair."""
     near = unlit | UNLIT_DIFFUSE | (UNLIT_TRANSMISSION if above else UNLIT_REFLECTION)
-    f = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, near, sx, sy, sz,
+    f = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, diffuse, near, sx, sy, sz,
                    model, dx, dy, dz, skip)
     o0 = o1 = o2 = 0.0
     if has_hair(lp):
         far = unlit | UNLIT_DIFFUSE | (UNLIT_REFLECTION if above else UNLIT_TRANSMISSION)
-        o = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, bits, far, sx, sy, sz,
+        o = eval_parts(lp, lt, hp, r, mu, wox, woy, woz, wix, wiy, wiz, above, inside, sel, diffuse, far, sx, sy, sz,
                        model, dx, dy, dz, skip)
         o0, o1, o2 = o[3], o[4], o[5]
     if above:

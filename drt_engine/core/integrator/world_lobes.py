@@ -18,7 +18,7 @@ import numpy as np
 
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
-from ..bsdf.layout import DIFFUSE, OREN_NAYAR, P_KIND, SAMPLE_DIFFUSE
+from ..bsdf.layout import DIFFUSE, OREN_NAYAR, P_KIND
 from ..bsdf.mixture import diffuse_selection, eval_lobes, sample_lobes
 
 COSINE = -1.0
@@ -60,7 +60,7 @@ def world_from_lobes(lp, lt, hp, prow, mu, frame, smooth, dn, wo_l, inside, u, k
             continue
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u[j, k, 1, 0], u[j, k, 0, 0],
-                         u[j, k, 0, 1], inside[j], sel, 0, SAMPLE_DIFFUSE, sx, sy, sz, model, dn[j, 0], dn[j, 1],
+                         u[j, k, 0, 1], inside[j], sel, 0, True, sx, sy, sz, model, dn[j, 0], dn[j, 1],
                          dn[j, 2])
         x, y, z = s[0], s[1], s[2]
         wi[j, 0] = x * frame[j, 0, 0] + y * frame[j, 1, 0] + z * frame[j, 2, 0]
@@ -78,5 +78,5 @@ def world_density(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel,
     core.bsdf.mixture.side_of), or COSINE where it leaves the world's cosine sample."""
     if not _drawn_from_lobes(lp, lt, hp, r, mu, woz, sel):
         return COSINE
-    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, 0, SAMPLE_DIFFUSE, 0, sx, sy, sz,
+    return eval_lobes(lp, lt, hp, r, mu, wox, woy, woz, x, y, z, above, inside, sel, 0, True, 0, sx, sy, sz,
                       model, dx, dy, dz, -1)[6]
