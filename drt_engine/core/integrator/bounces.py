@@ -6,8 +6,8 @@ sheen) while it has taken fewer than k of them (Cycles' path_state_next, whose k
 setting + 1: with k = 0 a diffuse surface gets direct light only, DRT's classic image). A
 translucent lobe is a diffuse transmission, which Cycles counts as a transmission bounce: it is
 sampled as a glossy lobe is, whatever the diffuse bounces (core.bsdf.shader.Lobe.bounces_diffuse).
-The answer is the ``diffuse`` bits of core.bsdf.mixture, 0 where paths carry no depths (diffuse
-bounces 0).
+The answer is the ``diffuse`` flag of core.bsdf.mixture, False where paths carry no depths
+(diffuse bounces 0); ``lobe_choice`` fills the lobe choice it allows.
 
 The glossy and transmission limits work as Cycles' path_state_next: every lobe is sampled as
 usual, and a bounce that takes the path's glossy (non-diffuse reflection) or transmission depth
@@ -19,7 +19,10 @@ transparent surfaces; DRT ends it there too). The depths only reach a limit belo
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..base.jit import kernel
+from ..bsdf.mixture import selection
 from ..shading.lightpath import DIFFUSE_DEPTH, GLOSSY_DEPTH, TRANSMISSION_DEPTH
 
 
@@ -30,6 +33,23 @@ def diffuse_left(bounces, j, limit):
     if limit <= 0 or len(bounces) == 0:
         return False
     return bounces[j, DIFFUSE_DEPTH] < limit
+
+
+@kernel(inline="always")
+def lobe_choices(lp, n_sampled):
+    """Room for ``lobe_choice``: a row over the lobes paths may continue through without the diffuse
+    reflections (``n_sampled``; none where only diffuse reflections are: no lobe to read), one over every lobe."""
+    return np.empty((1, n_sampled)), np.empty((1, max(lp.shape[0], 1)))
+
+
+@kernel(inline="always")
+def lobe_choice(lp, lt, hp, r, mu, mu_o, choices, bounces, j, limit):
+    """(The lobe choice at hit j, filled by core.bsdf.mixture's ``selection``, the ``diffuse_left`` flag
+    it was filled with), in one of ``choices`` (``lobe_choices``)."""
+    diffuse = diffuse_left(bounces, j, limit)
+    sel = choices[1] if diffuse else choices[0]
+    selection(lp, lt, hp, r, mu, mu_o, sel, 0, diffuse)
+    return sel, diffuse
 
 LIMIT_TRANSPARENCY = ("paths ended by the Glossy or Transmission bounce limit stop at transparent surfaces, "
                       "where Cycles lets them pass on")

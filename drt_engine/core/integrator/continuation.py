@@ -11,11 +11,11 @@ import numpy as np
 from ..base.jit import kernel
 from ..bsdf.bump_shadowing import smooth_local
 from ..bsdf.hair_lobes import files_as_transmission
-from ..bsdf.mixture import UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, selection, side_of
+from ..bsdf.mixture import UNLIT_REFLECTION, UNLIT_TRANSMISSION, sample_lobes, side_of
 from ..geometry.accel import spawn_point
 from ..shading.lightpath import DEPTH, DIFFUSE, DIFFUSE_DEPTH, GLOSSY, GLOSSY_DEPTH, KIND, REFLECT, SINGULAR
 from ..shading.lightpath import TRANSMISSION_DEPTH, TRANSMIT, TRANSPARENT_DEPTH
-from .bounces import diffuse_left
+from .bounces import lobe_choice, lobe_choices
 from .lightpasses import eval_parts, other_parts, share
 from .world_lobes import COSINE, world_density
 
@@ -47,13 +47,10 @@ def continue_paths(lp, lt, hp, prow, mu, n_sampled, frame, smooth, dn, wo_l, ins
     diffuse lobes' and the other lobes' reflection's shares of the BSDF toward the new direction
     (Cycles' bsdf_eval_pass_*_weight), a delta lobe's whole by its side.
     Shader and hits as core.integrator.direct has them."""
-    sel_nd = np.empty((1, n_sampled))  # no column where only diffuse reflections are: no lobe to read
-    sel_all = np.empty((1, max(lp.shape[0], 1)))
+    choices = lobe_choices(lp, n_sampled)
     sel_world = np.empty((1, max(lp.shape[0], 1)))
     for j in range(len(wo_l)):
-        diffuse_on = diffuse_left(bounces, j, diffuse_limit)
-        sel = sel_all if diffuse_on else sel_nd
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, diffuse_on)
+        sel, diffuse_on = lobe_choice(lp, lt, hp, prow[j], mu, wo_l[j, 2], choices, bounces, j, diffuse_limit)
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         s = sample_lobes(lp, lt, hp, prow[j], mu, wo_l[j, 0], wo_l[j, 1], wo_l[j, 2], u_select[j], u2[j, 0], u2[j, 1],
                          inside[j], sel, 0, diffuse_on, sx, sy, sz, model, dn[j, 0], dn[j, 1], dn[j, 2])

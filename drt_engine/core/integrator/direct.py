@@ -17,7 +17,7 @@ from ..bsdf.mixture import UNLIT_DIFFUSE, UNLIT_REFLECTION, UNLIT_TRANSMISSION, 
 from ..geometry import embree
 from ..geometry.accel import blocked, lift, spawn_point
 from ..lights.strategies import NO_MIS, NO_SHADOW, UNRESTRICTED
-from .bounces import diffuse_left
+from .bounces import lobe_choice, lobe_choices
 from .clamp import clamped, limit_at
 from .lightpasses import add_split, add_weighted, eval_parts, other_parts
 from .mis import power
@@ -126,8 +126,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     """
     rayhit = embree.new_rayhit()
     scratch = np.empty((2, 3, 4))
-    sel_nd = np.empty((1, n_sampled))  # no column where only diffuse reflections are: no lobe to read
-    sel_all = np.empty((1, max(lp.shape[0], 1)))
+    choices = lobe_choices(lp, n_sampled)
     sel_rim = np.empty((1, max(lp.shape[0], 1)))
     keep = f_diff.shape[1] > 0
     see_through = len(clear) > 0
@@ -138,9 +137,7 @@ def direct_light(lp, lt, hp, prow, mu, n_sampled, pos, ng, frame, smooth, dn, wo
     traced = queued = 0
     for j in range(len(pos)):
         first = splitting and passed[path[j]] == 0
-        diffuse_on = diffuse_left(bounces, j, diffuse_limit)
-        sel = sel_all if diffuse_on else sel_nd
-        selection(lp, lt, hp, prow[j], mu, wo_l[j, 2], sel, 0, diffuse_on)
+        sel, diffuse_on = lobe_choice(lp, lt, hp, prow[j], mu, wo_l[j, 2], choices, bounces, j, diffuse_limit)
         time = times[j] if len(times) else 0.5
         sx, sy, sz, model = smooth_local(smooth, frame, j)
         hx = hy = hz = 0.0
