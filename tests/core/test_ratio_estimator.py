@@ -177,17 +177,21 @@ def test_film_reads_combined_resolved():
     assert np.allclose(images["Noise"][0, 0], np.abs(half_a - half_b) / 2)
 
 
-def test_diffuse_bounces_set_the_ratio_estimator_aside_only_for_diffuse_reflections():
-    """With diffuse bounces a diffuse reflection's direct light is weighed against its rays, which the
-    ratio estimator does not do, so it stands aside; a Translucent's rays are traced whatever the
-    diffuse bounces (Lobe.bounces_diffuse), so a scene whose only diffuse lobes are Translucent keeps
-    the plan it has at diffuse bounces 0."""
+def test_the_ratio_estimator_takes_lambertian_materials_without_diffuse_bounces():
+    """The ratio estimator's closed form is of Lambert's cosine (MaterialShader.lambertian): a scene with
+    no Lambertian material gives it nothing to take, so the plan names no strategy for it. With
+    diffuse bounces a diffuse reflection's direct light is weighed against its rays, which the ratio
+    estimator does not do, so it stands aside; a Translucent's rays are traced whatever the diffuse
+    bounces (Lobe.bounces_diffuse), and only they name diffuse rays at diffuse bounces 0."""
     scene, base = soft_shadow_scene(16)
 
-    def ratio(closure, diffuse_bounces):
+    def plan(closure, diffuse_bounces):
         materials = [replace(m, closures=[Closure(closure, color=(0.6, 0.6, 0.6))]) for m in scene.materials]
         settings = RenderSettings(samples=1, shadow_estimator="RATIO", diffuse_bounces=diffuse_bounces, **base)
-        return Renderer(replace(scene, materials=materials), settings).plan.ratio
+        return Renderer(replace(scene, materials=materials), settings).plan
 
-    assert ratio("TRANSLUCENT", 1) == ratio("TRANSLUCENT", 0) != []
-    assert ratio("DIFFUSE", 0) != [] and ratio("DIFFUSE", 1) == []
+    for closure in ("TRANSLUCENT", "GLOSSY"):
+        assert plan(closure, 0).ratio == plan(closure, 1).ratio == []
+    assert plan("TRANSLUCENT", 0).rays["diffuse"] and not plan("DIFFUSE", 0).rays["diffuse"]
+    assert plan("DIFFUSE", 1).rays["diffuse"]
+    assert plan("DIFFUSE", 0).ratio != [] and plan("DIFFUSE", 1).ratio == []

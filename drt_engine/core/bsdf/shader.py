@@ -112,6 +112,11 @@ class Lobe:
         return self.diffuse and self.kind != "translucent"
 
     @property
+    def transmits_diffuse(self) -> bool:
+        """A diffuse transmission (translucent), whose rays continue whatever the diffuse bounces."""
+        return self.diffuse and not self.bounces_diffuse
+
+    @property
     def alpha_t(self) -> float:
         """Spread of the refracted directions of a glass lobe (alpha scaled by the bend)."""
         return self.alpha * min(1.0, abs(self.eta - 1.0))
@@ -672,8 +677,10 @@ class MaterialShader:
 
     @property
     def lambertian(self) -> bool:
-        """Its diffuse part is Lambert about the shading normal (no Oren-Nayar, no translucent lobe)."""
-        return all(lobe.kind == "diffuse" for lobe in self.lobes if lobe.diffuse)
+        """It has a diffuse part, and that is Lambert about the shading normal (no Oren-Nayar, no
+        translucent lobe): what the ratio estimator's closed form is of (core.integrator.ratio)."""
+        diffuse = [lobe.kind for lobe in self.lobes if lobe.diffuse]
+        return bool(diffuse) and all(kind == "diffuse" for kind in diffuse)
 
     def bind(self, values: dict) -> "MaterialShader":
         """A copy whose lobes take per-hit values: ``values[closure index]`` maps "weight" and

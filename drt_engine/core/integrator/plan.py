@@ -79,7 +79,7 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     # diffuse reflections bounce with diffuse bounces on; a translucent lobe's ray (a diffuse
     # transmission, counted as a transmission bounce as Cycles does) always (Lobe.bounces_diffuse)
     reflected = bounces and settings.diffuse_bounces > 0 and any(lobe.bounces_diffuse for lobe in lobes)
-    transmitted = bounces and any(lobe.diffuse and not lobe.bounces_diffuse for lobe in lobes)
+    transmitted = bounces and any(lobe.transmits_diffuse for lobe in lobes)
     rays = {"camera": True,
             "shadow": lights.strategies > 0 and bool(kinds),
             "reflection": bounces and bool(kinds & REFLECTING),
@@ -114,10 +114,12 @@ def make_plan(scene, settings, geometry, lights, shaders) -> RenderPlan:
     dropped = len(scene.lights) - len(lights.lights)
     if dropped:
         left_out.append(f"{dropped} lights of zero power")
-    # the ratio estimator takes diffuse direct light as light sampling alone, which with
-    # diffuse bounces is weighed against the diffuse rays, and a shadow ray's visibility as all
-    # or nothing, which transparent shadows are not (Monte Carlo then)
-    ratio = (ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and not reflected
+    # the ratio estimator takes the direct light of Lambertian materials (none in use: nothing for
+    # it) as light sampling alone, which with diffuse bounces is weighed against the diffuse rays,
+    # and a shadow ray's visibility as all or nothing, which transparent shadows are not (Monte
+    # Carlo then)
+    lambert = any(shaders[m].lambertian for m in used)
+    ratio = (ratio_strategies(lights, settings.shadow_estimator) if rays["shadow"] and lambert and not reflected
              and not clear else [])
     by_ratio = settings.shadow_estimator == "RATIO"
     monte_carlo = [name for k, name in enumerate(strategies) if k not in ratio] if by_ratio else []
