@@ -180,23 +180,25 @@ class Renderer:
         return ((index % w + x0) + (index // w + y0) * self.camera.resolution[0]).astype(np.uint32)
 
     def _trace(self, samples: Samples, sampler, replicate, pool):
-        """Trace a wave, split into one contiguous piece per thread, and add it to the film.
+        """Trace a wave, split into one interleaved piece per thread, and add it to the film.
 
-        Every path depends only on its own (pixel, sample) and Embree answers each ray alone,
-        so the pieces give the values one piece would, and the film receives them in the
-        same order in one call: the image is bit-identical for any thread count. Each piece
-        runs the whole loop (kernels, NumPy's array loops and Embree release the GIL).
+        Piece i takes every ``pieces``-th sample from i: a wave holds the image in pixel order,
+        and contiguous pieces gave one thread the image's top and the other its bottom, whose
+        costs differ (one thread idle while the other finished). Every path depends only on its
+        own (pixel, sample) and Embree answers each ray alone, so the pieces give the values one
+        piece would, and the film receives them in the wave's order in one call: the image is
+        bit-identical for any thread count. Each piece runs the whole loop (kernels, NumPy's
+        array loops and Embree release the GIL).
         """
         n = len(samples)
         pieces = min(self.threads, max(1, n // _MIN_PIECE))
         if pieces == 1:
             values = self.integrator.trace(samples, sampler)
         else:
-            bounds = np.linspace(0, n, pieces + 1).astype(np.int64)
-            jobs = [pool.submit(self.integrator.trace, samples.take(slice(a, b)), sampler)
-                    for a, b in zip(bounds[:-1], bounds[1:])]
+            rows = [np.arange(i, n, pieces) for i in range(pieces)]
+            jobs = [pool.submit(self.integrator.trace, samples.take(r), sampler) for r in rows]
             parts = [job.result() for job in jobs]
-            values = {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
+            values = {name: _interleaved(rows, [part[name] for part in parts]) for name in parts[0]}
         self.film.add(samples.index, values, samples.sample, replicate=replicate)
 
     def _result(self, outcome) -> RenderResult:
@@ -252,3 +254,11 @@ class Renderer:
         if last is not None:
             last.update(found)
         return denoised_passes(passes, self._denoised[1], s.passes)
+
+
+def _interleaved(rows: list, parts: list) -> np.ndarray:
+    """One array of the pieces' rows put back where ``rows`` took them from."""
+    out = np.empty((sum(len(p) for p in parts),) + parts[0].shape[1:], parts[0].dtype)
+    for r, part in zip(rows, parts):
+        out[r] = part
+    return out
