@@ -21,6 +21,7 @@
 #   make node-parity DRT vs Cycles per shader node case and closure (bench/node_parity.py: docs/shader-node-parity.md)
 #   make sky-parity-4.2 the Sky Texture's cases against Blender 4.2's Cycles (Nishita; same page)
 #   make scene-parity DRT vs Cycles per scene setting: shadows, visibility, holdout, catcher, linking, groups, cameras (bench/scene_parity.py: docs/scene-parity.md)
+#   make gi-pair     the README's Cornell box with diffuse bounces, DRT and Cycles side by side (bench/gi_pair.py)
 #   make venv        only create .venv (Python 3.11) with the pinned requirements
 #   make clean       remove out/, dist/ and caches; make distclean also removes the venvs and wheels/
 #   make blender-env build (once, cached in BLENDER_ENV) a Debian 13 root with Blender 4.3.2; needs root
@@ -61,7 +62,7 @@ KERNELS ?= ship
 # Blender's extension tool ships inside the bpy wheel; expanded when a recipe runs (after the venv exists).
 BLENDER_EXT = $(PY) $(firstword $(wildcard $(VENV)/lib/python3.11/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py))
 
-.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-instances bench-ratio bench-denoise bench-farm texture-parity node-parity sky-parity-4.2 scene-parity clean distclean blender-env test-blender
+.PHONY: help venv render test test-versions extension scenes bench bench-throughput bench-instances bench-ratio bench-denoise bench-farm texture-parity node-parity sky-parity-4.2 scene-parity gi-pair clean distclean blender-env test-blender
 
 help:
 	@sed -n 's/^#   //p' Makefile
@@ -176,3 +177,6 @@ sky-parity-4.2: $(VENV)-4.2/.drt-requirements-installed
 
 scene-parity: $(STAMP)
 	$(PY) bench/scene_parity.py
+
+gi-pair: $(STAMP)
+	$(PY) bench/gi_pair.py
