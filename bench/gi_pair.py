@@ -2,11 +2,11 @@
 
 cornell_box rendered by Blender (``bpy.ops.render.render``) with DRT at diffuse bounces 0 (the
 classic image) and 4, and with Cycles at 4, configured as the parity tests configure it
-(tests.support.render_helpers.configure_cycles: the same Light Paths and pixel filter, no
-denoising, no adaptive sampling). Each result is saved through the scene's colour management as a
-PNG in docs/images/ and as a linear EXR, whose Combined means go into the caption.
+(tests.support.render_helpers.render: the same Light Paths and pixel filter, no denoising, no
+adaptive sampling). Each result is read back from its linear EXR, whose Combined means go into the
+caption, and saved through the scene's colour management as a PNG in docs/images/.
 Writes README's block ``bench:gi-pair``.
-Run: python bench/gi_pair.py [--width 256] [--samples 256]
+Run: make gi-pair, or python bench/gi_pair.py [--width 256] [--samples 256]
 """
 from __future__ import annotations
 
@@ -25,33 +25,27 @@ import drt_engine  # noqa: E402
 from blocks import write_block  # noqa: E402
 from drt_engine.headless.cli import exit_now  # noqa: E402
 from scenes import load  # noqa: E402
-from tests.support.render_helpers import configure_cycles, read_channels  # noqa: E402
+from tests.support.render_helpers import render  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
 BOUNCES = 4
 RENDERS = (("DRT", 0), ("DRT", BOUNCES), ("CYCLES", BOUNCES))
+NAMES = {"DRT": "DRT", "CYCLES": "Cycles"}
 
 
-def render(scene, engine: str, bounces: int, samples: int, folder: Path) -> tuple[Path, np.ndarray]:
-    """The PNG of one render in docs/images/ and its linear Combined RGB."""
-    scene.drt.diffuse_bounces = bounces
-    scene.drt.samples = samples
-    scene.drt.use_adaptive_sampling = False
+def shot(scene, engine: str, bounces: int, samples: int, folder: Path) -> tuple[Path, np.ndarray]:
+    """One render (the tests' ``render``: its EXR read back) as a PNG in docs/images/, and its linear
+    Combined RGB."""
+    scene.drt.diffuse_bounces = bounces  # Cycles' too: configure_cycles copies DRT's Light Paths
     scene.drt.use_denoising = False
-    scene.drt.seed = 0
-    configure_cycles(scene, samples, 0)
-    scene.render.engine = engine
-    bpy.ops.render.render(scene=scene.name)
-    result = bpy.data.images["Render Result"]
+    combined = render(scene, engine, samples, 0, folder, name=f"diffuse{bounces}").passes["Combined"]
     png = IMAGES / f"cornell_box_{engine.lower()}_diffuse{bounces}.png"
-    exr = folder / f"{engine}_{bounces}.exr"
     settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):  # Blender 5.0+
+        settings.media_type = "IMAGE"
     settings.file_format, settings.color_mode, settings.color_depth = "PNG", "RGB", "8"
-    result.save_render(str(png), scene=scene)
-    settings.file_format, settings.color_mode, settings.color_depth = "OPEN_EXR", "RGBA", "32"
-    result.save_render(str(exr), scene=scene)
-    channels = read_channels(exr)
-    return png, np.stack([channels[c] for c in "RGB"], axis=-1).astype(np.float64)
+    bpy.data.images["Render Result"].save_render(str(png), scene=scene)
+    return png, combined[..., :3].astype(np.float64)
 
 
 def main(argv=None):
@@ -61,17 +55,16 @@ def main(argv=None):
     args = parser.parse_args(argv)
     drt_engine.register()
     scene, _ = load("cornell_box", args.width)
-    scene.render.image_settings.media_type = "IMAGE"
     with tempfile.TemporaryDirectory() as folder:
-        shots = {(engine, b): render(scene, engine, b, args.samples, Path(folder)) for engine, b in RENDERS}
+        shots = {(engine, b): shot(scene, engine, b, args.samples, Path(folder)) for engine, b in RENDERS}
     drt, cycles = shots["DRT", BOUNCES][1].mean(), shots["CYCLES", BOUNCES][1].mean()
     classic = shots["DRT", 0][1].mean()
-    cells = [f"![cornell_box, {'DRT' if e == 'DRT' else 'Cycles'}, diffuse bounces {b}](docs/images/{p.name})"
-             for (e, b), (p, _) in shots.items()]
+    labels = [f"{NAMES[e]}, diffuse bounces {b}" for e, b in RENDERS]
     text = "\n".join([
-        f"| DRT, diffuse bounces 0 | DRT, diffuse bounces {BOUNCES} | Cycles, diffuse bounces {BOUNCES} |",
-        "|---|---|---|",
-        "| " + " | ".join(cells) + " |",
+        "| " + " | ".join(labels) + " |",
+        "|---" * len(labels) + "|",
+        "| " + " | ".join(f"![cornell_box, {label}](docs/images/{shots[key][0].name})"
+                          for key, label in zip(RENDERS, labels)) + " |",
         "",
         f"cornell_box at {scene.render.resolution_x}x{scene.render.resolution_y}, {args.samples} samples per "
         f"pixel, no denoising, each saved through the scene's colour management (`make gi-pair`). "
