@@ -8,7 +8,8 @@
 #                    one with compiled kernels (tools/ship_kernels.py; KERNELS= leaves them out)
 #   make scenes      rebuild the sample .blend files from their scripts
 #   make bench       DRT vs Cycles error against time (bench/run.py: bench/results/, bench/RESULTS.md,
-#                    bench/plots/), then ray throughput and memory; about an hour on 2 cores
+#                    bench/plots/), then ray throughput and memory, instances, the ratio estimator and
+#                    where a render's time goes per kernel (bench/render_time.py); about 30 minutes on 2 cores
 #   make bench-throughput  only DRT vs raw Embree rays/s and peak memory (bench/throughput.py)
 #   make bench-instances  a floor of 1,000 and 10,000 pebble instances, DRT vs Cycles time and memory
 #                    (bench/instances.py: docs/performance.md)
@@ -131,6 +132,7 @@ bench: $(STAMP)
 	$(PY) bench/throughput.py
 	$(PY) bench/instances.py
 	$(PY) bench/ratio_estimator.py --publish
+	$(PY) bench/render_time.py --publish
 
 bench-throughput: $(STAMP)
 	$(PY) bench/throughput.py

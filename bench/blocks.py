@@ -17,6 +17,7 @@ PAGES = {  # bench:NAME block -> the docs page (or the README) that holds it
     "throughput": DOCS / "performance.md",
     "preview-times": DOCS / "performance.md",
     "instances": DOCS / "performance.md",
+    "render-time": DOCS / "performance.md",
     "adaptive-calibration": DOCS / "adaptive-sampling.md",
     "adaptive-calibration-gi": DOCS / "adaptive-sampling.md",
     "adaptive-gain": DOCS / "adaptive-sampling.md",
