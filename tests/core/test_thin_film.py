@@ -1,7 +1,12 @@
 """Thin-film Fresnel (core.bsdf.thin_film): its limits (no thickness or a film of the outside's IOR
 is plain Fresnel, a film over a metal of the outside's IOR is the bare F82 metal), reflectance in
 [0, 1] and finite everywhere, the Fourier-space sum against a direct spectral integration of the
-Airy reflectance, and Principled lobes that take the film, with no cost when there is none."""
+Airy reflectance, and Principled lobes that take the film, with no cost when there is none (the
+sensitivity table not even made at import)."""
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -37,6 +42,17 @@ def test_a_film_of_the_outsides_ior_over_metal_is_the_bare_metal():
 
 def test_sensitivity_is_one_at_zero_path_difference():
     assert np.allclose(tf.SENSITIVITY[:3, 0], 1.0) and np.allclose(tf.SENSITIVITY[3:, 0], 0.0)
+
+
+def test_the_sensitivity_table_is_made_on_first_use_only():
+    """Importing the renderer (every lobe module) does not make it (0.6 s of CPU in each process);
+    reading it makes it once, as sensitivity_table() makes it."""
+    check = ("import drt_engine.core.render.render, drt_engine.core.bsdf.thin_film as tf; "
+             "print('SENSITIVITY' in vars(tf))")
+    out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True,
+                         cwd=Path(__file__).resolve().parents[2], check=True)
+    assert out.stdout.split() == ["False"]
+    assert tf.SENSITIVITY is tf.sensitivity() and np.array_equal(tf.SENSITIVITY, tf.sensitivity_table())
 
 
 THICKNESS = [0.0, 0.05, 0.5, 1.0, 30.0, 500.0, 1e4, 1e7]

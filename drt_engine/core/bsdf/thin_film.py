@@ -59,7 +59,20 @@ def sensitivity_table(size: int = TABLE_SIZE) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([s.real.T, s.imag.T]))
 
 
-SENSITIVITY = sensitivity_table()
+def sensitivity() -> np.ndarray:
+    """``SENSITIVITY``, made on first use and kept: it costs 0.6 s of CPU, which a process whose
+    kernels load from the cache and whose materials have no film never needs."""
+    table = globals().get("SENSITIVITY")
+    if table is None:
+        table = globals()["SENSITIVITY"] = sensitivity_table()
+    return table
+
+
+def __getattr__(name: str):
+    """``tf.SENSITIVITY`` (what the kernels read, when they compile) through ``sensitivity()``."""
+    if name == "SENSITIVITY":
+        return sensitivity()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @kernel(inline="always")
@@ -230,7 +243,7 @@ def dielectric(cos_i, thickness: float, film_ior: float, eta: float, tint=np.one
     """(N, 3) ``film_dielectric`` with Cycles' specular ``tint`` over an array of cosines (tables)."""
     cos_i = np.ascontiguousarray(np.atleast_1d(cos_i), np.float64)
     out = np.empty((len(cos_i), 3))
-    _dielectric_rows(SENSITIVITY, cos_i, float(thickness), float(film_ior), float(eta),
+    _dielectric_rows(sensitivity(), cos_i, float(thickness), float(film_ior), float(eta),
                      np.ascontiguousarray(tint, np.float64), out)
     return out
 
@@ -239,6 +252,6 @@ def conductor(cos_i, thickness: float, film_ior: float, f0, tint) -> np.ndarray:
     """(N, 3) ``film_conductor`` over an array of cosines (tables)."""
     cos_i = np.ascontiguousarray(np.atleast_1d(cos_i), np.float64)
     out = np.empty((len(cos_i), 3))
-    _conductor_rows(SENSITIVITY, cos_i, float(thickness), float(film_ior), np.ascontiguousarray(f0, np.float64),
+    _conductor_rows(sensitivity(), cos_i, float(thickness), float(film_ior), np.ascontiguousarray(f0, np.float64),
                     np.ascontiguousarray(tint, np.float64), out)
     return out
